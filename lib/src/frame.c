@@ -1,0 +1,235 @@
+/* Command and reply frames, byte by byte; see j288/frame.h for the contract. */
+#include "j288/frame.h"
+
+#include <string.h>
+
+/* Byte offsets on the wire (spec tables). */
+enum {
+    CMD_MODE = 2, CMD_RES = 3, CMD_TAU = 4, CMD_SPEED = 6, CMD_POS = 8, CMD_KP = 12,
+    CMD_KD = 14, CMD_CRC = 16, CMD_CRC_WORDS = 4,
+    RPL_MODE = 2, RPL_TEMP = 3, RPL_SENSOR = 4, RPL_VOL = 5, RPL_TORQUE = 6, RPL_SPEED = 8,
+    RPL_POS = 10, RPL_MERROR = 14, RPL_OUT = 18, RPL_RES = 20, RPL_CRC = 22,
+    RPL_CRC_FIRST = 2, RPL_CRC_WORDS = 5
+};
+
+#define OUT_POS_MASK 0x1FFFu
+#define EXFLAG_SHIFT 13u
+
+/* mode byte: id in bits 0-3, status in bits 4-6, timeout in bit 7. */
+static uint8_t mode_pack(uint8_t id, uint8_t status, bool timeout)
+{
+    return (uint8_t)((unsigned)id | ((unsigned)status << 4) | (timeout ? 0x80u : 0u));
+}
+
+static uint8_t mode_id(uint8_t mode) { return (uint8_t)(mode & 0x0Fu); }
+static uint8_t mode_status(uint8_t mode) { return (uint8_t)((mode >> 4) & 0x07u); }
+static bool mode_timeout(uint8_t mode) { return (mode & 0x80u) != 0u; }
+
+/* Two's complement from the unsigned wire pattern, without implementation-defined casts. */
+static int16_t as_i16(uint16_t u)
+{
+    return (u < 0x8000u) ? (int16_t)u : (int16_t)(-(int32_t)(0x10000u - (uint32_t)u));
+}
+
+static int32_t as_i32(uint32_t u)
+{
+    if (u < 0x80000000u) {
+        return (int32_t)u;
+    }
+    return (int32_t)(-(int32_t)(0xFFFFFFFFu - u)) - 1;
+}
+
+static uint16_t from_i16(int16_t v) { return (uint16_t)v; }
+static uint32_t from_i32(int32_t v) { return (uint32_t)v; }
+
+static int cmd_check(const j288_cmd_raw_t *cmd)
+{
+    if (cmd->id > J288_BROADCAST_ID) {
+        return J288_ERR_BAD_ID;
+    }
+    if (cmd->status > J288_MODE_FOC) {
+        return J288_ERR_BAD_STATUS;
+    }
+    if ((cmd->kp < 0) || (cmd->kd < 0)) {
+        return J288_ERR_NEG_GAIN;
+    }
+    return J288_OK;
+}
+
+int j288_cmd_encode(const j288_cmd_raw_t *cmd, uint8_t out[J288_CMD_LEN], const j288_crc_t *crc)
+{
+    uint8_t f[J288_CMD_LEN];
+    int err;
+
+    if ((cmd == NULL) || (out == NULL)) {
+        return J288_ERR_NULL;
+    }
+    err = cmd_check(cmd);
+    if (err != J288_OK) {
+        return err;
+    }
+    /* Built in a local frame and copied at the end, so out is untouched on any error and
+     * never holds a half-built frame that a DMA could pick up. */
+    f[0] = J288_CMD_HEAD0;
+    f[1] = J288_CMD_HEAD1;
+    f[CMD_MODE] = mode_pack(cmd->id, cmd->status, cmd->watchdog);
+    f[CMD_RES] = 0u;
+    j288_put_u16le(&f[CMD_TAU], from_i16(cmd->tau));
+    j288_put_u16le(&f[CMD_SPEED], from_i16(cmd->speed));
+    j288_put_u32le(&f[CMD_POS], from_i32(cmd->pos));
+    j288_put_u16le(&f[CMD_KP], from_i16(cmd->kp));
+    j288_put_u16le(&f[CMD_KD], from_i16(cmd->kd));
+    j288_put_u32le(&f[CMD_CRC], j288_crc32_run(crc, f, CMD_CRC_WORDS));
+    memcpy(out, f, sizeof f);
+    return J288_OK;
+}
+
+void j288_cmd_unpack(const uint8_t in[J288_CMD_LEN], j288_cmd_raw_t *cmd)
+{
+    uint8_t mode = in[CMD_MODE];
+    cmd->id = mode_id(mode);
+    cmd->status = mode_status(mode);
+    cmd->watchdog = mode_timeout(mode);
+    cmd->reserved = in[CMD_RES];
+    cmd->tau = as_i16(j288_get_u16le(&in[CMD_TAU]));
+    cmd->speed = as_i16(j288_get_u16le(&in[CMD_SPEED]));
+    cmd->pos = as_i32(j288_get_u32le(&in[CMD_POS]));
+    cmd->kp = as_i16(j288_get_u16le(&in[CMD_KP]));
+    cmd->kd = as_i16(j288_get_u16le(&in[CMD_KD]));
+}
+
+uint32_t j288_cmd_crc_expected(const uint8_t in[J288_CMD_LEN], const j288_crc_t *crc)
+{
+    return j288_crc32_run(crc, in, CMD_CRC_WORDS);
+}
+
+uint32_t j288_frame_crc_field(const uint8_t *frame, size_t len)
+{
+    return j288_get_u32le(&frame[len - 4u]);
+}
+
+int j288_cmd_decode(const uint8_t in[J288_CMD_LEN], j288_cmd_raw_t *cmd, const j288_crc_t *crc)
+{
+    if ((in == NULL) || (cmd == NULL)) {
+        return J288_ERR_NULL;
+    }
+    if ((in[0] != J288_CMD_HEAD0) || (in[1] != J288_CMD_HEAD1)) {
+        return J288_ERR_BAD_HEADER;
+    }
+    if (j288_cmd_crc_expected(in, crc) != j288_get_u32le(&in[CMD_CRC])) {
+        return J288_ERR_CRC;
+    }
+    j288_cmd_unpack(in, cmd);
+    return J288_OK;
+}
+
+int j288_reply_encode(const j288_reply_raw_t *reply, uint8_t out[J288_REPLY_LEN],
+                      const j288_crc_t *crc)
+{
+    uint8_t f[J288_REPLY_LEN];
+
+    if ((reply == NULL) || (out == NULL)) {
+        return J288_ERR_NULL;
+    }
+    if (reply->id > J288_MAX_ID) {
+        return J288_ERR_BAD_ID;
+    }
+    if (reply->status > 7u) {
+        return J288_ERR_BAD_STATUS;
+    }
+    if ((reply->out_pos > OUT_POS_MASK) || (reply->warnings > 7u)) {
+        return J288_ERR_RANGE;
+    }
+    f[0] = J288_REPLY_HEAD0;
+    f[1] = J288_REPLY_HEAD1;
+    f[RPL_MODE] = mode_pack(reply->id, reply->status, reply->watchdog_tripped);
+    f[RPL_TEMP] = (uint8_t)reply->case_temp_c;
+    f[RPL_SENSOR] = reply->winding_temp_c;
+    f[RPL_VOL] = reply->voltage_raw;
+    j288_put_u16le(&f[RPL_TORQUE], from_i16(reply->torque));
+    j288_put_u16le(&f[RPL_SPEED], from_i16(reply->speed));
+    j288_put_u32le(&f[RPL_POS], from_i32(reply->pos));
+    j288_put_u32le(&f[RPL_MERROR], reply->faults);
+    j288_put_u16le(&f[RPL_OUT],
+                   (uint16_t)(reply->out_pos | ((unsigned)reply->warnings << EXFLAG_SHIFT)));
+    j288_put_u16le(&f[RPL_RES], reply->reserved);
+    j288_put_u32le(&f[RPL_CRC], j288_crc32_run(crc, &f[RPL_CRC_FIRST], RPL_CRC_WORDS));
+    memcpy(out, f, sizeof f);
+    return J288_OK;
+}
+
+void j288_reply_unpack(const uint8_t in[J288_REPLY_LEN], j288_reply_raw_t *reply)
+{
+    uint8_t mode = in[RPL_MODE];
+    uint16_t out = j288_get_u16le(&in[RPL_OUT]);
+    reply->id = mode_id(mode);
+    reply->status = mode_status(mode);
+    reply->watchdog_tripped = mode_timeout(mode);
+    reply->case_temp_c = (int8_t)((in[RPL_TEMP] < 0x80u) ? (int)in[RPL_TEMP]
+                                                         : (int)in[RPL_TEMP] - 256);
+    reply->winding_temp_c = in[RPL_SENSOR];
+    reply->voltage_raw = in[RPL_VOL];
+    reply->torque = as_i16(j288_get_u16le(&in[RPL_TORQUE]));
+    reply->speed = as_i16(j288_get_u16le(&in[RPL_SPEED]));
+    reply->pos = as_i32(j288_get_u32le(&in[RPL_POS]));
+    reply->faults = j288_get_u32le(&in[RPL_MERROR]);
+    reply->out_pos = (uint16_t)(out & OUT_POS_MASK);
+    reply->warnings = (uint8_t)(out >> EXFLAG_SHIFT);
+    reply->reserved = j288_get_u16le(&in[RPL_RES]);
+}
+
+uint32_t j288_reply_crc_expected(const uint8_t in[J288_REPLY_LEN], const j288_crc_t *crc)
+{
+    return j288_crc32_run(crc, &in[RPL_CRC_FIRST], RPL_CRC_WORDS);
+}
+
+int j288_reply_decode(const uint8_t in[J288_REPLY_LEN], j288_reply_raw_t *reply,
+                      const j288_crc_t *crc)
+{
+    if ((in == NULL) || (reply == NULL)) {
+        return J288_ERR_NULL;
+    }
+    if ((in[0] != J288_REPLY_HEAD0) || (in[1] != J288_REPLY_HEAD1)) {
+        return J288_ERR_BAD_HEADER;
+    }
+    if (j288_reply_crc_expected(in, crc) != j288_get_u32le(&in[RPL_CRC])) {
+        return J288_ERR_CRC;
+    }
+    j288_reply_unpack(in, reply);
+    return J288_OK;
+}
+
+static const char *const fault_names[J288_FAULT_COUNT] = {
+    "over-current",
+    "transient over-voltage",
+    "sustained over-voltage",
+    "under-voltage",
+    "chip over-temperature",
+    "MOSFET over/under-temperature",
+    "MOSFET temperature abnormal",
+    "case over/under-temperature",
+    "case temperature abnormal",
+    "winding over-temperature",
+    "rotor encoder 1 error",
+    "rotor encoder 2 error",
+    "output encoder error",
+    "stored data error",
+    "abnormal reset",
+    "waiting for unlock",
+    "driver verification error",
+    "calibration mode",
+    "communication checksum error",
+    "driver version too low",
+    "firmware model error",
+    "encoder angle abnormal",
+};
+
+const char *j288_fault_name(unsigned bit)
+{
+    return (bit < J288_FAULT_COUNT) ? fault_names[bit] : "unknown fault";
+}
+
+const char *j288_warning_name(unsigned bit)
+{
+    return (bit == 0u) ? "low-voltage supply abnormal" : "unknown warning";
+}

@@ -1,0 +1,285 @@
+/* SI <-> raw conversions; see j288/units.h for the contract. */
+#include "j288/units.h"
+
+#if J288_CONFIG_SI
+
+#include <stdint.h>
+
+#define N_RATIO ((j288_real_t)J288_GEAR_RATIO)
+
+typedef enum { Q_TORQUE, Q_SPEED, Q_POS, Q_KP, Q_KD } quantity_t;
+
+/* LSB per SI unit on the requested side. Rotor angle = N * output angle, rotor torque =
+ * output torque / N, rotor gains = output gains / N^2. */
+static j288_real_t lsb_per_unit(quantity_t q, j288_side_t side)
+{
+    static const j288_real_t rotor[5] = {
+        (j288_real_t)J288_SCALE_TORQUE, (j288_real_t)J288_SCALE_SPEED,
+        (j288_real_t)J288_SCALE_POS, (j288_real_t)J288_SCALE_KP, (j288_real_t)J288_SCALE_KD};
+    j288_real_t k = rotor[q];
+    if (side == J288_SIDE_OUTPUT) {
+        switch (q) {
+        case Q_SPEED:
+        case Q_POS:
+            k = k * N_RATIO;
+            break;
+        case Q_TORQUE:
+            k = k / N_RATIO;
+            break;
+        default:
+            k = k / (N_RATIO * N_RATIO);
+            break;
+        }
+    }
+    return k;
+}
+
+static bool side_ok(j288_side_t side)
+{
+    return (side == J288_SIDE_ROTOR) || (side == J288_SIDE_OUTPUT);
+}
+
+/* Round half away from zero without libm: the fraction v - trunc(v) is exact. */
+static int32_t round_half_away(j288_real_t v)
+{
+    int32_t t = (int32_t)v;
+    j288_real_t frac = v - (j288_real_t)t;
+    if (frac >= (j288_real_t)0.5) {
+        t++;
+    } else if (frac <= (j288_real_t)-0.5) {
+        t--;
+    }
+    return t;
+}
+
+/*
+ * Scale and round one quantity into [lo, hi]. Returns J288_OK, J288_ERR_NOT_FINITE, or
+ * range_err; with clamp set, out-of-range values saturate and *was_clamped is set instead.
+ */
+static int convert(j288_real_t si, quantity_t q, j288_side_t side, int32_t lo, int32_t hi,
+                   int range_err, bool clamp, bool *was_clamped, int32_t *out)
+{
+    j288_real_t v;
+    bool is_gain = (q == Q_KP) || (q == Q_KD);
+
+    if (si != si) {
+        return J288_ERR_NOT_FINITE;
+    }
+    if (is_gain && (si < (j288_real_t)0)) {
+        if (!clamp) {
+            return J288_ERR_NEG_GAIN;
+        }
+        *was_clamped = true;
+        *out = 0;
+        return J288_OK;
+    }
+    v = si * lsb_per_unit(q, side);
+    /* Anything that rounds into [lo, hi] is in range; the bounds are exact in float too. */
+    if (!(v >= (j288_real_t)lo - (j288_real_t)0.5) || !(v < (j288_real_t)hi + (j288_real_t)0.5)) {
+        if (!clamp) {
+            return range_err;
+        }
+        *was_clamped = true;
+        *out = (v < (j288_real_t)0) ? lo : hi;
+        return J288_OK;
+    }
+    *out = round_half_away(v);
+    return J288_OK;
+}
+
+static int convert16(j288_real_t si, quantity_t q, j288_side_t side, int range_err, bool clamp,
+                     bool *was_clamped, int16_t *out)
+{
+    int32_t v = 0;
+    int err = convert(si, q, side, INT16_MIN, INT16_MAX, range_err, clamp, was_clamped, &v);
+    if (err == J288_OK) {
+        *out = (int16_t)v;
+    }
+    return err;
+}
+
+static int cmd_from_si(const j288_cmd_si_t *si, j288_side_t side, j288_cmd_raw_t *raw,
+                       bool clamp, unsigned *clamped)
+{
+    j288_cmd_raw_t r = {0};
+    bool c[5] = {false, false, false, false, false};
+    int err;
+    unsigned mask = 0u;
+    unsigned i;
+
+    if ((si == NULL) || (raw == NULL)) {
+        return J288_ERR_NULL;
+    }
+    if (!side_ok(side)) {
+        return J288_ERR_BAD_ARG;
+    }
+    r.id = si->id;
+    r.status = si->status;
+    r.watchdog = si->watchdog;
+    err = convert16(si->tau, Q_TORQUE, side, J288_ERR_RANGE_TAU, clamp, &c[0], &r.tau);
+    if (err == J288_OK) {
+        err = convert16(si->speed, Q_SPEED, side, J288_ERR_RANGE_SPEED, clamp, &c[1], &r.speed);
+    }
+    if (err == J288_OK) {
+        err = convert(si->pos, Q_POS, side, INT32_MIN, INT32_MAX, J288_ERR_RANGE_POS, clamp,
+                      &c[2], &r.pos);
+    }
+    if (err == J288_OK) {
+        err = convert16(si->kp, Q_KP, side, J288_ERR_RANGE_KP, clamp, &c[3], &r.kp);
+    }
+    if (err == J288_OK) {
+        err = convert16(si->kd, Q_KD, side, J288_ERR_RANGE_KD, clamp, &c[4], &r.kd);
+    }
+    if (err != J288_OK) {
+        return err;
+    }
+    for (i = 0u; i < 5u; i++) {
+        mask |= c[i] ? (1u << i) : 0u;
+    }
+    if (clamped != NULL) {
+        *clamped = mask;
+    }
+    *raw = r;
+    return J288_OK;
+}
+
+int j288_cmd_from_si(const j288_cmd_si_t *si, j288_side_t side, j288_cmd_raw_t *raw)
+{
+    return cmd_from_si(si, side, raw, false, NULL);
+}
+
+int j288_cmd_from_si_clamped(const j288_cmd_si_t *si, j288_side_t side, j288_cmd_raw_t *raw,
+                             unsigned *clamped)
+{
+    return cmd_from_si(si, side, raw, true, clamped);
+}
+
+int j288_cmd_encode_si(const j288_cmd_si_t *si, j288_side_t side, uint8_t out[J288_CMD_LEN],
+                       const j288_crc_t *crc)
+{
+    j288_cmd_raw_t raw;
+    int err = j288_cmd_from_si(si, side, &raw);
+    if (err != J288_OK) {
+        return err;
+    }
+    return j288_cmd_encode(&raw, out, crc);
+}
+
+static int one16(j288_real_t si, quantity_t q, j288_side_t side, int range_err, int16_t *raw)
+{
+    bool unused = false;
+    if (raw == NULL) {
+        return J288_ERR_NULL;
+    }
+    if (!side_ok(side)) {
+        return J288_ERR_BAD_ARG;
+    }
+    return convert16(si, q, side, range_err, false, &unused, raw);
+}
+
+int j288_torque_to_raw(j288_real_t nm, j288_side_t side, int16_t *raw)
+{
+    return one16(nm, Q_TORQUE, side, J288_ERR_RANGE_TAU, raw);
+}
+
+int j288_speed_to_raw(j288_real_t rad_s, j288_side_t side, int16_t *raw)
+{
+    return one16(rad_s, Q_SPEED, side, J288_ERR_RANGE_SPEED, raw);
+}
+
+int j288_kp_to_raw(j288_real_t nm_per_rad, j288_side_t side, int16_t *raw)
+{
+    return one16(nm_per_rad, Q_KP, side, J288_ERR_RANGE_KP, raw);
+}
+
+int j288_kd_to_raw(j288_real_t nms_per_rad, j288_side_t side, int16_t *raw)
+{
+    return one16(nms_per_rad, Q_KD, side, J288_ERR_RANGE_KD, raw);
+}
+
+int j288_pos_to_raw(j288_real_t rad, j288_side_t side, int32_t *raw)
+{
+    bool unused = false;
+    if (raw == NULL) {
+        return J288_ERR_NULL;
+    }
+    if (!side_ok(side)) {
+        return J288_ERR_BAD_ARG;
+    }
+    return convert(rad, Q_POS, side, INT32_MIN, INT32_MAX, J288_ERR_RANGE_POS, false, &unused,
+                   raw);
+}
+
+static j288_real_t from_raw(int32_t raw, quantity_t q, j288_side_t side)
+{
+    return (j288_real_t)raw / lsb_per_unit(q, side_ok(side) ? side : J288_SIDE_ROTOR);
+}
+
+j288_real_t j288_torque_from_raw(int32_t raw, j288_side_t side)
+{
+    return from_raw(raw, Q_TORQUE, side);
+}
+
+j288_real_t j288_speed_from_raw(int32_t raw, j288_side_t side)
+{
+    return from_raw(raw, Q_SPEED, side);
+}
+
+j288_real_t j288_pos_from_raw(int32_t raw, j288_side_t side) { return from_raw(raw, Q_POS, side); }
+
+j288_real_t j288_kp_from_raw(int32_t raw, j288_side_t side) { return from_raw(raw, Q_KP, side); }
+
+j288_real_t j288_kd_from_raw(int32_t raw, j288_side_t side) { return from_raw(raw, Q_KD, side); }
+
+j288_real_t j288_out_pos_to_rad(uint16_t out_pos)
+{
+    return (j288_real_t)(out_pos & (J288_OUT_POS_COUNTS - 1u)) *
+           (j288_real_t)(2.0 * J288_PI / (double)J288_OUT_POS_COUNTS);
+}
+
+int j288_reply_to_si(const j288_reply_raw_t *raw, j288_side_t side, j288_reply_si_t *si)
+{
+    if ((raw == NULL) || (si == NULL)) {
+        return J288_ERR_NULL;
+    }
+    if (!side_ok(side)) {
+        return J288_ERR_BAD_ARG;
+    }
+    si->id = raw->id;
+    si->status = raw->status;
+    si->watchdog_tripped = raw->watchdog_tripped;
+    si->case_temp_c = (j288_real_t)raw->case_temp_c;
+    si->winding_temp_c = (j288_real_t)raw->winding_temp_c;
+    si->voltage_v = (j288_real_t)raw->voltage_raw * (j288_real_t)J288_SCALE_VOLTAGE;
+    si->torque = j288_torque_from_raw(raw->torque, side);
+    si->speed = j288_speed_from_raw(raw->speed, side);
+    si->pos = j288_pos_from_raw(raw->pos, side);
+    si->out_pos = j288_out_pos_to_rad(raw->out_pos);
+    si->faults = raw->faults;
+    si->warnings = raw->warnings;
+    return J288_OK;
+}
+
+int j288_cmd_to_si(const j288_cmd_raw_t *raw, j288_side_t side, j288_cmd_si_t *si)
+{
+    if ((raw == NULL) || (si == NULL)) {
+        return J288_ERR_NULL;
+    }
+    if (!side_ok(side)) {
+        return J288_ERR_BAD_ARG;
+    }
+    si->id = raw->id;
+    si->status = raw->status;
+    si->watchdog = raw->watchdog;
+    si->tau = j288_torque_from_raw(raw->tau, side);
+    si->speed = j288_speed_from_raw(raw->speed, side);
+    si->pos = j288_pos_from_raw(raw->pos, side);
+    si->kp = j288_kp_from_raw(raw->kp, side);
+    si->kd = j288_kd_from_raw(raw->kd, side);
+    return J288_OK;
+}
+
+#else
+/* ISO C forbids an empty translation unit. */
+typedef int j288_units_disabled_t;
+#endif /* J288_CONFIG_SI */
