@@ -1,0 +1,25 @@
+#!/usr/bin/env bash
+# The committed golden vectors (test/vectors/) must equal what the generator produces now:
+# regenerate into $BUILD/vectors-fresh and compare file by file. Run from the repository root.
+set -euo pipefail
+build=${BUILD:-build}
+python=${PYTHON:-python3}
+fresh="$build/vectors-fresh"
+rm -rf "$fresh"
+mkdir -p "$fresh"
+"$python" tools/vectors/gen_vectors.py --out "$fresh"
+status=0
+for f in "$fresh"/*; do
+    name=$(basename "$f")
+    if ! cmp -s "$f" "test/vectors/$name"; then
+        echo "FAIL: test/vectors/$name differs from a fresh regeneration (run: make vectors)"
+        diff -u "test/vectors/$name" "$f" | head -n 20 || true
+        status=1
+    fi
+done
+for f in test/vectors/*; do
+    case "$f" in *.md) continue ;; esac
+    [ -e "$fresh/$(basename "$f")" ] || { echo "FAIL: $f is not produced by the generator"; status=1; }
+done
+[ $status -eq 0 ] && echo "vectors: committed files equal a fresh regeneration"
+exit $status
