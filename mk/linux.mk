@@ -1,0 +1,39 @@
+# mk/linux.mk - the Linux termios2 port (port/linux) and its test against the simulator.
+#   $(LINUX_A)                   libj288_linux.a: link it before $(LIB_A)
+#   $(BUILD)/test/test_linux_port  Unity test over a real pty served by $(BIN)/j288-sim
+# Users: -Iport/linux, #include "j288_linux.h", link $(LINUX_A) $(LIB_A).
+
+LINUX_SRC := port/linux/j288_linux.c
+LINUX_HDR := port/linux/j288_linux.h
+LINUX_OBJ := $(LINUX_SRC:%.c=$(OBJ)/%.o)
+LINUX_A := $(BUILD)/lib/libj288_linux.a
+LINUX_CPPFLAGS := $(CPPFLAGS_LIB) -Iport/linux
+LINUX_PORT_TEST := $(BUILD)/test/test_linux_port
+
+$(OBJ)/port/linux/%.o: port/linux/%.c $(LINUX_HDR) $(LIB_HDR)
+	@mkdir -p $(@D)
+	$(CC) $(LINUX_CPPFLAGS) $(CFLAGS_COMMON) -c $< -o $@
+
+$(LINUX_A): $(LINUX_OBJ)
+	@mkdir -p $(@D)
+	rm -f $@
+	$(AR) rcs $@ $^
+
+$(OBJ)/test/linux/%.o: test/linux/%.c $(LINUX_HDR) $(LIB_HDR) $(UNITY)/unity.c
+	@mkdir -p $(@D)
+	$(CC) $(TEST_CPPFLAGS) -Iport/linux -DJ288_SIM_DEFAULT='"$(BIN)/j288-sim"' \
+	    $(CFLAGS_COMMON) -c $< -o $@
+
+$(LINUX_PORT_TEST): $(OBJ)/test/linux/test_linux_port.o $(UNITY_OBJ) $(LINUX_A) $(LIB_A)
+	@mkdir -p $(@D)
+	$(CC) $(CFLAGS_COMMON) $^ -o $@ $(LDFLAGS_COMMON) -lm
+
+.PHONY: linux
+linux: $(LINUX_A)
+
+ALL_TARGETS += $(LINUX_A)
+ifneq ($(wildcard test/linux/test_linux_port.c),)
+ALL_TARGETS += $(LINUX_PORT_TEST)
+HOST_TESTS += $(LINUX_PORT_TEST)
+TEST_DEPS += $(BIN)/j288-sim
+endif
