@@ -1,0 +1,196 @@
+/* Strict command-line parsing; see args.h. */
+#include "args.h"
+
+#include <ctype.h>
+#include <errno.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cli.h"
+
+void cli_args_init(cli_args_t *a, int argc, char **argv)
+{
+    a->argc = argc;
+    a->argv = argv;
+    a->index = 1;
+    a->only_positional = false;
+    a->opt_name = NULL;
+}
+
+static const cli_opt_t *find_opt(const cli_opt_t *opts, const char *name, size_t name_len)
+{
+    for (; opts->name != NULL; opts++) {
+        if (strlen(opts->name) == name_len && strncmp(opts->name, name, name_len) == 0) {
+            return opts;
+        }
+    }
+    return NULL;
+}
+
+int cli_args_next(cli_args_t *a, const cli_opt_t *opts, const char **value)
+{
+    const char *arg;
+    const char *eq;
+    const cli_opt_t *o;
+    size_t name_len;
+
+    *value = NULL;
+    if (a->index >= a->argc) {
+        return CLI_ARG_END;
+    }
+    arg = a->argv[a->index++];
+    if (a->only_positional || arg[0] != '-' || arg[1] == '\0') {
+        *value = arg;
+        return CLI_ARG_POSITIONAL;
+    }
+    if (strcmp(arg, "--") == 0) {
+        a->only_positional = true;
+        return cli_args_next(a, opts, value);
+    }
+    if (strcmp(arg, "-h") == 0 || strcmp(arg, "--help") == 0) {
+        return CLI_ARG_HELP;
+    }
+    eq = strchr(arg, '=');
+    name_len = eq != NULL ? (size_t)(eq - arg) : strlen(arg);
+    o = find_opt(opts, arg, name_len);
+    if (o == NULL) {
+        cli_error("unknown option '%.*s' (try --help)", (int)name_len, arg);
+        return CLI_ARG_ERROR;
+    }
+    a->opt_name = o->name;
+    if (!o->has_value) {
+        if (eq != NULL) {
+            cli_error("option %s takes no value", o->name);
+            return CLI_ARG_ERROR;
+        }
+        return o->key;
+    }
+    if (eq != NULL) {
+        *value = eq + 1;
+    } else if (a->index < a->argc) {
+        *value = a->argv[a->index++];
+    } else {
+        cli_error("option %s needs a value", o->name);
+        return CLI_ARG_ERROR;
+    }
+    return o->key;
+}
+
+int cli_parse_int(const char *opt, const char *text, long long lo, long long hi,
+                  long long *out)
+{
+    const char *digits = text;
+    char *end = NULL;
+    long long v;
+    int base = 10;
+
+    if (*digits == '+' || *digits == '-') {
+        digits++;
+    }
+    if (digits[0] == '0' && (digits[1] == 'x' || digits[1] == 'X')) {
+        base = 16;
+    }
+    /* strtoll skips leading spaces and takes a second sign: refuse both. */
+    if (!isxdigit((unsigned char)digits[0])) {
+        cli_error("%s: '%s' is not a whole number", opt, text);
+        return -1;
+    }
+    errno = 0;
+    v = strtoll(text, &end, base);
+    if (end == text || *end != '\0') {
+        cli_error("%s: '%s' is not a whole number", opt, text);
+        return -1;
+    }
+    if (errno == ERANGE || v < lo || v > hi) {
+        cli_error("%s: %s is out of range %lld..%lld", opt, text, lo, hi);
+        return -1;
+    }
+    *out = v;
+    return 0;
+}
+
+int cli_parse_real(const char *opt, const char *text, double *out)
+{
+    char *end = NULL;
+    double v;
+    const char *p = text;
+
+    if (*p == '+' || *p == '-') {
+        p++;
+    }
+    if (!(isdigit((unsigned char)*p) || (*p == '.' && isdigit((unsigned char)p[1])))) {
+        cli_error("%s: '%s' is not a number", opt, text);
+        return -1;
+    }
+    errno = 0;
+    v = strtod(text, &end);
+    if (end == text || *end != '\0') {
+        cli_error("%s: '%s' is not a number", opt, text);
+        return -1;
+    }
+    if (errno == ERANGE && (v > 1.0 || v < -1.0)) {
+        cli_error("%s: %s is out of range", opt, text);
+        return -1;
+    }
+    if (!isfinite(v)) {
+        cli_error("%s: '%s' is not a finite number", opt, text);
+        return -1;
+    }
+    *out = v;
+    return 0;
+}
+
+int cli_parse_choice(const char *opt, const char *text, const char *const *choices, int *out)
+{
+    int i;
+    for (i = 0; choices[i] != NULL; i++) {
+        if (strcmp(text, choices[i]) == 0) {
+            *out = i;
+            return 0;
+        }
+    }
+    if (choices[0] != NULL && choices[1] != NULL && choices[2] == NULL) {
+        cli_error("%s: '%s' is not %s or %s", opt, text, choices[0], choices[1]);
+    } else {
+        cli_error("%s: '%s' is not a valid choice", opt, text);
+    }
+    return -1;
+}
+
+int cli_parse_id_list(const char *opt, const char *text, unsigned max_id, uint32_t *mask)
+{
+    char item[32];
+    const char *p = text;
+    uint32_t m = 0;
+
+    if (*p == '\0') {
+        cli_error("%s: empty id list", opt);
+        return -1;
+    }
+    for (;;) {
+        const char *comma = strchr(p, ',');
+        size_t n = comma != NULL ? (size_t)(comma - p) : strlen(p);
+        long long id;
+        if (n == 0 || n >= sizeof item) {
+            cli_error("%s: '%s' is not a comma-separated list of ids", opt, text);
+            return -1;
+        }
+        memcpy(item, p, n);
+        item[n] = '\0';
+        if (cli_parse_int(opt, item, 0, (long long)max_id, &id) != 0) {
+            return -1;
+        }
+        if ((m & (1ul << id)) != 0u) {
+            cli_error("%s: id %lld is listed twice", opt, id);
+            return -1;
+        }
+        m |= (uint32_t)(1ul << id);
+        if (comma == NULL) {
+            break;
+        }
+        p = comma + 1;
+    }
+    *mask = m;
+    return 0;
+}

@@ -1,0 +1,59 @@
+/*
+ * args.h - strict command-line parsing for the j288 tool.
+ *
+ * Options are long ("--id 3" or "--id=3"); "-h" is --help; "--" ends the options. A value is
+ * always the next argument, even when it starts with '-' (so "--tau -0.5" works). Numbers
+ * must be complete: "3x", "", " 3" and "0x" are refused, as are NaN and infinities. Every
+ * parse function prints one error line (cli_error) naming the option and returns -1, or
+ * returns 0 with the value stored.
+ */
+#ifndef J288_CLI_ARGS_H
+#define J288_CLI_ARGS_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+typedef struct {
+    const char *name; /* "--id" */
+    bool has_value;
+    int key; /* >= 0, returned by cli_args_next() */
+} cli_opt_t;
+
+#define CLI_ARG_END (-1)
+#define CLI_ARG_POSITIONAL (-2)
+#define CLI_ARG_ERROR (-3)
+#define CLI_ARG_HELP (-4)
+
+typedef struct {
+    int argc;
+    char **argv;
+    int index;            /* next argument to look at */
+    bool only_positional; /* after "--" */
+    const char *opt_name; /* the option just returned, for messages */
+} cli_args_t;
+
+/* Start after argv[0] (the command name). */
+void cli_args_init(cli_args_t *a, int argc, char **argv);
+
+/*
+ * Next item: an option's key (its value, if any, in *value), CLI_ARG_POSITIONAL (*value is
+ * the argument), CLI_ARG_HELP (-h/--help), CLI_ARG_END, or CLI_ARG_ERROR (unknown option,
+ * missing value, value given to a flag; already reported). opts ends with a NULL name.
+ */
+int cli_args_next(cli_args_t *a, const cli_opt_t *opts, const char **value);
+
+/* Whole number in [lo, hi]; decimal or 0x-prefixed hexadecimal, optional sign. */
+int cli_parse_int(const char *opt, const char *text, long long lo, long long hi,
+                  long long *out);
+
+/* Finite real number (strtod syntax, no trailing characters). */
+int cli_parse_real(const char *opt, const char *text, double *out);
+
+/* One of choices (NULL-terminated); *out is its index. */
+int cli_parse_choice(const char *opt, const char *text, const char *const *choices, int *out);
+
+/* Comma-separated servo ids, each in [0, max_id], no duplicates: sets bits of *mask. */
+int cli_parse_id_list(const char *opt, const char *text, unsigned max_id, uint32_t *mask);
+
+#endif /* J288_CLI_ARGS_H */

@@ -1,0 +1,149 @@
+/*
+ * j288 - the command-line tool: an offline frame calculator (encode, decode) and, with
+ * --port, a bus master for J288/S288 servos (scan, status, hold, move, torque, stop, log),
+ * plus plot for the CSV that log writes.
+ */
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "args.h"
+#include "cli.h"
+
+static const char *current_command;
+
+void cli_set_command(const char *name) { current_command = name; }
+
+void cli_error(const char *fmt, ...)
+{
+    va_list ap;
+    fflush(stdout);
+    if (current_command != NULL) {
+        fprintf(stderr, "j288 %s: ", current_command);
+    } else {
+        fputs("j288: ", stderr);
+    }
+    va_start(ap, fmt);
+    vfprintf(stderr, fmt, ap);
+    va_end(ap);
+    fputc('\n', stderr);
+}
+
+typedef int (*command_fn)(int argc, char **argv, const cli_global_t *g);
+
+typedef struct {
+    const char *name;
+    command_fn fn;
+    const char *summary;
+} command_t;
+
+static const command_t commands[] = {
+    {"encode", cli_cmd_encode, "print a command frame as hex (offline)"},
+    {"decode", cli_cmd_decode, "check and explain a command or reply given as hex (offline)"},
+    {"scan", cli_cmd_scan, "list every servo id 0-14 that answers"},
+    {"status", cli_cmd_status, "read and decode one servo's reply"},
+    {"hold", cli_cmd_hold, "hold a servo at its current position"},
+    {"move", cli_cmd_move, "move a servo to a position"},
+    {"torque", cli_cmd_torque, "apply a feed-forward torque"},
+    {"stop", cli_cmd_stop, "lock one servo, or all (broadcast)"},
+    {"log", cli_cmd_log, "run the cycle scheduler and log replies to CSV"},
+    {"plot", cli_cmd_plot, "plot a log CSV to PNG with gnuplot"},
+    {NULL, NULL, NULL}};
+
+static void usage(FILE *f)
+{
+    const command_t *c;
+    fputs("usage: j288 [--port DEV] [--baud N] COMMAND [options]\n"
+          "       j288 COMMAND --help\n"
+          "\n"
+          "commands:\n",
+          f);
+    for (c = commands; c->name != NULL; c++) {
+        fprintf(f, "  %-8s %s\n", c->name, c->summary);
+    }
+    fputs("\n"
+          "global options (bus commands also take them after the command):\n"
+          "  --port DEV   serial device of the bus (default: $J288_PORT)\n"
+          "  --baud N     line rate in bit/s (default 6000000)\n"
+          "  --version    print the library version\n"
+          "\n"
+          "exit status: 0 success; 1 invalid frame, device or bus failure (no reply, servo\n"
+          "absent, device in use or gone); 2 bad command line; 3 optional helper missing\n"
+          "(plot without gnuplot); 130/143 stopped by SIGINT/SIGTERM after locking every\n"
+          "servo the command drove.\n",
+          f);
+}
+
+enum { OPT_PORT, OPT_BAUD, OPT_VERSION };
+static const cli_opt_t global_opts[] = {{"--port", true, OPT_PORT},
+                                        {"--baud", true, OPT_BAUD},
+                                        {"--version", false, OPT_VERSION},
+                                        {NULL, false, 0}};
+
+int main(int argc, char **argv)
+{
+    cli_global_t g = {NULL, 0};
+    cli_args_t a;
+    const char *v;
+    const command_t *c;
+    long long baud;
+    int key;
+
+    cli_set_command(NULL);
+    cli_args_init(&a, argc, argv);
+    /* Global options stop at the first positional argument: the command. */
+    for (;;) {
+        key = cli_args_next(&a, global_opts, &v);
+        if (key == CLI_ARG_END) {
+            cli_error("no command given (try j288 --help)");
+            return CLI_EXIT_USAGE;
+        }
+        if (key == CLI_ARG_HELP) {
+            usage(stdout);
+            return CLI_EXIT_OK;
+        }
+        if (key == CLI_ARG_ERROR) {
+            return CLI_EXIT_USAGE;
+        }
+        if (key == CLI_ARG_POSITIONAL) {
+            break;
+        }
+        if (key == OPT_VERSION) {
+            printf("j288 %s\n", J288_VERSION_STRING);
+            return CLI_EXIT_OK;
+        }
+        if (key == OPT_PORT) {
+            g.port = v;
+        } else if (cli_parse_int("--baud", v, 9600, 100000000, &baud) != 0) {
+            return CLI_EXIT_USAGE;
+        } else {
+            g.baud = (uint32_t)baud;
+        }
+    }
+    if (strcmp(v, "help") == 0) {
+        /* `j288 help CMD` is `j288 CMD --help`. */
+        if (a.index < argc) {
+            for (c = commands; c->name != NULL; c++) {
+                if (strcmp(argv[a.index], c->name) == 0) {
+                    char *help_argv[3];
+                    help_argv[0] = argv[a.index];
+                    help_argv[1] = (char *)"--help";
+                    help_argv[2] = NULL;
+                    cli_set_command(c->name);
+                    return c->fn(2, help_argv, &g);
+                }
+            }
+        }
+        usage(stdout);
+        return CLI_EXIT_OK;
+    }
+    for (c = commands; c->name != NULL; c++) {
+        if (strcmp(v, c->name) == 0) {
+            cli_set_command(c->name);
+            return c->fn(argc - (a.index - 1), argv + (a.index - 1), &g);
+        }
+    }
+    cli_error("unknown command '%s' (try j288 --help)", v);
+    return CLI_EXIT_USAGE;
+}

@@ -1,0 +1,84 @@
+# Shared helpers for the CLI end-to-end tests (sourced, not run). Each test script counts
+# its checks and ends with a Unity-style summary line ("N Tests N Failures 0 Ignored" then
+# OK or FAIL), exiting non-zero when anything failed.
+# shellcheck shell=bash
+
+BIN=${BIN:-build/bin}
+BUILD=${BUILD:-build}
+J288=${J288:-$BIN/j288}
+E2E_TESTS=0
+E2E_FAILURES=0
+E2E_TMP=$(mktemp -d "${TMPDIR:-/tmp}/j288-e2e.XXXXXX")
+
+e2e_cleanup_tmp() { rm -rf "$E2E_TMP"; }
+
+E2E_NAME=$(basename "$0" .sh)
+e2e_pass() { E2E_TESTS=$((E2E_TESTS + 1)); echo "$E2E_NAME:$1:PASS"; }
+e2e_fail() { # name reason
+    E2E_TESTS=$((E2E_TESTS + 1)); E2E_FAILURES=$((E2E_FAILURES + 1))
+    echo "$E2E_NAME:$1:FAIL: $2"
+}
+
+# Run a command with a time bound, capturing stdout, stderr and status into E2E_OUT,
+# E2E_ERR, E2E_RC.
+e2e_run() {
+    timeout -k 2 "${E2E_CMD_TIMEOUT:-20}" "$@" >"$E2E_TMP/out" 2>"$E2E_TMP/err"
+    E2E_RC=$?
+    E2E_OUT=$(cat "$E2E_TMP/out")
+    E2E_ERR=$(cat "$E2E_TMP/err")
+}
+
+# expect_ok NAME EXPECTED_STDOUT CMD...: exit 0, stdout exactly EXPECTED, stderr empty.
+expect_ok() {
+    local name=$1 want=$2; shift 2
+    e2e_run "$@"
+    if [ "$E2E_RC" -ne 0 ]; then
+        e2e_fail "$name" "exit $E2E_RC (stderr: $E2E_ERR)"
+    elif [ "$E2E_OUT" != "$want" ]; then
+        e2e_fail "$name" "stdout '$E2E_OUT', want '$want'"
+    elif [ -n "$E2E_ERR" ]; then
+        e2e_fail "$name" "unexpected stderr '$E2E_ERR'"
+    else
+        e2e_pass "$name"
+    fi
+}
+
+# expect_bad NAME WANT_RC PATTERN CMD...: exits WANT_RC ("nonzero" for any non-zero), prints
+# nothing on stdout and exactly one line on stderr matching the extended regex PATTERN.
+expect_bad() {
+    local name=$1 want_rc=$2 pattern=$3; shift 3
+    e2e_run "$@"
+    local lines
+    lines=$(printf '%s' "$E2E_ERR" | grep -c '')
+    if [ "$E2E_RC" -eq 0 ]; then
+        e2e_fail "$name" "exit 0, want failure"
+    elif [ "$want_rc" != nonzero ] && [ "$E2E_RC" -ne "$want_rc" ]; then
+        e2e_fail "$name" "exit $E2E_RC, want $want_rc (stderr: $E2E_ERR)"
+    elif [ -n "$E2E_OUT" ]; then
+        e2e_fail "$name" "stdout not empty: '$E2E_OUT'"
+    elif [ "$lines" -ne 1 ]; then
+        e2e_fail "$name" "want exactly one stderr line, got $lines: '$E2E_ERR'"
+    elif ! printf '%s' "$E2E_ERR" | grep -Eq -- "$pattern"; then
+        e2e_fail "$name" "stderr '$E2E_ERR' does not match /$pattern/"
+    else
+        e2e_pass "$name"
+    fi
+}
+
+# expect_true NAME CMD...: the command (a shell check) succeeds.
+expect_true() {
+    local name=$1; shift
+    if "$@" >"$E2E_TMP/chk" 2>&1; then
+        e2e_pass "$name"
+    else
+        e2e_fail "$name" "$(head -c 600 "$E2E_TMP/chk")"
+    fi
+}
+
+e2e_summary() {
+    echo
+    echo "-----------------------"
+    echo "$E2E_TESTS Tests $E2E_FAILURES Failures 0 Ignored"
+    if [ "$E2E_FAILURES" -eq 0 ]; then echo OK; else echo FAIL; fi
+    [ "$E2E_FAILURES" -eq 0 ]
+}
