@@ -1,0 +1,486 @@
+/* j288 port for the STM32Cube HAL; the contract and the application's duties are in
+ * j288_stm32.h, the walk-through in docs/porting.md. */
+#include "j288_stm32.h"
+
+#include <string.h>
+
+#include "j288/crc32.h"
+#include "j288/frame.h"
+
+/* Compile-time checks (C99: a negative array size fails the build). */
+typedef char j288_stm32_rx_holds_reply[(J288_STM32_RX_BUF_SIZE > J288_REPLY_LEN) ? 1 : -1];
+typedef char j288_stm32_rx_whole_lines[(J288_STM32_RX_BUF_SIZE % J288_STM32_DCACHE_LINE) == 0u ? 1 : -1];
+typedef char j288_stm32_rx_fits_hal[(J288_STM32_RX_BUF_SIZE <= 0xFFFFu) ? 1 : -1];
+
+/* The callbacks carry only a HAL handle; this table maps it back to the bus. Written only by
+ * init/deinit in thread context, read by the ISRs: a slot is filled before it is published,
+ * and a pointer store is atomic on Cortex-M. */
+static j288_stm32_t *volatile registry[J288_STM32_MAX_BUSES];
+
+static j288_stm32_t *find_uart(const UART_HandleTypeDef *huart)
+{
+    for (size_t i = 0; i < J288_STM32_MAX_BUSES; i++) {
+        j288_stm32_t *p = registry[i];
+        if ((p != NULL) && (huart != NULL) && (p->cfg.huart == huart)) {
+            return p;
+        }
+    }
+    return NULL;
+}
+
+static void hal_check(j288_stm32_t *p, HAL_StatusTypeDef st)
+{
+    if (st != HAL_OK) {
+        p->stats.hal_failures++;
+    }
+}
+
+/* ---- cache maintenance (Cortex-M7 D-cache) ---------------------------------------------- */
+
+static void cache_clean(void *buf, size_t len)
+{
+#if J288_STM32_DCACHE
+    SCB_CleanDCache_by_Addr(buf, (int32_t)len);
+#else
+    (void)buf;
+    (void)len;
+#endif
+}
+
+static void cache_invalidate(void *buf, size_t len)
+{
+#if J288_STM32_DCACHE
+    SCB_InvalidateDCache_by_Addr(buf, (int32_t)len);
+#else
+    (void)buf;
+    (void)len;
+#endif
+}
+
+/* ---- port operations -------------------------------------------------------------------- */
+
+static uint32_t timer_now(const j288_stm32_t *p)
+{
+    return (uint32_t)__HAL_TIM_GET_COUNTER(p->cfg.htim);
+}
+
+static uint32_t now_of(const j288_stm32_t *p)
+{
+    return (p->cfg.now_us != NULL) ? p->cfg.now_us() : timer_now(p);
+}
+
+static uint32_t op_now_us(void *ctx)
+{
+    return now_of(ctx);
+}
+
+static void de_write(const j288_stm32_t *p, bool active)
+{
+    if (p->cfg.de_port != NULL) {
+        bool high = active != p->cfg.de_active_low;
+        HAL_GPIO_WritePin(p->cfg.de_port, p->cfg.de_pin, high ? GPIO_PIN_SET : GPIO_PIN_RESET);
+    }
+}
+
+/* Single-wire mode: the transmitter and receiver share the pin, so the receiver is switched
+ * off while we talk (no echo to discard) and the reception still armed from the last
+ * transaction is abandoned first: anything it would still deliver is stale. */
+static void op_set_dir(void *ctx, j288_dir_t dir)
+{
+    j288_stm32_t *p = ctx;
+    p->dir = (uint8_t)dir;
+    if (dir == J288_DIR_TX) {
+        hal_check(p, HAL_UART_AbortReceive(p->cfg.huart));
+        hal_check(p, HAL_HalfDuplex_EnableTransmitter(p->cfg.huart));
+        de_write(p, true);
+    } else {
+        de_write(p, false);
+        hal_check(p, HAL_HalfDuplex_EnableReceiver(p->cfg.huart));
+    }
+}
+
+static int op_start_tx(void *ctx, const uint8_t *data, size_t len)
+{
+    j288_stm32_t *p = ctx;
+    if ((data == NULL) || (len == 0u) || (len > J288_STM32_TX_BUF_SIZE)) {
+        return J288_ERR_BAD_ARG;
+    }
+    /* Copy into the DMA buffer: the bus object may sit where the DMA cannot read. */
+    memcpy(p->cfg.dma->tx, data, len);
+    cache_clean(p->cfg.dma->tx, J288_STM32_TX_BUF_SIZE);
+    p->stats.tx_frames++;
+    if (HAL_UART_Transmit_DMA(p->cfg.huart, p->cfg.dma->tx, (uint16_t)len) != HAL_OK) {
+        p->stats.hal_failures++;
+        return J288_ERR_PORT;
+    }
+    return J288_OK;
+}
+
+static void rx_arm(j288_stm32_t *p)
+{
+    p->rx_pos = 0u;
+    /* Drop cached copies before the DMA writes, so that no dirty line is evicted on top of
+     * received bytes later. */
+    cache_invalidate(p->cfg.dma->rx, J288_STM32_RX_BUF_SIZE);
+    if (HAL_UARTEx_ReceiveToIdle_DMA(p->cfg.huart, p->cfg.dma->rx,
+                                     (uint16_t)J288_STM32_RX_BUF_SIZE) != HAL_OK) {
+        p->stats.hal_failures++;
+        j288_bus_on_error(&p->bus, J288_LINE_DMA);
+    }
+}
+
+static void op_start_rx(void *ctx)
+{
+    rx_arm(ctx);
+}
+
+static uint32_t channel_it(uint32_t channel)
+{
+    switch (channel) {
+    case TIM_CHANNEL_1: return TIM_IT_CC1;
+    case TIM_CHANNEL_2: return TIM_IT_CC2;
+    case TIM_CHANNEL_3: return TIM_IT_CC3;
+    case TIM_CHANNEL_4: return TIM_IT_CC4;
+    default: return 0u;
+    }
+}
+
+static HAL_TIM_ActiveChannel channel_active(uint32_t channel)
+{
+    switch (channel) {
+    case TIM_CHANNEL_1: return HAL_TIM_ACTIVE_CHANNEL_1;
+    case TIM_CHANNEL_2: return HAL_TIM_ACTIVE_CHANNEL_2;
+    case TIM_CHANNEL_3: return HAL_TIM_ACTIVE_CHANNEL_3;
+    case TIM_CHANNEL_4: return HAL_TIM_ACTIVE_CHANNEL_4;
+    default: return HAL_TIM_ACTIVE_CHANNEL_CLEARED;
+    }
+}
+
+/* The timer counts at 1 MHz, free running (maybe 16 bits): the compare goes delay ticks
+ * ahead of the counter, modulo its period, whatever clock now_us comes from. */
+static void op_arm_timeout(void *ctx, uint32_t deadline_us)
+{
+    j288_stm32_t *p = ctx;
+    TIM_HandleTypeDef *htim = p->cfg.htim;
+    uint32_t it = channel_it(p->cfg.tim_channel);
+    int32_t delay = (int32_t)(deadline_us - op_now_us(p));
+    uint32_t arr = (uint32_t)__HAL_TIM_GET_AUTORELOAD(htim);
+    uint32_t ticks = (delay < 1) ? 1u : (uint32_t)delay;
+    uint32_t cmp;
+
+    if ((arr != 0xFFFFFFFFu) && (ticks > arr)) {
+        ticks = arr; /* an early wake-up only re-arms: the bus checks the real deadline */
+    }
+    cmp = (uint32_t)__HAL_TIM_GET_COUNTER(htim) + ticks;
+    if ((arr != 0xFFFFFFFFu) && (cmp > arr)) {
+        cmp -= arr + 1u;
+    }
+    __HAL_TIM_DISABLE_IT(htim, it);
+    __HAL_TIM_SET_COMPARE(htim, p->cfg.tim_channel, cmp);
+    __HAL_TIM_CLEAR_FLAG(htim, it); /* TIM_FLAG_CCn has the same bit as TIM_IT_CCn */
+    __HAL_TIM_ENABLE_IT(htim, it);
+}
+
+#if J288_STM32_HW_CRC
+static uint32_t op_crc32(void *ctx, const uint8_t *data, size_t nwords)
+{
+    const j288_stm32_t *p = ctx;
+    return j288_stm32_crc32(p->cfg.hcrc, data, nwords);
+}
+#endif
+
+/* Thread-context sections of the bus against its own interrupts: PRIMASK, saved so that a
+ * caller which already masked stays masked. */
+static void op_lock(void *ctx)
+{
+    j288_stm32_t *p = ctx;
+    uint32_t saved = __get_PRIMASK();
+    __disable_irq();
+    p->lock_saved = saved;
+}
+
+static void op_unlock(void *ctx)
+{
+    const j288_stm32_t *p = ctx;
+    __set_PRIMASK(p->lock_saved);
+}
+
+static const j288_port_t port_plain = {
+    .start_tx = op_start_tx,
+    .now_us = op_now_us,
+    .start_rx = op_start_rx,
+    .set_dir = op_set_dir,
+    .lock = op_lock,
+    .unlock = op_unlock,
+};
+
+static const j288_port_t port_timer = {
+    .start_tx = op_start_tx,
+    .now_us = op_now_us,
+    .start_rx = op_start_rx,
+    .set_dir = op_set_dir,
+    .arm_timeout = op_arm_timeout,
+    .lock = op_lock,
+    .unlock = op_unlock,
+};
+
+#if J288_STM32_HW_CRC
+static const j288_port_t port_plain_crc = {
+    .start_tx = op_start_tx,
+    .now_us = op_now_us,
+    .start_rx = op_start_rx,
+    .set_dir = op_set_dir,
+    .crc32 = op_crc32,
+    .lock = op_lock,
+    .unlock = op_unlock,
+};
+
+static const j288_port_t port_timer_crc = {
+    .start_tx = op_start_tx,
+    .now_us = op_now_us,
+    .start_rx = op_start_rx,
+    .set_dir = op_set_dir,
+    .arm_timeout = op_arm_timeout,
+    .crc32 = op_crc32,
+    .lock = op_lock,
+    .unlock = op_unlock,
+};
+#endif
+
+static const j288_port_t *pick_ops(const j288_stm32_config_t *cfg)
+{
+    bool timer = cfg->htim != NULL;
+#if J288_STM32_HW_CRC
+    if (cfg->hcrc != NULL) {
+        return timer ? &port_timer_crc : &port_plain_crc;
+    }
+#endif
+    return timer ? &port_timer : &port_plain;
+}
+
+/* ---- lifecycle -------------------------------------------------------------------------- */
+
+static int check_config(const j288_stm32_config_t *cfg)
+{
+    if ((cfg->huart == NULL) || (cfg->dma == NULL)) {
+        return J288_ERR_NULL;
+    }
+    if ((cfg->htim != NULL) && (channel_it(cfg->tim_channel) == 0u)) {
+        return J288_ERR_BAD_CONFIG;
+    }
+    if (cfg->now_us == NULL) {
+        if ((cfg->htim == NULL) || (__HAL_TIM_GET_AUTORELOAD(cfg->htim) != 0xFFFFFFFFu)) {
+            return J288_ERR_BAD_CONFIG;
+        }
+    }
+    return J288_OK;
+}
+
+int j288_stm32_init(j288_stm32_t *p, const j288_stm32_config_t *cfg,
+                    const j288_bus_config_t *bus_cfg)
+{
+    size_t free_slot = J288_STM32_MAX_BUSES;
+    int rc;
+
+    if ((p == NULL) || (cfg == NULL)) {
+        return J288_ERR_NULL;
+    }
+    rc = check_config(cfg);
+    if (rc != J288_OK) {
+        return rc;
+    }
+    for (size_t i = 0; i < J288_STM32_MAX_BUSES; i++) {
+        const j288_stm32_t *q = registry[i];
+        if ((q == p) || ((q != NULL) && (q->cfg.huart == cfg->huart))) {
+            return J288_ERR_BUSY;
+        }
+        if ((q == NULL) && (free_slot == J288_STM32_MAX_BUSES)) {
+            free_slot = i;
+        }
+    }
+    if (free_slot == J288_STM32_MAX_BUSES) {
+        return J288_ERR_BUSY;
+    }
+
+    memset(p, 0, sizeof *p);
+    p->cfg = *cfg;
+    rc = j288_bus_init(&p->bus, pick_ops(cfg), p, bus_cfg);
+    if (rc != J288_OK) {
+        return rc;
+    }
+    if (cfg->htim != NULL) {
+        __HAL_TIM_DISABLE_IT(cfg->htim, channel_it(cfg->tim_channel));
+    }
+    op_set_dir(p, J288_DIR_RX);
+    registry[free_slot] = p;
+    return J288_OK;
+}
+
+void j288_stm32_deinit(j288_stm32_t *p)
+{
+    for (size_t i = 0; i < J288_STM32_MAX_BUSES; i++) {
+        if ((p != NULL) && (registry[i] == p)) {
+            registry[i] = NULL;
+            if (p->cfg.htim != NULL) {
+                __HAL_TIM_DISABLE_IT(p->cfg.htim, channel_it(p->cfg.tim_channel));
+            }
+            (void)HAL_UART_AbortReceive(p->cfg.huart);
+            de_write(p, false);
+        }
+    }
+}
+
+j288_bus_t *j288_stm32_bus(j288_stm32_t *p)
+{
+    return (p != NULL) ? &p->bus : NULL;
+}
+
+uint32_t j288_stm32_now_us(const j288_stm32_t *p)
+{
+    return (p != NULL) ? now_of(p) : 0u;
+}
+
+const j288_stm32_stats_t *j288_stm32_stats(const j288_stm32_t *p)
+{
+    return (p != NULL) ? &p->stats : NULL;
+}
+
+/* ---- callbacks -------------------------------------------------------------------------- */
+
+bool j288_stm32_on_tx_cplt(UART_HandleTypeDef *huart)
+{
+    j288_stm32_t *p = find_uart(huart);
+    if (p == NULL) {
+        return false;
+    }
+    /* TxCplt comes on the UART's transmission-complete flag: the stop bit of the last byte
+     * is out, so the bus may turn the line around now (it calls set_dir and start_rx). */
+    j288_bus_on_tx_done(&p->bus);
+    return true;
+}
+
+/* ReceiveToIdle reports the fill level of the buffer, not a delta: half-transfer, idle and
+ * full events of one reception each give the position reached so far. The reception has
+ * ended (idle or full) when the HAL's RxState is no longer BUSY_RX; in receive direction it
+ * is re-armed at once, so that a reply split by a gap is still heard whole. */
+bool j288_stm32_on_rx_event(UART_HandleTypeDef *huart, uint16_t size)
+{
+    j288_stm32_t *p = find_uart(huart);
+    uint16_t pos;
+    bool ended;
+
+    if (p == NULL) {
+        return false;
+    }
+    p->stats.rx_events++;
+    ended = huart->RxState != HAL_UART_STATE_BUSY_RX;
+    pos = p->rx_pos;
+    if (size > J288_STM32_RX_BUF_SIZE) {
+        size = (uint16_t)J288_STM32_RX_BUF_SIZE; /* never trust a count beyond the buffer */
+    }
+    if (size > pos) {
+        cache_invalidate(p->cfg.dma->rx, J288_STM32_RX_BUF_SIZE);
+        j288_bus_on_rx(&p->bus, &p->cfg.dma->rx[pos], (size_t)(size - pos));
+        p->stats.rx_bytes += (uint32_t)(size - pos);
+        p->rx_pos = size;
+    }
+    if (ended) {
+        if (size < J288_STM32_RX_BUF_SIZE) {
+            j288_bus_on_rx_idle(&p->bus);
+        }
+        if (p->dir == (uint8_t)J288_DIR_RX) {
+            rx_arm(p);
+        }
+    }
+    return true;
+}
+
+static uint32_t line_flags(uint32_t hal_error)
+{
+    uint32_t f = 0u;
+    f |= ((hal_error & HAL_UART_ERROR_PE) != 0u) ? J288_LINE_PARITY : 0u;
+    f |= ((hal_error & HAL_UART_ERROR_NE) != 0u) ? J288_LINE_NOISE : 0u;
+    f |= ((hal_error & HAL_UART_ERROR_FE) != 0u) ? J288_LINE_FRAMING : 0u;
+    f |= ((hal_error & HAL_UART_ERROR_ORE) != 0u) ? J288_LINE_OVERRUN : 0u;
+    f |= ((hal_error & HAL_UART_ERROR_DMA) != 0u) ? J288_LINE_DMA : 0u;
+    return (f != 0u) ? f : J288_LINE_NOISE; /* an error without a known bit is still one */
+}
+
+/* In DMA mode the HAL treats receive errors as blocking: it has aborted the reception before
+ * this callback, and the bytes of the broken frame are not delivered. Report the error, then
+ * listen again if we are in receive direction. */
+bool j288_stm32_on_error(UART_HandleTypeDef *huart)
+{
+    j288_stm32_t *p = find_uart(huart);
+    if (p == NULL) {
+        return false;
+    }
+    p->stats.line_errors++;
+    j288_bus_on_error(&p->bus, line_flags(huart->ErrorCode));
+    if ((p->dir == (uint8_t)J288_DIR_RX) && (huart->RxState != HAL_UART_STATE_BUSY_RX)) {
+        rx_arm(p);
+    }
+    return true;
+}
+
+bool j288_stm32_on_timer(TIM_HandleTypeDef *htim)
+{
+    bool mine = false;
+    for (size_t i = 0; i < J288_STM32_MAX_BUSES; i++) {
+        j288_stm32_t *p = registry[i];
+        if ((p == NULL) || (htim == NULL) || (p->cfg.htim != htim) ||
+            (htim->Channel != channel_active(p->cfg.tim_channel))) {
+            continue;
+        }
+        __HAL_TIM_DISABLE_IT(htim, channel_it(p->cfg.tim_channel)); /* one-shot */
+        p->stats.timer_events++;
+        j288_bus_on_timer(&p->bus);
+        mine = true;
+    }
+    return mine;
+}
+
+/* ---- CRC unit --------------------------------------------------------------------------- */
+
+#if J288_STM32_HW_CRC
+#define CRC_CHUNK_WORDS 8u
+
+uint32_t j288_stm32_crc32(CRC_HandleTypeDef *hcrc, const uint8_t *data, size_t nwords)
+{
+    uint32_t scratch[CRC_CHUNK_WORDS];
+    uint32_t crc = J288_CRC32_INIT;
+    uint32_t saved;
+    bool first = true;
+
+    if ((hcrc == NULL) || ((data == NULL) && (nwords != 0u))) {
+        return j288_crc32_update_nibble(J288_CRC32_INIT, data, (data == NULL) ? 0u : nwords);
+    }
+    J288_STM32_CRC_LOCK(saved);
+    while (first || (nwords > 0u)) {
+        size_t n = (nwords < CRC_CHUNK_WORDS) ? nwords : CRC_CHUNK_WORDS;
+        for (size_t i = 0; i < n; i++) {
+            scratch[i] = j288_get_u32le(&data[4u * i]);
+        }
+        crc = first ? HAL_CRC_Calculate(hcrc, scratch, (uint32_t)n)
+                    : HAL_CRC_Accumulate(hcrc, scratch, (uint32_t)n);
+        first = false;
+        data = (n > 0u) ? &data[4u * n] : data;
+        nwords -= n;
+    }
+    J288_STM32_CRC_UNLOCK(saved);
+    return crc;
+}
+
+/* The one mutable global the library-wide HW backend needs: it has no context argument. */
+static CRC_HandleTypeDef *volatile default_crc;
+
+void j288_stm32_crc_attach(CRC_HandleTypeDef *hcrc)
+{
+    default_crc = hcrc;
+}
+
+uint32_t j288_stm32_crc32_default(const uint8_t *data, size_t nwords)
+{
+    return j288_stm32_crc32(default_crc, data, nwords);
+}
+#endif

@@ -1,0 +1,220 @@
+/*
+ * j288_stm32.h - j288 port for the STM32Cube HAL: one bus per UART in single-wire
+ * half-duplex mode, DMA both ways, idle-line reception, optional DE pin, response timeout
+ * from a timer compare channel, and the CRC unit as the frame CRC.
+ *
+ * What the application does (see examples/stm32_hal/ and docs/porting.md):
+ *  - configures each UART with HAL_HalfDuplex_Init() at the bus baud (6 Mbps), 8N1, with a
+ *    DMA stream for TX and one for RX (both normal mode, byte width), and enables the UART
+ *    and both DMA stream interrupts at ONE priority (also the timer's, when advance_in_isr);
+ *  - declares the DMA buffers with J288_STM32_DMA_BUFFER() in RAM the DMA can reach;
+ *  - calls j288_stm32_init() per bus, then forwards from its own HAL callbacks (the port
+ *    never defines the HAL's weak callbacks):
+ *        HAL_UART_TxCpltCallback(h)           -> j288_stm32_on_tx_cplt(h)
+ *        HAL_UARTEx_RxEventCallback(h, size)  -> j288_stm32_on_rx_event(h, size)
+ *        HAL_UART_ErrorCallback(h)            -> j288_stm32_on_error(h)
+ *        HAL_TIM_OC_DelayElapsedCallback(t)   -> j288_stm32_on_timer(t)
+ *    Each returns true when the handle belonged to a registered bus, so one callback can
+ *    serve several buses and unrelated UARTs/timers.
+ *
+ * Several buses: up to J288_STM32_MAX_BUSES are registered at once (one per UART); the
+ * callbacks find the bus by handle with a short linear search.
+ *
+ * Interrupt context: every j288_stm32_on_* function is ISR-safe and is meant to be called from
+ * the HAL callbacks above (i.e. from the UART/DMA/timer IRQ). init/deinit are thread only.
+ */
+#ifndef J288_STM32_H
+#define J288_STM32_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "j288/bus.h"
+#include "j288/port.h"
+
+/* The HAL header. "main.h" is what CubeMX generates in every project and it includes the
+ * family's HAL (stm32f4xx_hal.h, stm32h7xx_hal.h, ...), so the default works on any family;
+ * port/stm32_hal/stub/ provides a main.h of its own for builds without the HAL. */
+#ifndef J288_STM32_HAL_HEADER
+#define J288_STM32_HAL_HEADER "main.h"
+#endif
+#include J288_STM32_HAL_HEADER
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* ---- configuration macros (define before including, or with -D) ------------------------ */
+
+/* How many buses (UARTs) may be registered at once. */
+#ifndef J288_STM32_MAX_BUSES
+#define J288_STM32_MAX_BUSES 4u
+#endif
+
+/* 1: use the CRC unit for frames (j288_stm32_config_t.hcrc). 0: compile the hardware path
+ * out; frames use the library's compile-time software backend (J288_CONFIG_CRC_BACKEND). */
+#ifndef J288_STM32_HW_CRC
+#define J288_STM32_HW_CRC 1
+#endif
+
+/* The CRC unit is shared by everything on the chip (other libraries, firmware image checks).
+ * One frame CRC resets the unit and feeds 4 or 5 words (well under a microsecond at 168 MHz)
+ * inside J288_STM32_CRC_LOCK()/J288_STM32_CRC_UNLOCK(). The default masks all interrupts
+ * (PRIMASK) around the computation, which is safe when the other users run at thread level or
+ * below the bus interrupts and themselves take the same lock. Replace both with your RTOS
+ * mutex only if the bus never advances in an ISR (advance_in_isr = false). The variable named
+ * by the argument (a uint32_t) may hold saved state. */
+#ifndef J288_STM32_CRC_LOCK
+#define J288_STM32_CRC_LOCK(saved) ((saved) = __get_PRIMASK(), __disable_irq())
+#define J288_STM32_CRC_UNLOCK(saved) __set_PRIMASK(saved)
+#endif
+
+/* 1 on cores with a data cache in use (Cortex-M7 with SCB_EnableDCache()): the port cleans the
+ * TX buffer before each transmit and invalidates the RX buffer before and after each
+ * reception. The DMA buffers are then aligned to and sized in whole 32-byte cache lines, so
+ * maintenance never touches a neighbour's data. 0 (default): no cache maintenance; leave it 0
+ * when the buffers live in non-cacheable RAM (MPU region, or DTCM where the DMA reaches it). */
+#ifndef J288_STM32_DCACHE
+#define J288_STM32_DCACHE 0
+#endif
+
+/* Cache line / DMA buffer alignment in bytes (32 on Cortex-M7). */
+#ifndef J288_STM32_DCACHE_LINE
+#define J288_STM32_DCACHE_LINE 32u
+#endif
+
+/* Placement of the DMA buffers: e.g. __attribute__((section(".dma_buffer"))) to put them in
+ * an SRAM the DMA controller can reach (not the F4's CCM RAM, not the H7's DTCM) or in a
+ * non-cacheable MPU region. Empty by default (.bss). */
+#ifndef J288_STM32_DMA_SECTION
+#define J288_STM32_DMA_SECTION
+#endif
+
+/* Alignment attribute for the DMA buffers (GCC, Clang and Arm Compiler 6 syntax; IAR users
+ * define it as their equivalent). */
+#ifndef J288_STM32_DMA_ALIGN
+#define J288_STM32_DMA_ALIGN __attribute__((aligned(J288_STM32_DCACHE_LINE)))
+#endif
+
+/* Receive DMA buffer size: a whole number of cache lines, larger than one reply so that the
+ * idle line, not a full buffer, ends a normal reception. */
+#ifndef J288_STM32_RX_BUF_SIZE
+#define J288_STM32_RX_BUF_SIZE 64u
+#endif
+
+/* Transmit DMA buffer size: one command rounded up to whole cache lines. */
+#define J288_STM32_TX_BUF_SIZE                                                                 \
+    (((J288_CMD_LEN + J288_STM32_DCACHE_LINE - 1u) / J288_STM32_DCACHE_LINE) * J288_STM32_DCACHE_LINE)
+
+/* ---- types ----------------------------------------------------------------------------- */
+
+/* The DMA buffers of one bus. Declare with J288_STM32_DMA_BUFFER(name) at file scope, so that
+ * placement and alignment apply; the port copies each command in (20 bytes) rather than let
+ * the DMA read the bus object, which may live in RAM the DMA cannot reach. */
+typedef struct {
+    uint8_t tx[J288_STM32_TX_BUF_SIZE];
+    uint8_t rx[J288_STM32_RX_BUF_SIZE];
+} j288_stm32_dma_t;
+
+#define J288_STM32_DMA_BUFFER(name) J288_STM32_DMA_SECTION J288_STM32_DMA_ALIGN j288_stm32_dma_t name
+
+/* All pointers must outlive the bus. Fields marked optional may be NULL/0. */
+typedef struct {
+    UART_HandleTypeDef *huart; /* required: initialised with HAL_HalfDuplex_Init() */
+    j288_stm32_dma_t *dma;     /* required: declared with J288_STM32_DMA_BUFFER() */
+
+    /* Optional driver-enable pin of an external transceiver: driven active while we
+     * transmit, inactive otherwise. de_port NULL: no pin. */
+    GPIO_TypeDef *de_port;
+    uint16_t de_pin;
+    bool de_active_low;
+
+    /* Time. now_us: the application's monotonic microsecond tick (any context, wraps at
+     * 2^32). When NULL, htim's counter is the tick; it must then count at 1 MHz with a 32-bit
+     * reload of 0xFFFFFFFF (TIM2/TIM5 on the F4), which init checks. */
+    uint32_t (*now_us)(void);
+
+    /* Optional response timeout: a timer counting at 1 MHz, started by the application
+     * (HAL_TIM_Base_Start), whose capture/compare channel tim_channel (TIM_CHANNEL_1..4) is
+     * free and in its reset (frozen output compare) mode. The port writes the compare value
+     * and enables that channel's interrupt; forward HAL_TIM_OC_DelayElapsedCallback to
+     * j288_stm32_on_timer(). Several buses may share one timer on different channels. NULL:
+     * no timer; call j288_bus_poll() (or j288_sched_poll()) often enough yourself. */
+    TIM_HandleTypeDef *htim;
+    uint32_t tim_channel;
+
+    /* Optional CRC unit in its reset configuration (J288_STM32_HW_CRC = 1): polynomial
+     * 0x04C11DB7, initial value 0xFFFFFFFF, no reversal, 32-bit input. NULL: software CRC. */
+    CRC_HandleTypeDef *hcrc;
+} j288_stm32_config_t;
+
+/* Port-side counters. */
+typedef struct {
+    uint32_t tx_frames;    /* transmits started */
+    uint32_t rx_events;    /* receive events taken (half, idle, full) */
+    uint32_t rx_bytes;     /* bytes handed to the bus */
+    uint32_t line_errors;  /* error callbacks */
+    uint32_t hal_failures; /* HAL calls that did not return HAL_OK */
+    uint32_t timer_events;
+} j288_stm32_stats_t;
+
+/* One bus on one UART. Caller-allocated (statically, usually); must not move while
+ * registered. Private: use the functions below. */
+typedef struct j288_stm32 {
+    j288_bus_t bus;
+    j288_stm32_config_t cfg;
+    volatile uint16_t rx_pos;  /* bytes of the current reception already handed out */
+    volatile uint8_t dir;      /* j288_dir_t last set */
+    uint32_t lock_saved;
+    j288_stm32_stats_t stats;
+} j288_stm32_t;
+
+/* ---- functions ------------------------------------------------------------------------- */
+
+/* Set up p, register it and initialise its bus (j288_bus_init with bus_cfg, which may be
+ * NULL for defaults). Leaves the line in receive direction with the DE pin inactive.
+ * Errors: J288_ERR_NULL (p, cfg, huart or dma), J288_ERR_BUSY (this UART is registered
+ * already, or J288_STM32_MAX_BUSES are), J288_ERR_BAD_CONFIG (no now_us and no 32-bit 1 MHz
+ * timer; a bad tim_channel), or j288_bus_init()'s codes. Thread only. */
+int j288_stm32_init(j288_stm32_t *p, const j288_stm32_config_t *cfg,
+                    const j288_bus_config_t *bus_cfg);
+
+/* Unregister p (the callbacks ignore its handles from now on). Thread only. */
+void j288_stm32_deinit(j288_stm32_t *p);
+
+/* The bus driven by p, for j288_bus_* and j288_sched_*. */
+j288_bus_t *j288_stm32_bus(j288_stm32_t *p);
+
+/* The microsecond tick p uses (its now_us, or the timer counter). Any context. */
+uint32_t j288_stm32_now_us(const j288_stm32_t *p);
+
+const j288_stm32_stats_t *j288_stm32_stats(const j288_stm32_t *p);
+
+/* Callback forwarding, ISR-safe. Each returns false (and does nothing) when the handle
+ * belongs to no registered bus. */
+bool j288_stm32_on_tx_cplt(UART_HandleTypeDef *huart);
+bool j288_stm32_on_rx_event(UART_HandleTypeDef *huart, uint16_t size);
+bool j288_stm32_on_error(UART_HandleTypeDef *huart);
+bool j288_stm32_on_timer(TIM_HandleTypeDef *htim);
+
+#if J288_STM32_HW_CRC
+/* The manual's crc32_core over nwords little-endian words at data (any alignment) on the CRC
+ * unit hcrc, inside J288_STM32_CRC_LOCK. Words are assembled from bytes into an aligned
+ * scratch buffer (never a cast of data), 8 words at a time: HAL_CRC_Calculate for the first
+ * chunk (it resets the unit), HAL_CRC_Accumulate for the rest. A frame is 4 or 5 words.
+ * Returns the CRC. ISR-safe. */
+uint32_t j288_stm32_crc32(CRC_HandleTypeDef *hcrc, const uint8_t *data, size_t nwords);
+
+/* The same as a context-free function for J288_CONFIG_CRC_BACKEND = J288_CRC_BACKEND_HW with
+ * J288_CONFIG_CRC_HW_FUNCTION=j288_stm32_crc32_default, after j288_stm32_crc_attach(). Before
+ * an attach (or with NULL) it computes in software, bit-identically. */
+void j288_stm32_crc_attach(CRC_HandleTypeDef *hcrc);
+uint32_t j288_stm32_crc32_default(const uint8_t *data, size_t nwords);
+#endif
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* J288_STM32_H */

@@ -1,0 +1,211 @@
+/*
+ * stm32_hal_stub.h - the slice of the STM32Cube HAL (and CMSIS core) that port/stm32_hal uses.
+ *
+ * Written for this project, not taken from ST: it declares only the types, constants, macros
+ * and functions that j288_stm32.c names, with the HAL's own names and signatures, so that the
+ * port source compiles unchanged against this stub (host tests, the link-only firmware
+ * example) and against the real STM32Cube HAL. Register structures list only the registers
+ * the port touches; their layout is NOT the silicon's, so nothing built on this stub can drive
+ * real hardware. Constants that the port passes back to the HAL (channel numbers, flag bits)
+ * carry the values the HAL uses, so a mistake shows up the same way in both builds.
+ *
+ * Implementations: test/stm32/fake_hal.c (a host-side fake that records calls and fires the
+ * HAL's callbacks) and stm32_hal_stub.c (do-nothing bodies so that firmware links).
+ */
+#ifndef J288_STM32_HAL_STUB_H
+#define J288_STM32_HAL_STUB_H
+
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* ---- common ---------------------------------------------------------------------------- */
+typedef enum { HAL_OK = 0x00u, HAL_ERROR = 0x01u, HAL_BUSY = 0x02u, HAL_TIMEOUT = 0x03u } HAL_StatusTypeDef;
+
+/* ---- GPIO ------------------------------------------------------------------------------ */
+typedef struct {
+    volatile uint32_t ODR;
+    volatile uint32_t BSRR;
+} GPIO_TypeDef;
+
+typedef enum { GPIO_PIN_RESET = 0u, GPIO_PIN_SET } GPIO_PinState;
+
+void HAL_GPIO_WritePin(GPIO_TypeDef *GPIOx, uint16_t GPIO_Pin, GPIO_PinState PinState);
+GPIO_PinState HAL_GPIO_ReadPin(GPIO_TypeDef *GPIOx, uint16_t GPIO_Pin);
+
+/* ---- DMA ------------------------------------------------------------------------------- */
+typedef struct {
+    volatile uint32_t CR;
+    volatile uint32_t NDTR;
+} DMA_Stream_TypeDef;
+
+typedef struct __DMA_HandleTypeDef {
+    DMA_Stream_TypeDef *Instance;
+    void *Parent;
+} DMA_HandleTypeDef;
+
+/* ---- UART ------------------------------------------------------------------------------ */
+typedef struct {
+    volatile uint32_t SR;
+    volatile uint32_t DR;
+    volatile uint32_t BRR;
+    volatile uint32_t CR1;
+    volatile uint32_t CR2;
+    volatile uint32_t CR3;
+} USART_TypeDef;
+
+typedef struct {
+    uint32_t BaudRate;
+    uint32_t WordLength;
+    uint32_t StopBits;
+    uint32_t Parity;
+    uint32_t Mode;
+    uint32_t HwFlowCtl;
+    uint32_t OverSampling;
+} UART_InitTypeDef;
+
+/* The HAL keeps transmit and receive states apart (gState, RxState). */
+typedef uint32_t HAL_UART_StateTypeDef;
+#define HAL_UART_STATE_RESET 0x00u
+#define HAL_UART_STATE_READY 0x20u
+#define HAL_UART_STATE_BUSY 0x24u
+#define HAL_UART_STATE_BUSY_TX 0x21u
+#define HAL_UART_STATE_BUSY_RX 0x22u
+#define HAL_UART_STATE_ERROR 0xE0u
+
+/* UART ErrorCode bits. */
+#define HAL_UART_ERROR_NONE 0x00000000u
+#define HAL_UART_ERROR_PE 0x00000001u
+#define HAL_UART_ERROR_NE 0x00000002u
+#define HAL_UART_ERROR_FE 0x00000004u
+#define HAL_UART_ERROR_ORE 0x00000008u
+#define HAL_UART_ERROR_DMA 0x00000010u
+
+typedef struct __UART_HandleTypeDef {
+    USART_TypeDef *Instance;
+    UART_InitTypeDef Init;
+    const uint8_t *pTxBuffPtr;
+    uint16_t TxXferSize;
+    uint8_t *pRxBuffPtr;
+    uint16_t RxXferSize;
+    DMA_HandleTypeDef *hdmatx;
+    DMA_HandleTypeDef *hdmarx;
+    volatile HAL_UART_StateTypeDef gState;
+    volatile HAL_UART_StateTypeDef RxState;
+    volatile uint32_t ErrorCode;
+} UART_HandleTypeDef;
+
+HAL_StatusTypeDef HAL_HalfDuplex_Init(UART_HandleTypeDef *huart);
+HAL_StatusTypeDef HAL_HalfDuplex_EnableTransmitter(UART_HandleTypeDef *huart);
+HAL_StatusTypeDef HAL_HalfDuplex_EnableReceiver(UART_HandleTypeDef *huart);
+HAL_StatusTypeDef HAL_UART_Transmit_DMA(UART_HandleTypeDef *huart, const uint8_t *pData, uint16_t Size);
+HAL_StatusTypeDef HAL_UARTEx_ReceiveToIdle_DMA(UART_HandleTypeDef *huart, uint8_t *pData, uint16_t Size);
+HAL_StatusTypeDef HAL_UART_AbortReceive(UART_HandleTypeDef *huart);
+void HAL_UART_IRQHandler(UART_HandleTypeDef *huart);
+
+/* Weak in the HAL; the application defines them (the port never does). */
+void HAL_UART_TxCpltCallback(UART_HandleTypeDef *huart);
+void HAL_UARTEx_RxEventCallback(UART_HandleTypeDef *huart, uint16_t Size);
+void HAL_UART_ErrorCallback(UART_HandleTypeDef *huart);
+
+/* ---- timers ---------------------------------------------------------------------------- */
+typedef struct {
+    volatile uint32_t CR1;
+    volatile uint32_t DIER;
+    volatile uint32_t SR;
+    volatile uint32_t CNT;
+    volatile uint32_t PSC;
+    volatile uint32_t ARR;
+    volatile uint32_t CCR1;
+    volatile uint32_t CCR2;
+    volatile uint32_t CCR3;
+    volatile uint32_t CCR4;
+} TIM_TypeDef;
+
+typedef struct {
+    uint32_t Prescaler;
+    uint32_t CounterMode;
+    uint32_t Period;
+    uint32_t ClockDivision;
+    uint32_t AutoReloadPreload;
+} TIM_Base_InitTypeDef;
+
+typedef enum {
+    HAL_TIM_ACTIVE_CHANNEL_1 = 0x01u,
+    HAL_TIM_ACTIVE_CHANNEL_2 = 0x02u,
+    HAL_TIM_ACTIVE_CHANNEL_3 = 0x04u,
+    HAL_TIM_ACTIVE_CHANNEL_4 = 0x08u,
+    HAL_TIM_ACTIVE_CHANNEL_CLEARED = 0x00u
+} HAL_TIM_ActiveChannel;
+
+typedef struct __TIM_HandleTypeDef {
+    TIM_TypeDef *Instance;
+    TIM_Base_InitTypeDef Init;
+    HAL_TIM_ActiveChannel Channel;
+} TIM_HandleTypeDef;
+
+#define TIM_CHANNEL_1 0x00000000u
+#define TIM_CHANNEL_2 0x00000004u
+#define TIM_CHANNEL_3 0x00000008u
+#define TIM_CHANNEL_4 0x0000000Cu
+
+/* Capture/compare interrupt enables (DIER) and flags (SR): bit n for channel n. */
+#define TIM_IT_CC1 0x00000002u
+#define TIM_IT_CC2 0x00000004u
+#define TIM_IT_CC3 0x00000008u
+#define TIM_IT_CC4 0x00000010u
+#define TIM_FLAG_CC1 0x00000002u
+#define TIM_FLAG_CC2 0x00000004u
+#define TIM_FLAG_CC3 0x00000008u
+#define TIM_FLAG_CC4 0x00000010u
+
+#define __HAL_TIM_GET_COUNTER(h) ((h)->Instance->CNT)
+#define __HAL_TIM_GET_AUTORELOAD(h) ((h)->Instance->ARR)
+#define __HAL_TIM_ENABLE_IT(h, it) ((h)->Instance->DIER |= (it))
+#define __HAL_TIM_DISABLE_IT(h, it) ((h)->Instance->DIER &= ~(it))
+/* SR bits are cleared by writing 0 (rc_w0), others written as 1 stay untouched. */
+#define __HAL_TIM_CLEAR_FLAG(h, f) ((h)->Instance->SR = ~(f))
+#define __HAL_TIM_SET_COMPARE(h, ch, v)                                                        \
+    (*((ch) == TIM_CHANNEL_1   ? &(h)->Instance->CCR1                                          \
+       : (ch) == TIM_CHANNEL_2 ? &(h)->Instance->CCR2                                          \
+       : (ch) == TIM_CHANNEL_3 ? &(h)->Instance->CCR3                                          \
+                               : &(h)->Instance->CCR4) = (v))
+
+HAL_StatusTypeDef HAL_TIM_Base_Start(TIM_HandleTypeDef *htim);
+void HAL_TIM_IRQHandler(TIM_HandleTypeDef *htim);
+void HAL_TIM_OC_DelayElapsedCallback(TIM_HandleTypeDef *htim); /* weak in the HAL */
+
+/* ---- CRC unit -------------------------------------------------------------------------- */
+typedef struct {
+    volatile uint32_t DR;
+    volatile uint32_t IDR;
+    volatile uint32_t CR;
+} CRC_TypeDef;
+
+typedef struct {
+    CRC_TypeDef *Instance;
+} CRC_HandleTypeDef;
+
+/* Resets the unit to its initial value, feeds BufferLength words, returns the result. */
+uint32_t HAL_CRC_Calculate(CRC_HandleTypeDef *hcrc, uint32_t pBuffer[], uint32_t BufferLength);
+/* Feeds BufferLength more words without resetting, returns the running result. */
+uint32_t HAL_CRC_Accumulate(CRC_HandleTypeDef *hcrc, uint32_t pBuffer[], uint32_t BufferLength);
+
+/* ---- system ---------------------------------------------------------------------------- */
+HAL_StatusTypeDef HAL_Init(void);
+uint32_t HAL_GetTick(void);
+
+/* ---- CMSIS core (static inline in CMSIS; plain functions here) -------------------------- */
+uint32_t __get_PRIMASK(void);
+void __set_PRIMASK(uint32_t priMask);
+void __disable_irq(void);
+void SCB_CleanDCache_by_Addr(volatile void *addr, int32_t dsize);
+void SCB_InvalidateDCache_by_Addr(volatile void *addr, int32_t dsize);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* J288_STM32_HAL_STUB_H */

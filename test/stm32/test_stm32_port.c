@@ -1,0 +1,563 @@
+/*
+ * The STM32 HAL port driven through full transactions with the real bus engine, against the
+ * fake HAL (test/stm32/fake_hal.c). The test plays the application (it defines the HAL's weak
+ * callbacks and forwards them to the port, as a CubeMX project does) and the hardware (it
+ * completes transmits, delivers bytes, idles the line, raises errors, fires the timer).
+ * Built with J288_STM32_DCACHE=1 and J288_STM32_RX_BUF_SIZE=32 so that the cache maintenance
+ * is exercised and a 26-byte reply crosses the half-transfer point.
+ */
+#include "unity.h"
+
+#include <string.h>
+
+#include "fake_hal.h"
+#include "j288/j288.h"
+#include "j288_stm32.h"
+
+/* ---- the application side: HAL callbacks forwarded to the port ------------------------- */
+
+void HAL_UART_TxCpltCallback(UART_HandleTypeDef *huart) { (void)j288_stm32_on_tx_cplt(huart); }
+void HAL_UARTEx_RxEventCallback(UART_HandleTypeDef *huart, uint16_t Size)
+{
+    (void)j288_stm32_on_rx_event(huart, Size);
+}
+void HAL_UART_ErrorCallback(UART_HandleTypeDef *huart) { (void)j288_stm32_on_error(huart); }
+void HAL_TIM_OC_DelayElapsedCallback(TIM_HandleTypeDef *htim) { (void)j288_stm32_on_timer(htim); }
+
+/* ---- fixtures ------------------------------------------------------------------------- */
+
+/* The spec's worked frames (bytes from the independent generator). */
+static const uint8_t k_cmd_foc3[J288_CMD_LEN] = {0xfe, 0xee, 0x93, 0x00, 0x00, 0x00, 0x00,
+                                                 0x00, 0x5f, 0x14, 0x00, 0x00, 0x00, 0x05,
+                                                 0x00, 0x32, 0xa6, 0x4b, 0x30, 0x3f};
+static const uint8_t k_reply3[J288_REPLY_LEN] = {
+    0xfc, 0xee, 0x13, 0x24, 0x29, 0x30, 0x00, 0x05, 0xd7, 0xff, 0x5f, 0x14, 0x00,
+    0x00, 0x00, 0x00, 0x00, 0x00, 0xe8, 0x03, 0x00, 0x00, 0x49, 0xc2, 0x3b, 0xee};
+static const uint8_t k_lock_broadcast_head[3] = {0xfe, 0xee, 0x8f};
+
+static USART_TypeDef usart1_regs, usart2_regs;
+static UART_HandleTypeDef huart1, huart2, huart_other;
+static TIM_TypeDef tim2_regs;
+static TIM_HandleTypeDef htim2;
+static CRC_TypeDef crc_regs;
+static CRC_HandleTypeDef hcrc;
+static GPIO_TypeDef gpioa;
+#define DE_PIN ((uint16_t)0x0100u)
+
+J288_STM32_DMA_BUFFER(dma1);
+J288_STM32_DMA_BUFFER(dma2);
+static j288_stm32_t port1, port2;
+
+static uint32_t fake_now;
+static uint32_t clock_us(void) { return fake_now; }
+
+static int done_count;
+static j288_txn_t last_txn;
+static void on_done(void *user, const j288_txn_t *txn)
+{
+    (void)user;
+    done_count++;
+    last_txn = *txn;
+}
+
+static j288_cmd_raw_t foc3_cmd(void)
+{
+    j288_cmd_raw_t c;
+    memset(&c, 0, sizeof c);
+    c.id = 3u;
+    c.status = J288_MODE_FOC;
+    c.watchdog = true;
+    c.pos = 5215;
+    c.kp = 1280;
+    c.kd = 12800;
+    return c;
+}
+
+static j288_stm32_config_t base_config(UART_HandleTypeDef *h, j288_stm32_dma_t *dma)
+{
+    j288_stm32_config_t c;
+    memset(&c, 0, sizeof c);
+    c.huart = h;
+    c.dma = dma;
+    c.now_us = clock_us;
+    c.hcrc = &hcrc;
+    return c;
+}
+
+void setUp(void)
+{
+    fake_hal_reset();
+    memset(&huart1, 0, sizeof huart1);
+    memset(&huart2, 0, sizeof huart2);
+    memset(&huart_other, 0, sizeof huart_other);
+    memset(&tim2_regs, 0, sizeof tim2_regs);
+    memset(&htim2, 0, sizeof htim2);
+    huart1.Instance = &usart1_regs;
+    huart2.Instance = &usart2_regs;
+    huart_other.Instance = &usart2_regs;
+    (void)HAL_HalfDuplex_Init(&huart1);
+    (void)HAL_HalfDuplex_Init(&huart2);
+    (void)HAL_HalfDuplex_Init(&huart_other);
+    htim2.Instance = &tim2_regs;
+    tim2_regs.ARR = 0xFFFFFFFFu;
+    hcrc.Instance = &crc_regs;
+    fake_now = 1000u;
+    done_count = 0;
+    memset(&last_txn, 0, sizeof last_txn);
+}
+
+void tearDown(void)
+{
+    j288_stm32_deinit(&port1);
+    j288_stm32_deinit(&port2);
+}
+
+static void init_port1(const j288_bus_config_t *bus_cfg, bool timer, bool de)
+{
+    j288_stm32_config_t c = base_config(&huart1, &dma1);
+    if (timer) {
+        c.htim = &htim2;
+        c.tim_channel = TIM_CHANNEL_1;
+    }
+    if (de) {
+        c.de_port = &gpioa;
+        c.de_pin = DE_PIN;
+    }
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_stm32_init(&port1, &c, bus_cfg));
+}
+
+/* Submit foc3 on port1 and complete its transmit. */
+static void send_foc3(void)
+{
+    j288_cmd_raw_t cmd = foc3_cmd();
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_bus_submit(j288_stm32_bus(&port1), &cmd, fake_now, on_done, NULL));
+    j288_bus_poll(j288_stm32_bus(&port1), fake_now);
+    TEST_ASSERT_TRUE(fake_hal_tx_busy(&huart1));
+    fake_now += 40u;
+    TEST_ASSERT_TRUE(fake_hal_tx_complete(&huart1));
+}
+
+static void poll1(void) { j288_bus_poll(j288_stm32_bus(&port1), fake_now); }
+
+/* ---- init ----------------------------------------------------------------------------- */
+
+static void test_init_rejects_bad_config(void)
+{
+    j288_stm32_config_t c = base_config(&huart1, &dma1);
+    TEST_ASSERT_EQUAL_INT(J288_ERR_NULL, j288_stm32_init(NULL, &c, NULL));
+    TEST_ASSERT_EQUAL_INT(J288_ERR_NULL, j288_stm32_init(&port1, NULL, NULL));
+    c.dma = NULL;
+    TEST_ASSERT_EQUAL_INT(J288_ERR_NULL, j288_stm32_init(&port1, &c, NULL));
+    c = base_config(NULL, &dma1);
+    TEST_ASSERT_EQUAL_INT(J288_ERR_NULL, j288_stm32_init(&port1, &c, NULL));
+
+    /* no tick at all: neither now_us nor a 32-bit timer */
+    c = base_config(&huart1, &dma1);
+    c.now_us = NULL;
+    TEST_ASSERT_EQUAL_INT(J288_ERR_BAD_CONFIG, j288_stm32_init(&port1, &c, NULL));
+    c.htim = &htim2;
+    c.tim_channel = TIM_CHANNEL_1;
+    tim2_regs.ARR = 0xFFFFu; /* a 16-bit timer cannot be the tick */
+    TEST_ASSERT_EQUAL_INT(J288_ERR_BAD_CONFIG, j288_stm32_init(&port1, &c, NULL));
+    tim2_regs.ARR = 0xFFFFFFFFu;
+    c.tim_channel = 3u; /* not a TIM_CHANNEL_n */
+    TEST_ASSERT_EQUAL_INT(J288_ERR_BAD_CONFIG, j288_stm32_init(&port1, &c, NULL));
+    c.tim_channel = TIM_CHANNEL_2;
+    tim2_regs.CNT = 777u;
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_stm32_init(&port1, &c, NULL));
+    TEST_ASSERT_EQUAL_UINT32(777u, j288_stm32_now_us(&port1)); /* the timer is the tick */
+
+    /* one bus per UART */
+    c = base_config(&huart1, &dma2);
+    TEST_ASSERT_EQUAL_INT(J288_ERR_BUSY, j288_stm32_init(&port2, &c, NULL));
+}
+
+static void test_init_leaves_line_receiving_de_inactive(void)
+{
+    init_port1(NULL, false, true);
+    TEST_ASSERT_TRUE(fake_hal_receiver_on(&huart1));
+    TEST_ASSERT_FALSE(fake_hal_transmitter_on(&huart1));
+    TEST_ASSERT_EQUAL_INT(0, fake_hal_gpio_level(&gpioa, DE_PIN));
+}
+
+static void test_registry_is_bounded(void)
+{
+    static j288_stm32_t extra[J288_STM32_MAX_BUSES + 1u];
+    static UART_HandleTypeDef uarts[J288_STM32_MAX_BUSES + 1u];
+    static j288_stm32_dma_t J288_STM32_DMA_ALIGN bufs[J288_STM32_MAX_BUSES + 1u];
+    for (size_t i = 0; i <= J288_STM32_MAX_BUSES; i++) {
+        j288_stm32_config_t c = base_config(&uarts[i], &bufs[i]);
+        uarts[i].Instance = &usart1_regs;
+        (void)HAL_HalfDuplex_Init(&uarts[i]);
+        TEST_ASSERT_EQUAL_INT(i < J288_STM32_MAX_BUSES ? J288_OK : J288_ERR_BUSY,
+                              j288_stm32_init(&extra[i], &c, NULL));
+    }
+    for (size_t i = 0; i <= J288_STM32_MAX_BUSES; i++) {
+        j288_stm32_deinit(&extra[i]);
+    }
+    TEST_ASSERT_FALSE(j288_stm32_on_tx_cplt(&uarts[0]));
+}
+
+/* ---- transactions ---------------------------------------------------------------------- */
+
+static void test_full_transaction_call_order_and_bytes(void)
+{
+    size_t len = 0;
+    long abort_i, tx_i, de_on, clean_i, dma_i, de_off, rx_i, arm_i;
+    init_port1(NULL, false, true);
+    fake_hal_log_clear();
+
+    j288_cmd_raw_t cmd = foc3_cmd();
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_bus_submit(j288_stm32_bus(&port1), &cmd, fake_now, on_done, NULL));
+    poll1();
+
+    /* the worked frame, byte for byte, sent from the DMA buffer */
+    const uint8_t *sent = fake_hal_tx_data(&huart1, &len);
+    TEST_ASSERT_EQUAL_UINT32((uint32_t)(J288_CMD_LEN), (uint32_t)len);
+    TEST_ASSERT_EQUAL_HEX8_ARRAY(k_cmd_foc3, sent, J288_CMD_LEN);
+    TEST_ASSERT_TRUE(huart1.pTxBuffPtr == dma1.tx);
+    TEST_ASSERT_TRUE(fake_hal_transmitter_on(&huart1));
+    TEST_ASSERT_FALSE(fake_hal_receiver_on(&huart1));
+    TEST_ASSERT_EQUAL_INT(1, fake_hal_gpio_level(&gpioa, DE_PIN));
+
+    /* abort stale reception -> transmitter on -> DE -> cache clean -> DMA */
+    abort_i = fake_hal_log_find(FAKE_ABORT_RECEIVE, &huart1, 0);
+    tx_i = fake_hal_log_find(FAKE_HALFDUPLEX_TX, &huart1, 0);
+    de_on = fake_hal_log_find(FAKE_GPIO_WRITE, &gpioa, 0);
+    clean_i = fake_hal_log_find(FAKE_CACHE_CLEAN, dma1.tx, 0);
+    dma_i = fake_hal_log_find(FAKE_TRANSMIT_DMA, &huart1, 0);
+    TEST_ASSERT_TRUE(abort_i >= 0 && abort_i < tx_i);
+    TEST_ASSERT_TRUE(tx_i < de_on && de_on < dma_i);
+    TEST_ASSERT_TRUE(clean_i >= 0 && clean_i < dma_i);
+    TEST_ASSERT_EQUAL_UINT32(0u, fake_hal_log_at((size_t)clean_i)->arg % J288_STM32_DCACHE_LINE);
+    TEST_ASSERT_EQUAL_INT(-1, fake_hal_log_find(FAKE_RECEIVE_TO_IDLE_DMA, &huart1, 0));
+
+    /* transmit complete: DE off, receiver on, reception armed into the DMA buffer */
+    fake_now += 40u;
+    TEST_ASSERT_TRUE(fake_hal_tx_complete(&huart1));
+    de_off = fake_hal_log_find(FAKE_GPIO_WRITE, &gpioa, (size_t)dma_i);
+    rx_i = fake_hal_log_find(FAKE_HALFDUPLEX_RX, &huart1, (size_t)dma_i);
+    arm_i = fake_hal_log_find(FAKE_RECEIVE_TO_IDLE_DMA, &huart1, (size_t)dma_i);
+    TEST_ASSERT_TRUE(de_off >= 0 && rx_i >= 0 && arm_i > rx_i);
+    TEST_ASSERT_EQUAL_INT(0, fake_hal_gpio_level(&gpioa, DE_PIN));
+    TEST_ASSERT_TRUE(fake_hal_rx_armed(&huart1));
+    TEST_ASSERT_TRUE(huart1.pRxBuffPtr == dma1.rx);
+    TEST_ASSERT_EQUAL_UINT16(J288_STM32_RX_BUF_SIZE, huart1.RxXferSize);
+
+    /* the reply: half-transfer event at 16 bytes, then idle at 26 */
+    fake_now += 60u;
+    TEST_ASSERT_EQUAL_UINT32((uint32_t)(J288_REPLY_LEN), (uint32_t)fake_hal_rx_bytes(&huart1, k_reply3, J288_REPLY_LEN));
+    TEST_ASSERT_TRUE(fake_hal_rx_idle(&huart1));
+    TEST_ASSERT_EQUAL_UINT32(2u, j288_stm32_stats(&port1)->rx_events);
+    TEST_ASSERT_EQUAL_UINT32(J288_REPLY_LEN, j288_stm32_stats(&port1)->rx_bytes);
+    TEST_ASSERT_TRUE(fake_hal_count(FAKE_CACHE_INVALIDATE) >= 2u);
+    poll1();
+    fake_now += 10u;
+    poll1();
+
+    TEST_ASSERT_EQUAL_INT(1, done_count);
+    TEST_ASSERT_EQUAL_INT(J288_OK, last_txn.result);
+    TEST_ASSERT_EQUAL_UINT8(3u, last_txn.reply.id);
+    TEST_ASSERT_EQUAL_INT32(5215, last_txn.reply.pos);
+    TEST_ASSERT_EQUAL_INT16(-41, last_txn.reply.speed);
+    TEST_ASSERT_EQUAL_UINT16(1000u, last_txn.reply.out_pos);
+    /* frames were checked on the CRC unit (command and reply), with the lock released */
+    TEST_ASSERT_TRUE(fake_hal_count(FAKE_CRC_CALCULATE) >= 2u);
+    TEST_ASSERT_EQUAL_UINT32(0u, fake_hal_primask());
+}
+
+static void test_reply_split_by_a_gap_is_heard_whole(void)
+{
+    init_port1(NULL, false, false);
+    send_foc3();
+    /* 10 bytes, the line idles (reception ends and is re-armed), then the other 16 */
+    TEST_ASSERT_EQUAL_UINT32((uint32_t)(10u), (uint32_t)fake_hal_rx_bytes(&huart1, k_reply3, 10u));
+    TEST_ASSERT_TRUE(fake_hal_rx_idle(&huart1));
+    TEST_ASSERT_TRUE(fake_hal_rx_armed(&huart1));
+    TEST_ASSERT_EQUAL_UINT32((uint32_t)(16u), (uint32_t)fake_hal_rx_bytes(&huart1, &k_reply3[10], 16u));
+    TEST_ASSERT_TRUE(fake_hal_rx_idle(&huart1));
+    poll1();
+    TEST_ASSERT_EQUAL_INT(1, done_count);
+    TEST_ASSERT_EQUAL_INT(J288_OK, last_txn.result);
+    TEST_ASSERT_EQUAL_INT32(5215, last_txn.reply.pos);
+}
+
+static void test_reply_one_byte_per_event(void)
+{
+    /* an RxEvent per byte (e.g. a tiny buffer): each event's size is a fill level, so the
+     * port hands over only the new byte each time */
+    init_port1(NULL, false, false);
+    send_foc3();
+    for (uint16_t i = 0; i < J288_REPLY_LEN; i++) {
+        dma1.rx[i] = k_reply3[i];
+        huart1.RxState = (i + 1u < J288_REPLY_LEN) ? HAL_UART_STATE_BUSY_RX : HAL_UART_STATE_READY;
+        TEST_ASSERT_TRUE(j288_stm32_on_rx_event(&huart1, (uint16_t)(i + 1u)));
+    }
+    TEST_ASSERT_EQUAL_UINT32(J288_REPLY_LEN, j288_stm32_stats(&port1)->rx_bytes);
+    poll1();
+    TEST_ASSERT_EQUAL_INT(1, done_count);
+    TEST_ASSERT_EQUAL_INT(J288_OK, last_txn.result);
+}
+
+static void test_bogus_event_size_is_clamped(void)
+{
+    init_port1(NULL, false, false);
+    send_foc3();
+    huart1.RxState = HAL_UART_STATE_READY;
+    TEST_ASSERT_TRUE(j288_stm32_on_rx_event(&huart1, 0xFFFFu));
+    TEST_ASSERT_EQUAL_UINT32(J288_STM32_RX_BUF_SIZE, j288_stm32_stats(&port1)->rx_bytes);
+}
+
+static void test_error_mid_frame_fails_with_line_error(void)
+{
+    j288_bus_config_t bc;
+    memset(&bc, 0, sizeof bc);
+    init_port1(&bc, false, false);
+    send_foc3();
+    TEST_ASSERT_EQUAL_UINT32((uint32_t)(12u), (uint32_t)fake_hal_rx_bytes(&huart1, k_reply3, 12u));
+    fake_hal_rx_error(&huart1, HAL_UART_ERROR_FE | HAL_UART_ERROR_NE);
+    TEST_ASSERT_EQUAL_UINT32(1u, j288_stm32_stats(&port1)->line_errors);
+    TEST_ASSERT_TRUE(fake_hal_rx_armed(&huart1)); /* listening again */
+    poll1();
+    fake_now += j288_bus_reply_budget_us(j288_stm32_bus(&port1)) + 10u;
+    poll1();
+    TEST_ASSERT_EQUAL_INT(1, done_count);
+    TEST_ASSERT_EQUAL_INT(J288_ERR_LINE, last_txn.result);
+    TEST_ASSERT_EQUAL_UINT32(1u, j288_bus_stats(j288_stm32_bus(&port1))->line_errors);
+}
+
+static void test_timeout_from_timer_channel(void)
+{
+    uint32_t budget;
+    init_port1(NULL, true, false);
+    tim2_regs.CNT = 5000u;
+    send_foc3();
+    budget = j288_bus_reply_budget_us(j288_stm32_bus(&port1));
+    /* the compare channel is armed a deadline ahead of the counter */
+    TEST_ASSERT_TRUE((tim2_regs.DIER & TIM_IT_CC1) != 0u);
+    TEST_ASSERT_TRUE(tim2_regs.CCR1 > 5000u && tim2_regs.CCR1 <= 5000u + budget + 1u);
+    /* another channel's interrupt is not ours */
+    TEST_ASSERT_FALSE(fake_hal_tim_fire(&htim2, TIM_CHANNEL_2));
+    fake_now += budget + 5u;
+    TEST_ASSERT_TRUE(fake_hal_tim_fire(&htim2, TIM_CHANNEL_1));
+    TEST_ASSERT_EQUAL_UINT32(1u, j288_stm32_stats(&port1)->timer_events);
+    poll1();
+    TEST_ASSERT_EQUAL_INT(1, done_count);
+    TEST_ASSERT_EQUAL_INT(J288_ERR_TIMEOUT, last_txn.result);
+}
+
+static void test_timer_on_16_bit_counter_wraps(void)
+{
+    init_port1(NULL, true, false);
+    tim2_regs.ARR = 0xFFFFu;
+    tim2_regs.CNT = 0xFFF0u;
+    send_foc3();
+    TEST_ASSERT_TRUE((tim2_regs.DIER & TIM_IT_CC1) != 0u);
+    TEST_ASSERT_TRUE(tim2_regs.CCR1 < 0x0200u); /* wrapped past 0xFFFF, not beyond ARR */
+}
+
+static void test_advance_in_isr_timeout_ends_in_timer_interrupt(void)
+{
+    j288_bus_config_t bc;
+    memset(&bc, 0, sizeof bc);
+    bc.advance_in_isr = true;
+    init_port1(&bc, true, false);
+    send_foc3();
+    fake_now += j288_bus_reply_budget_us(j288_stm32_bus(&port1)) + 5u;
+    TEST_ASSERT_TRUE(fake_hal_tim_fire(&htim2, TIM_CHANNEL_1));
+    TEST_ASSERT_EQUAL_INT(1, done_count);
+    TEST_ASSERT_EQUAL_INT(J288_ERR_TIMEOUT, last_txn.result);
+}
+
+static void test_transmit_dma_failure_is_a_port_error(void)
+{
+    j288_cmd_raw_t cmd = foc3_cmd();
+    init_port1(NULL, false, false);
+    fake_hal_fail_next(FAKE_TRANSMIT_DMA);
+    (void)j288_bus_submit(j288_stm32_bus(&port1), &cmd, fake_now, on_done, NULL);
+    poll1();
+    fake_now += 1000u;
+    poll1();
+    TEST_ASSERT_EQUAL_INT(1, done_count);
+    TEST_ASSERT_EQUAL_INT(J288_ERR_PORT, last_txn.result);
+    TEST_ASSERT_EQUAL_UINT32(1u, j288_stm32_stats(&port1)->hal_failures);
+}
+
+static void test_receive_arm_failure_is_reported(void)
+{
+    init_port1(NULL, false, false);
+    fake_hal_fail_next(FAKE_RECEIVE_TO_IDLE_DMA);
+    send_foc3();
+    TEST_ASSERT_EQUAL_UINT32(1u, j288_stm32_stats(&port1)->hal_failures);
+    poll1();
+    fake_now += j288_bus_reply_budget_us(j288_stm32_bus(&port1)) + 10u;
+    poll1();
+    TEST_ASSERT_EQUAL_INT(1, done_count);
+    TEST_ASSERT_EQUAL_INT(J288_ERR_LINE, last_txn.result);
+}
+
+static void test_bytes_during_transmit_are_not_heard(void)
+{
+    j288_cmd_raw_t cmd = foc3_cmd();
+    init_port1(NULL, false, false);
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_bus_submit(j288_stm32_bus(&port1), &cmd, fake_now, on_done, NULL));
+    poll1();
+    /* single-wire: the receiver is off while we transmit */
+    TEST_ASSERT_EQUAL_UINT32((uint32_t)(0u), (uint32_t)fake_hal_rx_bytes(&huart1, k_reply3, J288_REPLY_LEN));
+}
+
+static void test_two_buses_route_by_handle(void)
+{
+    j288_cmd_raw_t cmd = foc3_cmd();
+    j288_stm32_config_t c2 = base_config(&huart2, &dma2);
+    init_port1(NULL, false, false);
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_stm32_init(&port2, &c2, NULL));
+
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_bus_submit(j288_stm32_bus(&port1), &cmd, fake_now, on_done, NULL));
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_bus_submit(j288_stm32_bus(&port2), &cmd, fake_now, on_done, NULL));
+    j288_bus_poll(j288_stm32_bus(&port1), fake_now);
+    j288_bus_poll(j288_stm32_bus(&port2), fake_now);
+    TEST_ASSERT_TRUE(huart2.pTxBuffPtr == dma2.tx);
+    fake_now += 40u;
+    TEST_ASSERT_TRUE(fake_hal_tx_complete(&huart2));
+    TEST_ASSERT_TRUE(fake_hal_tx_complete(&huart1));
+    TEST_ASSERT_TRUE(huart2.pRxBuffPtr == dma2.rx);
+
+    /* bus 2 gets the reply; bus 1 gets nothing and times out */
+    (void)fake_hal_rx_bytes(&huart2, k_reply3, J288_REPLY_LEN);
+    TEST_ASSERT_TRUE(fake_hal_rx_idle(&huart2));
+    j288_bus_poll(j288_stm32_bus(&port2), fake_now);
+    TEST_ASSERT_EQUAL_INT(1, done_count);
+    TEST_ASSERT_EQUAL_INT(J288_OK, last_txn.result);
+    TEST_ASSERT_EQUAL_UINT32(0u, j288_stm32_stats(&port1)->rx_bytes);
+    fake_now += j288_bus_reply_budget_us(j288_stm32_bus(&port1)) + 10u;
+    poll1();
+    TEST_ASSERT_EQUAL_INT(2, done_count);
+    TEST_ASSERT_EQUAL_INT(J288_ERR_TIMEOUT, last_txn.result);
+
+    /* a UART that is no bus of ours is left alone */
+    TEST_ASSERT_FALSE(j288_stm32_on_tx_cplt(&huart_other));
+    TEST_ASSERT_FALSE(j288_stm32_on_rx_event(&huart_other, 3u));
+    TEST_ASSERT_FALSE(j288_stm32_on_error(&huart_other));
+    TEST_ASSERT_FALSE(j288_stm32_on_tx_cplt(NULL));
+}
+
+static void test_estop_broadcasts_lock_without_waiting(void)
+{
+    size_t len = 0;
+    init_port1(NULL, false, false);
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_bus_estop(j288_stm32_bus(&port1), fake_now));
+    poll1();
+    const uint8_t *sent = fake_hal_tx_data(&huart1, &len);
+    TEST_ASSERT_EQUAL_UINT32((uint32_t)(J288_CMD_LEN), (uint32_t)len);
+    TEST_ASSERT_EQUAL_HEX8_ARRAY(k_lock_broadcast_head, sent, 3u);
+    fake_now += 40u;
+    TEST_ASSERT_TRUE(fake_hal_tx_complete(&huart1));
+    for (int i = 0; i < 3; i++) {
+        fake_now += 10u;
+        poll1();
+    }
+    TEST_ASSERT_TRUE(j288_bus_is_idle(j288_stm32_bus(&port1)));
+    TEST_ASSERT_EQUAL_UINT32(1u, j288_bus_stats(j288_stm32_bus(&port1))->estops);
+}
+
+static void test_scheduler_sweep_over_port(void)
+{
+    static j288_sched_t sched;
+    j288_cmd_raw_t cmd = foc3_cmd();
+    init_port1(NULL, false, false);
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_sched_init(&sched, j288_stm32_bus(&port1), NULL));
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_sched_enable(&sched, 3u, true));
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_sched_set_cmd(&sched, &cmd));
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_sched_start_sweep(&sched, fake_now));
+    j288_sched_poll(&sched, fake_now);
+    TEST_ASSERT_EQUAL_HEX8_ARRAY(k_cmd_foc3, fake_hal_tx_data(&huart1, NULL), J288_CMD_LEN);
+    fake_now += 40u;
+    TEST_ASSERT_TRUE(fake_hal_tx_complete(&huart1));
+    (void)fake_hal_rx_bytes(&huart1, k_reply3, J288_REPLY_LEN);
+    TEST_ASSERT_TRUE(fake_hal_rx_idle(&huart1));
+    for (int i = 0; i < 5; i++) {
+        fake_now += 5u;
+        j288_sched_poll(&sched, fake_now);
+    }
+    TEST_ASSERT_EQUAL_UINT32(1u, j288_sched_sweeps(&sched));
+    TEST_ASSERT_TRUE(j288_sched_slot(&sched, 3u)->has_reply);
+    TEST_ASSERT_EQUAL_INT32(5215, j288_sched_slot(&sched, 3u)->reply.pos);
+}
+
+/* ---- CRC unit --------------------------------------------------------------------------- */
+
+static void test_hw_crc_matches_worked_frames_at_any_alignment(void)
+{
+    uint8_t buf[J288_REPLY_LEN + 3u];
+    for (size_t off = 0; off < 4u; off++) {
+        memcpy(&buf[off], k_reply3, J288_REPLY_LEN);
+        /* reply: bytes 2..21 (5 words), CRC at 22 */
+        TEST_ASSERT_EQUAL_HEX32(j288_get_u32le(&k_reply3[22]), j288_stm32_crc32(&hcrc, &buf[off + 2u], 5u));
+        memcpy(&buf[off], k_cmd_foc3, J288_CMD_LEN);
+        TEST_ASSERT_EQUAL_HEX32(j288_get_u32le(&k_cmd_foc3[16]), j288_stm32_crc32(&hcrc, &buf[off], 4u));
+    }
+    TEST_ASSERT_EQUAL_UINT32(0u, fake_hal_primask());
+    TEST_ASSERT_EQUAL_UINT(8u, fake_hal_irq_disables()); /* locked once per CRC */
+}
+
+static void test_hw_crc_long_input_chunks_and_matches_software(void)
+{
+    uint8_t data[4u * 21u];
+    for (size_t i = 0; i < sizeof data; i++) {
+        data[i] = (uint8_t)(i * 37u + 5u);
+    }
+    TEST_ASSERT_EQUAL_HEX32(j288_crc32_update_bitwise(J288_CRC32_INIT, data, 21u),
+                            j288_stm32_crc32(&hcrc, data, 21u));
+    TEST_ASSERT_EQUAL_UINT(1u, fake_hal_count(FAKE_CRC_CALCULATE));
+    TEST_ASSERT_EQUAL_UINT(2u, fake_hal_count(FAKE_CRC_ACCUMULATE));
+    TEST_ASSERT_EQUAL_HEX32(J288_CRC32_INIT, j288_stm32_crc32(&hcrc, NULL, 0u));
+}
+
+static void test_default_crc_falls_back_to_software_until_attached(void)
+{
+    j288_stm32_crc_attach(NULL);
+    TEST_ASSERT_EQUAL_HEX32(j288_get_u32le(&k_cmd_foc3[16]), j288_stm32_crc32_default(k_cmd_foc3, 4u));
+    TEST_ASSERT_EQUAL_UINT(0u, fake_hal_count(FAKE_CRC_CALCULATE));
+    j288_stm32_crc_attach(&hcrc);
+    TEST_ASSERT_EQUAL_HEX32(j288_get_u32le(&k_cmd_foc3[16]), j288_stm32_crc32_default(k_cmd_foc3, 4u));
+    TEST_ASSERT_EQUAL_UINT(1u, fake_hal_count(FAKE_CRC_CALCULATE));
+    j288_stm32_crc_attach(NULL);
+}
+
+static void test_bus_lock_masks_and_restores(void)
+{
+    init_port1(NULL, false, false);
+    /* the port's lock pair: masked inside, the previous state restored after */
+    j288_stm32_bus(&port1)->port->lock(&port1);
+    TEST_ASSERT_EQUAL_UINT32(1u, fake_hal_primask());
+    j288_stm32_bus(&port1)->port->unlock(&port1);
+    TEST_ASSERT_EQUAL_UINT32(0u, fake_hal_primask());
+}
+
+int main(void)
+{
+    UNITY_BEGIN();
+    RUN_TEST(test_init_rejects_bad_config);
+    RUN_TEST(test_init_leaves_line_receiving_de_inactive);
+    RUN_TEST(test_registry_is_bounded);
+    RUN_TEST(test_full_transaction_call_order_and_bytes);
+    RUN_TEST(test_reply_split_by_a_gap_is_heard_whole);
+    RUN_TEST(test_reply_one_byte_per_event);
+    RUN_TEST(test_bogus_event_size_is_clamped);
+    RUN_TEST(test_error_mid_frame_fails_with_line_error);
+    RUN_TEST(test_timeout_from_timer_channel);
+    RUN_TEST(test_timer_on_16_bit_counter_wraps);
+    RUN_TEST(test_advance_in_isr_timeout_ends_in_timer_interrupt);
+    RUN_TEST(test_transmit_dma_failure_is_a_port_error);
+    RUN_TEST(test_receive_arm_failure_is_reported);
+    RUN_TEST(test_bytes_during_transmit_are_not_heard);
+    RUN_TEST(test_two_buses_route_by_handle);
+    RUN_TEST(test_estop_broadcasts_lock_without_waiting);
+    RUN_TEST(test_scheduler_sweep_over_port);
+    RUN_TEST(test_hw_crc_matches_worked_frames_at_any_alignment);
+    RUN_TEST(test_hw_crc_long_input_chunks_and_matches_software);
+    RUN_TEST(test_default_crc_falls_back_to_software_until_attached);
+    RUN_TEST(test_bus_lock_masks_and_restores);
+    return UNITY_END();
+}
