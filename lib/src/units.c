@@ -39,10 +39,11 @@ static bool side_ok(j288_side_t side)
     return (side == J288_SIDE_ROTOR) || (side == J288_SIDE_OUTPUT);
 }
 
-/* Round half away from zero without libm: the fraction v - trunc(v) is exact. */
-static int32_t round_half_away(j288_real_t v)
+/* Round half away from zero without libm: the fraction v - trunc(v) is exact. The caller
+ * keeps |v| a little above the int32 range at most, so int64_t never overflows. */
+static int64_t round_half_away(j288_real_t v)
 {
-    int32_t t = (int32_t)v;
+    int64_t t = (int64_t)v;
     j288_real_t frac = v - (j288_real_t)t;
     if (frac >= (j288_real_t)0.5) {
         t++;
@@ -60,6 +61,8 @@ static int convert(j288_real_t si, quantity_t q, j288_side_t side, int32_t lo, i
                    int range_err, bool clamp, bool *was_clamped, int32_t *out)
 {
     j288_real_t v;
+    int64_t r = 0;
+    bool in_range;
     bool is_gain = (q == Q_KP) || (q == Q_KD);
 
     if (si != si) {
@@ -74,8 +77,16 @@ static int convert(j288_real_t si, quantity_t q, j288_side_t side, int32_t lo, i
         return J288_OK;
     }
     v = si * lsb_per_unit(q, side);
-    /* Anything that rounds into [lo, hi] is in range; the bounds are exact in float too. */
-    if (!(v >= (j288_real_t)lo - (j288_real_t)0.5) || !(v < (j288_real_t)hi + (j288_real_t)0.5)) {
+    /* A coarse window first (also catches infinities and keeps the int64 cast defined), then
+     * the exact test on the rounded integer: a half just past lo or hi rounds away from zero,
+     * out of range. Comparing the real value against lo - 0.5 instead is wrong in float,
+     * where lo - 0.5 is not representable for int32. */
+    in_range = (v >= (j288_real_t)lo - (j288_real_t)1) && (v <= (j288_real_t)hi + (j288_real_t)1);
+    if (in_range) {
+        r = round_half_away(v);
+        in_range = (r >= (int64_t)lo) && (r <= (int64_t)hi);
+    }
+    if (!in_range) {
         if (!clamp) {
             return range_err;
         }
@@ -83,7 +94,7 @@ static int convert(j288_real_t si, quantity_t q, j288_side_t side, int32_t lo, i
         *out = (v < (j288_real_t)0) ? lo : hi;
         return J288_OK;
     }
-    *out = round_half_away(v);
+    *out = (int32_t)r;
     return J288_OK;
 }
 
