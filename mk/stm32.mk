@@ -29,3 +29,59 @@ ALL_TARGETS += $(STM32_TEST_BIN)
 .PHONY: stm32-test
 stm32-test: $(STM32_TEST_BIN)
 	BUILD=$(BUILD) bash scripts/run-tests.sh $(STM32_TEST_BIN)
+
+# ---- unit tests on the target instruction set (QEMU + semihosting) ----------------------
+# Every test/unit/test_*.c plus the port test against the fake HAL, built for three cores.
+# The micro:bit model (Cortex-M0) has 16K RAM; the images fit (checked by the linker script's
+# stack/heap assertion).
+ARM_CC ?= arm-none-eabi-gcc
+ARM_SIZE ?= arm-none-eabi-size
+TGT_CORES := m0 m4f m7
+TGT_m0_FLAGS := -mcpu=cortex-m0 -mthumb -mfloat-abi=soft
+TGT_m0_QEMU := microbit:cortex-m0
+TGT_m0_MEM := mem_microbit.ld
+TGT_m4f_FLAGS := -mcpu=cortex-m4 -mthumb -mfloat-abi=hard -mfpu=fpv4-sp-d16 -DJ288_CONFIG_SI_FLOAT=1
+TGT_m4f_QEMU := mps2-an386:cortex-m4
+TGT_m4f_MEM := mem_mps2.ld
+TGT_m7_FLAGS := -mcpu=cortex-m7 -mthumb -mfloat-abi=hard -mfpu=fpv5-d16
+TGT_m7_QEMU := mps2-an500:cortex-m7
+TGT_m7_MEM := mem_mps2.ld
+
+TGT_CPPFLAGS := $(CPPFLAGS_LIB) -I$(UNITY) -Itest/support -Itest/vectors -I$(STM32_PORT_DIR) \
+    -I$(STM32_STUB_DIR) -Itest/stm32 -DUNITY_INCLUDE_DOUBLE -DUNITY_SUPPORT_64 $(STM32_TEST_DEFS)
+TGT_CFLAGS := -std=c99 $(WARN) -O2 -g -ffunction-sections -fdata-sections
+TGT_LDFLAGS := -nostartfiles --specs=nano.specs --specs=rdimon.specs -Wl,--gc-sections -Ltest/target
+TGT_UNIT_NAMES := $(notdir $(basename $(UNIT_TEST_SRC)))
+TGT_COMMON_SRC := $(LIB_SRC) $(TEST_SUPPORT_SRC) test/target/startup.c
+TGT_HDRS := $(LIB_HDR) $(STM32_HDRS) $(wildcard test/support/*.h test/vectors/*.h)
+
+# $(1): core
+define TGT_CORE_RULES
+$(BUILD)/target/$(1)/obj/%.o: %.c $(TGT_HDRS) $(UNITY)/unity.c
+	@mkdir -p $$(@D)
+	$(ARM_CC) $(TGT_$(1)_FLAGS) $(TGT_CPPFLAGS) $(TGT_CFLAGS) -c $$< -o $$@
+
+$(BUILD)/target/$(1)/obj/unity.o: $(UNITY)/unity.c
+	@mkdir -p $$(@D)
+	$(ARM_CC) $(TGT_$(1)_FLAGS) -std=c99 -O2 -g -ffunction-sections -I$(UNITY) -DUNITY_INCLUDE_DOUBLE -DUNITY_SUPPORT_64 -c $$< -o $$@
+
+$(BUILD)/target/$(1)/test_%.elf: $(BUILD)/target/$(1)/obj/test/unit/test_%.o $(TGT_COMMON_SRC:%.c=$(BUILD)/target/$(1)/obj/%.o) $(BUILD)/target/$(1)/obj/unity.o test/target/sections.ld test/target/$(TGT_$(1)_MEM)
+	$(ARM_CC) $(TGT_$(1)_FLAGS) $(TGT_LDFLAGS) -T $(TGT_$(1)_MEM) $$(filter %.o,$$^) -o $$@ -lm
+
+$(BUILD)/target/$(1)/test_stm32_port.elf: $(addprefix $(BUILD)/target/$(1)/obj/,test/stm32/test_stm32_port.o test/stm32/fake_hal.o port/stm32_hal/j288_stm32.o) $(TGT_COMMON_SRC:%.c=$(BUILD)/target/$(1)/obj/%.o) $(BUILD)/target/$(1)/obj/unity.o test/target/sections.ld test/target/$(TGT_$(1)_MEM)
+	$(ARM_CC) $(TGT_$(1)_FLAGS) $(TGT_LDFLAGS) -T $(TGT_$(1)_MEM) $$(filter %.o,$$^) -o $$@ -lm
+
+TGT_$(1)_ELFS := $(TGT_UNIT_NAMES:%=$(BUILD)/target/$(1)/%.elf) $(BUILD)/target/$(1)/test_stm32_port.elf
+TGT_ALL_ELFS += $$(TGT_$(1)_ELFS)
+TGT_RUN_SPECS += $$(foreach e,$$(TGT_$(1)_ELFS),$(1):$(TGT_$(1)_QEMU):$$(e))
+endef
+TGT_ALL_ELFS :=
+TGT_RUN_SPECS :=
+$(foreach c,$(TGT_CORES),$(eval $(call TGT_CORE_RULES,$(c))))
+
+.PHONY: test-target target-tests
+target-tests: $(TGT_ALL_ELFS)
+
+test-target: $(TGT_ALL_ELFS)
+	@echo "test-target: $(words $(TGT_ALL_ELFS)) images: $(TGT_UNIT_NAMES) test_stm32_port on $(TGT_CORES)"
+	bash test/target/run-target.sh $(TGT_RUN_SPECS)

@@ -1,0 +1,42 @@
+#!/usr/bin/env bash
+# Run Cortex-M test images under qemu-system-arm with semihosting.
+# Arguments: one "core:machine:cpu:elf" per test image. Prints each image's Unity summary and
+# ends with "N passed, N failed"; the exit status says whether all passed.
+set -u
+if ! command -v qemu-system-arm >/dev/null 2>&1; then
+    echo "test-target: qemu-system-arm not found. Install the Debian package qemu-system-arm:" >&2
+    echo "    sudo apt-get install --no-install-recommends qemu-system-arm" >&2
+    exit 1
+fi
+per_test_timeout=${TARGET_TIMEOUT:-120}
+passed=0 failed=0 failed_names=()
+for spec in "$@"; do
+    IFS=: read -r core machine cpu elf <<<"$spec"
+    name="$core/$(basename "$elf" .elf)"
+    log=$(mktemp)
+    timeout -k 5 "$per_test_timeout" qemu-system-arm -M "$machine" -cpu "$cpu" -nographic \
+        -monitor none -serial none -semihosting-config enable=on,target=native \
+        -kernel "$elf" >"$log" 2>&1
+    rc=$?
+    summary=$(grep -E '^[0-9]+ Tests [0-9]+ Failures [0-9]+ Ignored' "$log" | tail -n1)
+    if [ $rc -eq 0 ] && [ -n "$summary" ]; then
+        passed=$((passed + 1))
+        echo "PASS  $name ($machine)  $summary"
+    else
+        failed=$((failed + 1))
+        failed_names+=("$name")
+        case $rc in
+            124) why="timed out after ${per_test_timeout}s" ;;
+            127) why="CPU fault (exit 127)" ;;
+            *) why="exit $rc" ;;
+        esac
+        echo "FAIL  $name ($machine)  $why  ${summary}"
+        grep -E ':FAIL' "$log" | head -n 20 | sed 's/^/      /'
+        tail -n 5 "$log" | sed 's/^/    | /'
+    fi
+    rm -f "$log"
+done
+echo
+[ $failed -gt 0 ] && echo "failed: ${failed_names[*]}"
+echo "$passed passed, $failed failed"
+[ $failed -eq 0 ]
