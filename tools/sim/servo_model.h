@@ -1,0 +1,182 @@
+/*
+ * servo_model.h - the simulated J288 bus: servos as the host sees them, without any I/O.
+ *
+ * Two levels:
+ * - j288_sim_servo_t: one servo. Protocol state (mode, 1 s watchdog, latched faults) and
+ *   physics: the hybrid law tau = tau_ff + kp (p_des - p) + kd (w_des - w) drives a rotor
+ *   (inertia, viscous and Coulomb friction, an optional output load through the 288.35
+ *   gear), with a two-node thermal model (winding, case) and a supply voltage. Integrated in
+ *   fixed steps of at most J288_SIM_STEP_US up to whatever time the caller gives.
+ * - j288_sim_bus_t: the wire. Bytes the host sent go through lib's command parser
+ *   (J288_PARSE_COMMAND) and j288_cmd_decode(); addressed servos answer through the send
+ *   callback, after the turnaround, with the configured faults injected (drop, corrupt,
+ *   late, noise, duplicate id) from a seeded generator: the same bytes at the same times
+ *   give the same output.
+ *
+ * Time is in microseconds since the simulation started (uint64_t, never wraps); the caller
+ * ties it to a clock (the pty front end uses CLOCK_MONOTONIC). Single-threaded; no
+ * allocation; objects are caller-allocated.
+ *
+ * Decisions where the manual is silent (documented for users of the simulator):
+ * - A command with status other than 0 or 1 is obeyed as lock.
+ * - While the watchdog is tripped the servo stays in lock and reports the trip; a command
+ *   with the watchdog bit 0 clears it and is then obeyed as usual.
+ * - The watchdog is fed by any good command addressed to the servo, broadcast included.
+ * - A frame with a bad CRC sets the communication-checksum fault on the servo its id byte
+ *   names (every servo for id 15); the bit is reported in the next reply, then cleared.
+ * - Winding above 150 C or case above 100 C sets the matching fault and removes torque
+ *   until the temperature falls 10 C below the limit. Supply below 10 V: under-voltage fault,
+ *   above 30 V: over-voltage fault (both remove torque); below 11 V: low-supply warning.
+ * - Injected fault bits are reported only; they do not change the physics.
+ */
+#ifndef J288_SIM_SERVO_MODEL_H
+#define J288_SIM_SERVO_MODEL_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "j288/frame.h"
+#include "j288/parser.h"
+
+#define J288_SIM_STEP_US 50u            /* integration step */
+#define J288_SIM_WATCHDOG_US 1000000u   /* the servo's communication watchdog */
+#define J288_SIM_WIND_LIMIT_C 150.0
+#define J288_SIM_CASE_LIMIT_C 100.0
+#define J288_SIM_TEMP_HYST_C 10.0
+#define J288_SIM_UNDER_VOLTAGE_V 10.0
+#define J288_SIM_OVER_VOLTAGE_V 30.0
+#define J288_SIM_LOW_SUPPLY_V 11.0
+
+/* Physical parameters, rotor side unless named otherwise. */
+typedef struct {
+    double inertia;      /* rotor inertia, kg m^2 */
+    double viscous;      /* viscous friction, N m s/rad */
+    double coulomb;      /* Coulomb (dry) friction, N m */
+    double tau_max;      /* motor torque limit, N m */
+    double load_inertia; /* extra inertia on the output shaft, kg m^2 */
+    double load_torque;  /* constant torque on the output shaft, N m (e.g. a weight) */
+    double voltage;      /* supply, V */
+    double ambient_c;    /* ambient temperature, deg C */
+    double loss_per_nm2; /* copper loss per torque squared, W/(N m)^2 */
+} j288_sim_params_t;
+
+/* Sensible defaults: a small rotor, 24 V, 25 C. */
+void j288_sim_params_default(j288_sim_params_t *prm);
+
+typedef struct {
+    uint8_t id;
+    j288_sim_params_t prm;
+    /* physics */
+    double p;            /* rotor angle since power-up, rad (multi-turn) */
+    double w;            /* rotor speed, rad/s */
+    double tau;          /* motor torque applied in the last step, N m */
+    double out_offset;   /* output angle = out_offset + p / N */
+    double t_wind, t_case;
+    /* protocol */
+    j288_cmd_raw_t cmd;  /* the last command obeyed */
+    uint8_t mode;        /* J288_MODE_LOCK or J288_MODE_FOC, as reported */
+    bool wd_enabled;
+    bool wd_tripped;
+    uint64_t last_cmd_us;
+    uint64_t now_us;     /* model time */
+    uint32_t faults_latched;  /* reported once, then cleared (checksum) */
+    uint32_t faults_active;   /* conditions (temperature, voltage) */
+    uint32_t faults_injected; /* --fault */
+    uint32_t watchdog_trips;
+} j288_sim_servo_t;
+
+/* Power up servo id at time 0: lock, watchdog off, rotor at start_angle (taken modulo 2 pi
+ * into [0, 2 pi), as the single-turn encoder reads it), output shaft at out_angle.
+ * prm NULL: defaults. */
+void j288_sim_servo_init(j288_sim_servo_t *s, uint8_t id, const j288_sim_params_t *prm,
+                         double start_angle, double out_angle);
+
+/* Integrate up to now_us (no-op if now_us is not later). Trips the watchdog at the exact
+ * time it starves. */
+void j288_sim_servo_advance(j288_sim_servo_t *s, uint64_t now_us);
+
+/* A good command for this servo (or broadcast) arrived at now_us. */
+void j288_sim_servo_command(j288_sim_servo_t *s, const j288_cmd_raw_t *cmd, uint64_t now_us);
+
+/* A frame naming this servo failed its CRC. */
+void j288_sim_servo_bad_crc(j288_sim_servo_t *s);
+
+/* The reply the servo sends now (clears report-once faults). */
+void j288_sim_servo_reply(j288_sim_servo_t *s, j288_reply_raw_t *r);
+
+/* Output shaft angle, rad (multi-turn), and the 13-bit OutPos the encoder reports. */
+double j288_sim_servo_out_angle(const j288_sim_servo_t *s);
+uint16_t j288_sim_servo_out_pos(const j288_sim_servo_t *s);
+
+/* ---- the bus ---------------------------------------------------------------------------- */
+
+typedef struct {
+    uint32_t turnaround_us; /* delay before a reply */
+    double drop;            /* probability a reply is not sent */
+    double corrupt;         /* probability one byte of a reply is changed */
+    double late;            /* probability a reply is delayed by late_us */
+    uint32_t late_us;       /* 0: 50 ms */
+    double noise;           /* probability of 1-8 noise bytes ahead of a reply */
+    uint16_t dup_ids;       /* bit n: a second servo also answers to id n */
+    uint64_t seed;
+    uint32_t idle_flush_us; /* a gap this long drops a partial command; 0: 5 ms */
+} j288_sim_bus_config_t;
+
+typedef struct {
+    uint64_t bytes;
+    uint64_t commands;      /* good frames */
+    uint64_t broadcasts;
+    uint64_t bad_crc;
+    uint64_t for_others;    /* good frames for ids not on this bus */
+    uint64_t replies;       /* replies sent (duplicates included) */
+    uint64_t dropped;
+    uint64_t corrupted;
+    uint64_t late;
+    uint64_t noise;
+    uint64_t duplicates;
+    uint64_t watchdog_trips;
+} j288_sim_stats_t;
+
+/* Bytes to put on the wire at at_us (>= the time of the command that caused them). */
+typedef void (*j288_sim_send_fn)(void *user, uint64_t at_us, const uint8_t *data, size_t len);
+/* Every complete command frame seen, good (cmd non-NULL) or with a bad CRC (cmd NULL). */
+typedef void (*j288_sim_log_fn)(void *user, uint64_t now_us, const uint8_t frame[J288_CMD_LEN],
+                                const j288_cmd_raw_t *cmd);
+
+typedef struct {
+    j288_parser_t parser;
+    j288_sim_bus_config_t cfg;
+    j288_sim_servo_t servo[J288_MAX_SERVOS];
+    j288_sim_servo_t dup[J288_MAX_SERVOS];
+    uint16_t present;       /* bit n: servo n is on the bus */
+    uint64_t rng;
+    uint8_t window[J288_CMD_LEN]; /* the last 20 bytes fed, oldest first */
+    uint64_t last_byte_us;
+    uint64_t now_us;
+    j288_sim_stats_t stats;
+    j288_sim_send_fn send;
+    j288_sim_log_fn log;
+    void *user;
+} j288_sim_bus_t;
+
+/* Set up a bus with the servos whose bits are set in ids (bit n = id n, 0-14). Each servo's
+ * power-up angles come from the seed. cfg, prm may be NULL. send may be NULL (replies are
+ * counted, not sent), log may be NULL. Returns 0, or -1 for ids == 0 or ids with bit 15. */
+int j288_sim_bus_init(j288_sim_bus_t *b, uint16_t ids, const j288_sim_bus_config_t *cfg,
+                      const j288_sim_params_t *prm, j288_sim_send_fn send, j288_sim_log_fn log,
+                      void *user);
+
+/* Inject fault bits (reported in every reply until changed). -1 for an id not on the bus. */
+int j288_sim_bus_inject_faults(j288_sim_bus_t *b, uint8_t id, uint32_t bits);
+
+/* Bytes from the host, received at now_us. */
+void j288_sim_bus_feed(j288_sim_bus_t *b, const uint8_t *data, size_t len, uint64_t now_us);
+
+/* Advance every servo to now_us (call now and then, e.g. every 10 ms, when idle). */
+void j288_sim_bus_advance(j288_sim_bus_t *b, uint64_t now_us);
+
+/* Servo id's state, or NULL when it is not on the bus. */
+j288_sim_servo_t *j288_sim_bus_servo(j288_sim_bus_t *b, uint8_t id);
+
+#endif /* J288_SIM_SERVO_MODEL_H */

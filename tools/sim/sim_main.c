@@ -1,0 +1,526 @@
+/*
+ * j288-sim - a simulated J288 servo bus on a pseudo-terminal.
+ *
+ * Prints the pty's path on stdout (one line), serves the servos until SIGINT/SIGTERM (or
+ * --exit-after), then closes the pty master (clients see the device vanish), removes the
+ * --link symlink and prints one statistics line on stderr. The servo physics and protocol
+ * live in servo_model.c; this file is the I/O: the pty, timing of replies, options, the log.
+ */
+#define _GNU_SOURCE 1 /* posix_openpt, ppoll, sigaction under -std=c99 */
+
+#include <errno.h>
+#include <fcntl.h>
+#include <poll.h>
+#include <signal.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <termios.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "servo_model.h"
+
+#define QUEUE_LEN 64u
+#define CHUNK_MAX 32u
+#define TICK_US 10000u   /* model advance when the line is quiet */
+#define NAP_US 1000u     /* no client has the pty open: look again this often */
+
+typedef struct {
+    uint64_t at_us;
+    size_t len;
+    uint8_t data[CHUNK_MAX];
+} chunk_t;
+
+typedef struct {
+    int master;
+    uint64_t t0_ns;
+    chunk_t q[QUEUE_LEN];
+    size_t qlen;
+    uint64_t queue_full;
+    uint64_t lost_no_client;
+    FILE *log;
+} sim_io_t;
+
+static volatile sig_atomic_t g_stop; /* set by SIGINT/SIGTERM/SIGHUP */
+
+static void on_signal(int sig)
+{
+    (void)sig;
+    g_stop = 1;
+}
+
+static void die(const char *fmt, ...) __attribute__((format(printf, 1, 2), noreturn));
+
+static void die(const char *fmt, ...)
+{
+    va_list ap;
+    fputs("j288-sim: ", stderr);
+    va_start(ap, fmt);
+    vfprintf(stderr, fmt, ap);
+    va_end(ap);
+    fputc('\n', stderr);
+    exit(2);
+}
+
+static uint64_t mono_ns(void)
+{
+    struct timespec ts;
+    (void)clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (uint64_t)ts.tv_sec * 1000000000u + (uint64_t)ts.tv_nsec;
+}
+
+static uint64_t sim_now_us(const sim_io_t *io) { return (mono_ns() - io->t0_ns) / 1000u; }
+
+/* ---- options ------------------------------------------------------------------------------ */
+
+typedef struct {
+    uint16_t ids;
+    const char *link;
+    const char *log;
+    double exit_after;
+    uint32_t faults[J288_MAX_SERVOS];
+    uint16_t fault_set;
+    bool quiet;
+    j288_sim_bus_config_t bus;
+    j288_sim_params_t prm;
+} options_t;
+
+static void usage(FILE *f)
+{
+    fputs("usage: j288-sim [options]\n"
+          "A simulated J288 servo bus on a pseudo-terminal. Prints the pty path on stdout\n"
+          "(one line), serves until SIGINT/SIGTERM or --exit-after, then closes the pty and\n"
+          "prints a statistics line on stderr.\n"
+          "\n"
+          "  --ids LIST          servo ids on the bus, e.g. 1,2,3 (default 1), 0-14\n"
+          "  --link PATH         also place a symlink to the pty at PATH (removed on exit)\n"
+          "  --voltage V         supply voltage (default 24)\n"
+          "  --ambient C         ambient temperature (default 25)\n"
+          "  --load-inertia J    extra inertia on each output shaft, kg m^2 (default 0)\n"
+          "  --load-torque NM    constant torque on each output shaft, N m (default 0)\n"
+          "  --turnaround-us N   reply delay (default 20)\n"
+          "  --log FILE          one line per received command frame ('-' = stderr)\n"
+          "  --exit-after S      exit after S seconds (for tests)\n"
+          "  --quiet             no messages but errors and the statistics line\n"
+          "fault injection (deterministic for a given --seed and command sequence):\n"
+          "  --seed N            random seed (default 1)\n"
+          "  --drop P            probability a reply is not sent\n"
+          "  --corrupt P         probability one byte of a reply is changed\n"
+          "  --late P            probability a reply is delayed by --late-us\n"
+          "  --late-us N         delay of a late reply (default 50000)\n"
+          "  --noise P           probability of 1-8 noise bytes ahead of a reply\n"
+          "  --dup ID            a second servo also answers to ID (repeatable)\n"
+          "  --fault ID:BITS     servo ID reports fault bits BITS (e.g. 0x200; repeatable)\n"
+          "log lines: SECONDS HEX20 then 'id=N status=N wd=0|1 tau= speed= pos= kp= kd='\n"
+          "for a good frame, or 'bad-crc id=N' for a frame whose CRC failed.\n",
+          f);
+}
+
+static double parse_double(const char *opt, const char *s, double lo, double hi)
+{
+    char *end;
+    double v;
+    errno = 0;
+    v = strtod(s, &end);
+    if (errno != 0 || end == s || *end != '\0' || !(v >= lo && v <= hi))
+        die("%s: '%s' is not a number in [%g, %g]", opt, s, lo, hi);
+    return v;
+}
+
+static unsigned long parse_ulong(const char *opt, const char *s, unsigned long max, int base)
+{
+    char *end;
+    unsigned long v;
+    errno = 0;
+    if (*s == '-')
+        die("%s: '%s' must not be negative", opt, s);
+    v = strtoul(s, &end, base);
+    if (errno != 0 || end == s || *end != '\0' || v > max)
+        die("%s: '%s' is not an integer in [0, %lu]", opt, s, max);
+    return v;
+}
+
+static uint16_t parse_id_list(const char *opt, const char *s)
+{
+    uint16_t ids = 0;
+    char buf[128];
+    char *tok, *save = NULL;
+    if (strlen(s) >= sizeof buf)
+        die("%s: list too long", opt);
+    strcpy(buf, s);
+    for (tok = strtok_r(buf, ",", &save); tok != NULL; tok = strtok_r(NULL, ",", &save))
+        ids = (uint16_t)(ids | (1u << parse_ulong(opt, tok, J288_MAX_ID, 10)));
+    if (ids == 0u)
+        die("%s: no id given", opt);
+    return ids;
+}
+
+static void parse_fault(options_t *o, const char *s)
+{
+    char buf[64];
+    char *colon;
+    unsigned long id;
+    if (strlen(s) >= sizeof buf)
+        die("--fault: '%s' too long", s);
+    strcpy(buf, s);
+    colon = strchr(buf, ':');
+    if (colon == NULL)
+        die("--fault: expected ID:BITS, got '%s'", s);
+    *colon = '\0';
+    id = parse_ulong("--fault", buf, J288_MAX_ID, 10);
+    o->faults[id] = (uint32_t)parse_ulong("--fault", colon + 1, 0xFFFFFFFFul, 0);
+    o->fault_set = (uint16_t)(o->fault_set | (1u << id));
+}
+
+static void parse_args(options_t *o, int argc, char **argv)
+{
+    int i;
+    memset(o, 0, sizeof *o);
+    o->ids = 1u << 1;
+    o->bus.seed = 1u;
+    o->bus.turnaround_us = 20u;
+    j288_sim_params_default(&o->prm);
+    for (i = 1; i < argc; i++) {
+        const char *a = argv[i];
+        const char *v = (i + 1 < argc) ? argv[i + 1] : NULL;
+        if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
+            usage(stdout);
+            exit(0);
+        }
+        if (strcmp(a, "--quiet") == 0) {
+            o->quiet = true;
+            continue;
+        }
+        if (strncmp(a, "--", 2) != 0)
+            die("unexpected argument '%s' (see --help)", a);
+        if (v == NULL)
+            die("%s needs a value (see --help)", a);
+        i++;
+        if (strcmp(a, "--ids") == 0)
+            o->ids = parse_id_list(a, v);
+        else if (strcmp(a, "--link") == 0)
+            o->link = v;
+        else if (strcmp(a, "--log") == 0)
+            o->log = v;
+        else if (strcmp(a, "--voltage") == 0)
+            o->prm.voltage = parse_double(a, v, 0.0, 127.5);
+        else if (strcmp(a, "--ambient") == 0)
+            o->prm.ambient_c = parse_double(a, v, -40.0, 120.0);
+        else if (strcmp(a, "--load-inertia") == 0)
+            o->prm.load_inertia = parse_double(a, v, 0.0, 100.0);
+        else if (strcmp(a, "--load-torque") == 0)
+            o->prm.load_torque = parse_double(a, v, -100.0, 100.0);
+        else if (strcmp(a, "--turnaround-us") == 0)
+            o->bus.turnaround_us = (uint32_t)parse_ulong(a, v, 10000000ul, 10);
+        else if (strcmp(a, "--exit-after") == 0)
+            o->exit_after = parse_double(a, v, 0.0, 86400.0);
+        else if (strcmp(a, "--seed") == 0)
+            o->bus.seed = (uint64_t)parse_ulong(a, v, 0xFFFFFFFFul, 0);
+        else if (strcmp(a, "--drop") == 0)
+            o->bus.drop = parse_double(a, v, 0.0, 1.0);
+        else if (strcmp(a, "--corrupt") == 0)
+            o->bus.corrupt = parse_double(a, v, 0.0, 1.0);
+        else if (strcmp(a, "--late") == 0)
+            o->bus.late = parse_double(a, v, 0.0, 1.0);
+        else if (strcmp(a, "--late-us") == 0)
+            o->bus.late_us = (uint32_t)parse_ulong(a, v, 10000000ul, 10);
+        else if (strcmp(a, "--noise") == 0)
+            o->bus.noise = parse_double(a, v, 0.0, 1.0);
+        else if (strcmp(a, "--dup") == 0)
+            o->bus.dup_ids = (uint16_t)(o->bus.dup_ids | parse_id_list(a, v));
+        else if (strcmp(a, "--fault") == 0)
+            parse_fault(o, v);
+        else
+            die("unknown option '%s' (see --help)", a);
+    }
+    if ((o->bus.dup_ids & ~o->ids) != 0u)
+        die("--dup names an id that is not in --ids");
+    if ((o->fault_set & ~o->ids) != 0u)
+        die("--fault names an id that is not in --ids");
+}
+
+/* ---- output queue ----------------------------------------------------------------------- */
+
+static void queue_send(void *user, uint64_t at_us, const uint8_t *data, size_t len)
+{
+    sim_io_t *io = user;
+    size_t i;
+    if (len > CHUNK_MAX || io->qlen == QUEUE_LEN) {
+        io->queue_full++;
+        return;
+    }
+    /* Keep the queue in time order; equal times keep their order. */
+    i = io->qlen;
+    while (i > 0u && io->q[i - 1u].at_us > at_us) {
+        io->q[i] = io->q[i - 1u];
+        i--;
+    }
+    io->q[i].at_us = at_us;
+    io->q[i].len = len;
+    memcpy(io->q[i].data, data, len);
+    io->qlen++;
+}
+
+static void queue_pop(sim_io_t *io)
+{
+    memmove(&io->q[0], &io->q[1], (io->qlen - 1u) * sizeof io->q[0]);
+    io->qlen--;
+}
+
+/* Write what is due. A client that went away loses its replies. */
+static void flush_due(sim_io_t *io, uint64_t now_us)
+{
+    while (io->qlen > 0u && io->q[0].at_us <= now_us) {
+        ssize_t n = write(io->master, io->q[0].data, io->q[0].len);
+        if (n < 0 && errno == EINTR)
+            continue;
+        if (n < 0 && (errno == EAGAIN || errno == EWOULDBLOCK))
+            return; /* the client is not reading; try again later */
+        if (n < 0) {
+            io->lost_no_client++;
+        } else if ((size_t)n < io->q[0].len) {
+            memmove(io->q[0].data, io->q[0].data + n, io->q[0].len - (size_t)n);
+            io->q[0].len -= (size_t)n;
+            continue;
+        }
+        queue_pop(io);
+    }
+}
+
+/* ---- log ------------------------------------------------------------------------------------ */
+
+static void log_frame(void *user, uint64_t now_us, const uint8_t frame[J288_CMD_LEN],
+                      const j288_cmd_raw_t *cmd)
+{
+    sim_io_t *io = user;
+    unsigned i;
+    if (io->log == NULL)
+        return;
+    fprintf(io->log, "%llu.%06llu ", (unsigned long long)(now_us / 1000000u),
+            (unsigned long long)(now_us % 1000000u));
+    for (i = 0; i < J288_CMD_LEN; i++)
+        fprintf(io->log, "%02x", frame[i]);
+    if (cmd != NULL)
+        fprintf(io->log, " id=%u status=%u wd=%u tau=%d speed=%d pos=%ld kp=%d kd=%d\n",
+                (unsigned)cmd->id, (unsigned)cmd->status, cmd->watchdog ? 1u : 0u,
+                (int)cmd->tau, (int)cmd->speed, (long)cmd->pos, (int)cmd->kp, (int)cmd->kd);
+    else
+        fprintf(io->log, " bad-crc id=%u\n", (unsigned)(frame[2] & 0x0Fu));
+    fflush(io->log);
+}
+
+/* ---- pty -------------------------------------------------------------------------------------- */
+
+static int open_pty(char *path, size_t cap)
+{
+    struct termios t;
+    const char *name;
+    int fd = posix_openpt(O_RDWR | O_NOCTTY);
+    if (fd < 0)
+        die("cannot create a pseudo-terminal: %s", strerror(errno));
+    if (grantpt(fd) != 0 || unlockpt(fd) != 0)
+        die("cannot unlock the pseudo-terminal: %s", strerror(errno));
+    name = ptsname(fd);
+    if (name == NULL || strlen(name) >= cap)
+        die("cannot name the pseudo-terminal");
+    strcpy(path, name);
+    /* Raw from the start, so that nothing is echoed or translated before a client sets its
+     * own mode (on a pty the master's settings are the slave's). */
+    if (tcgetattr(fd, &t) == 0) {
+        cfmakeraw(&t);
+        (void)tcsetattr(fd, TCSANOW, &t);
+    }
+    if (fcntl(fd, F_SETFL, fcntl(fd, F_GETFL) | O_NONBLOCK) != 0)
+        die("cannot make the pty non-blocking: %s", strerror(errno));
+    (void)fcntl(fd, F_SETFD, FD_CLOEXEC);
+    return fd;
+}
+
+static void place_link(const char *link, const char *target)
+{
+    struct stat st;
+    if (lstat(link, &st) == 0) {
+        if (!S_ISLNK(st.st_mode))
+            die("--link %s: exists and is not a symlink; not replacing it", link);
+        if (unlink(link) != 0)
+            die("--link %s: cannot replace: %s", link, strerror(errno));
+    }
+    if (symlink(target, link) != 0)
+        die("--link %s: %s", link, strerror(errno));
+}
+
+/* Remove the link only if it still points at our pty. */
+static void remove_link(const char *link, const char *target)
+{
+    char buf[256];
+    ssize_t n = readlink(link, buf, sizeof buf - 1u);
+    if (n > 0) {
+        buf[n] = '\0';
+        if (strcmp(buf, target) == 0)
+            (void)unlink(link);
+    }
+}
+
+static void install_signals(sigset_t *run_mask)
+{
+    struct sigaction sa;
+    sigset_t block;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = on_signal;
+    sigemptyset(&sa.sa_mask);
+    sa.sa_flags = 0;
+    (void)sigaction(SIGINT, &sa, NULL);
+    (void)sigaction(SIGTERM, &sa, NULL);
+    (void)sigaction(SIGHUP, &sa, NULL);
+    sa.sa_handler = SIG_IGN;
+    (void)sigaction(SIGPIPE, &sa, NULL);
+    /* Signals stay blocked except inside ppoll: no wake-up is lost between a check of
+     * g_stop and the sleep. */
+    sigemptyset(&block);
+    sigaddset(&block, SIGINT);
+    sigaddset(&block, SIGTERM);
+    sigaddset(&block, SIGHUP);
+    (void)sigprocmask(SIG_BLOCK, &block, run_mask);
+    sigdelset(run_mask, SIGINT);
+    sigdelset(run_mask, SIGTERM);
+    sigdelset(run_mask, SIGHUP);
+}
+
+static struct timespec ts_from_us(uint64_t us)
+{
+    struct timespec ts;
+    ts.tv_sec = (time_t)(us / 1000000u);
+    ts.tv_nsec = (long)(us % 1000000u) * 1000L;
+    return ts;
+}
+
+/* Read what the client sent; false when no client has the pty open. */
+static bool read_input(sim_io_t *io, j288_sim_bus_t *bus)
+{
+    uint8_t buf[512];
+    for (;;) {
+        ssize_t n = read(io->master, buf, sizeof buf);
+        if (n > 0) {
+            j288_sim_bus_feed(bus, buf, (size_t)n, sim_now_us(io));
+            continue;
+        }
+        if (n < 0 && errno == EINTR)
+            continue;
+        if (n < 0 && (errno == EAGAIN || errno == EWOULDBLOCK))
+            return true;
+        return false; /* EIO: the slave side is closed */
+    }
+}
+
+static void serve(sim_io_t *io, j288_sim_bus_t *bus, uint64_t exit_at_us, const sigset_t *mask)
+{
+    uint64_t last_tick = 0;
+    while (!g_stop) {
+        uint64_t now = sim_now_us(io);
+        uint64_t wake = now + TICK_US;
+        struct pollfd pfd;
+        struct timespec ts;
+        int rc;
+        if (exit_at_us != 0u && now >= exit_at_us)
+            break;
+        flush_due(io, now);
+        if (now - last_tick >= TICK_US) {
+            j288_sim_bus_advance(bus, now);
+            last_tick = now;
+        }
+        if (io->qlen > 0u && io->q[0].at_us < wake)
+            wake = io->q[0].at_us;
+        if (exit_at_us != 0u && exit_at_us < wake)
+            wake = exit_at_us;
+        ts = ts_from_us(wake > now ? wake - now : 0u);
+        pfd.fd = io->master;
+        pfd.events = POLLIN;
+        pfd.revents = 0;
+        rc = ppoll(&pfd, 1, &ts, mask);
+        if (rc < 0 && errno != EINTR)
+            die("poll: %s", strerror(errno));
+        if (rc <= 0)
+            continue;
+        if (!read_input(io, bus) || (pfd.revents & POLLHUP) != 0) {
+            /* No client: the master reports hang-up until one opens the pty. Nap rather
+             * than spin; replies still queued for a departed client are dropped. */
+            io->lost_no_client += io->qlen;
+            io->qlen = 0;
+            ts = ts_from_us(NAP_US);
+            (void)ppoll(NULL, 0, &ts, mask);
+        }
+    }
+}
+
+int main(int argc, char **argv)
+{
+    options_t o;
+    sim_io_t io;
+    j288_sim_bus_t *bus;
+    char path[128];
+    sigset_t run_mask;
+    uint64_t exit_at = 0;
+    uint8_t id;
+    const j288_sim_stats_t *st;
+
+    parse_args(&o, argc, argv);
+    memset(&io, 0, sizeof io);
+    bus = calloc(1, sizeof *bus);
+    if (bus == NULL)
+        die("out of memory");
+    install_signals(&run_mask);
+    if (o.log != NULL) {
+        io.log = (strcmp(o.log, "-") == 0) ? stderr : fopen(o.log, "w");
+        if (io.log == NULL)
+            die("--log %s: %s", o.log, strerror(errno));
+    }
+    if (j288_sim_bus_init(bus, o.ids, &o.bus, &o.prm, queue_send, log_frame, &io) != 0)
+        die("bad --ids");
+    for (id = 0; id < J288_MAX_SERVOS; id++)
+        if ((o.fault_set & (1u << id)) != 0u)
+            (void)j288_sim_bus_inject_faults(bus, id, o.faults[id]);
+
+    io.master = open_pty(path, sizeof path);
+    if (o.link != NULL)
+        place_link(o.link, path);
+    io.t0_ns = mono_ns();
+    if (o.exit_after > 0.0)
+        exit_at = (uint64_t)(o.exit_after * 1e6);
+    printf("%s\n", path);
+    fflush(stdout);
+    if (!o.quiet) {
+        fprintf(stderr, "j288-sim: servos");
+        for (id = 0; id < J288_MAX_SERVOS; id++)
+            if ((o.ids & (1u << id)) != 0u)
+                fprintf(stderr, " %u", (unsigned)id);
+        fprintf(stderr, " on %s%s%s\n", path, o.link ? " -> " : "", o.link ? o.link : "");
+    }
+
+    serve(&io, bus, exit_at, &run_mask);
+
+    /* Closing the master hangs up the slave: a client sees its device vanish. */
+    (void)close(io.master);
+    if (o.link != NULL)
+        remove_link(o.link, path);
+    j288_sim_bus_advance(bus, sim_now_us(&io));
+    st = &bus->stats;
+    fprintf(stderr,
+            "j288-sim: stats: bytes %llu commands %llu broadcast %llu bad-crc %llu "
+            "other-ids %llu replies %llu dropped %llu corrupted %llu late %llu noise %llu "
+            "duplicates %llu watchdog-trips %llu garbage-bytes %lu lost %llu\n",
+            (unsigned long long)st->bytes, (unsigned long long)st->commands,
+            (unsigned long long)st->broadcasts, (unsigned long long)st->bad_crc,
+            (unsigned long long)st->for_others, (unsigned long long)st->replies,
+            (unsigned long long)st->dropped, (unsigned long long)st->corrupted,
+            (unsigned long long)st->late, (unsigned long long)st->noise,
+            (unsigned long long)st->duplicates, (unsigned long long)st->watchdog_trips,
+            (unsigned long)bus->parser.stats.garbage_bytes,
+            (unsigned long long)(io.lost_no_client + io.queue_full));
+    if (io.log != NULL && io.log != stderr)
+        fclose(io.log);
+    free(bus);
+    return 0;
+}
