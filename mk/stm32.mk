@@ -85,3 +85,27 @@ target-tests: $(TGT_ALL_ELFS)
 test-target: $(TGT_ALL_ELFS)
 	@echo "test-target: $(words $(TGT_ALL_ELFS)) images: $(TGT_UNIT_NAMES) test_stm32_port on $(TGT_CORES)"
 	bash test/target/run-target.sh $(TGT_RUN_SPECS)
+
+# ---- firmware example (links against the stub; `make arm` builds it) --------------------
+STM32_EX_DIR := examples/stm32_hal
+STM32_EX_ELF := $(BUILD)/stm32/stm32_hal_example.elf
+STM32_EX_FLAGS := -mcpu=cortex-m4 -mthumb -mfloat-abi=hard -mfpu=fpv4-sp-d16 \
+    -DJ288_CONFIG_SI_FLOAT=1 -DJ288_CONFIG_CRC_BACKEND=J288_CRC_BACKEND_NIBBLE
+STM32_EX_CFLAGS := -std=c99 $(WARN) -Os -g -ffunction-sections -fdata-sections
+STM32_EX_CPPFLAGS := $(CPPFLAGS_LIB) -I$(STM32_PORT_DIR) -I$(STM32_STUB_DIR) -I$(STM32_EX_DIR)
+STM32_EX_SRC := $(wildcard $(STM32_EX_DIR)/*.c) $(STM32_PORT_SRC) $(STM32_STUB_DIR)/stm32_hal_stub.c $(LIB_SRC)
+STM32_EX_OBJ := $(STM32_EX_SRC:%.c=$(BUILD)/stm32/example/obj/%.o)
+
+$(BUILD)/stm32/example/obj/%.o: %.c $(STM32_HDRS) $(wildcard $(STM32_EX_DIR)/*.h)
+	@mkdir -p $(@D)
+	$(ARM_CC) $(STM32_EX_FLAGS) $(STM32_EX_CPPFLAGS) $(STM32_EX_CFLAGS) -c $< -o $@
+
+$(STM32_EX_ELF): $(STM32_EX_OBJ) $(STM32_EX_DIR)/stm32f407.ld
+	$(ARM_CC) $(STM32_EX_FLAGS) -nostartfiles --specs=nano.specs --specs=nosys.specs \
+	    -Wl,--gc-sections -Wl,-Map=$(@:.elf=.map) -T $(STM32_EX_DIR)/stm32f407.ld \
+	    $(filter %.o,$^) -o $@ -lm
+	$(ARM_SIZE) $@
+
+.PHONY: stm32-example
+stm32-example: $(STM32_EX_ELF)
+arm: stm32-example

@@ -46,6 +46,8 @@ typedef struct __DMA_HandleTypeDef {
     void *Parent;
 } DMA_HandleTypeDef;
 
+void HAL_DMA_IRQHandler(DMA_HandleTypeDef *hdma);
+
 /* ---- UART ------------------------------------------------------------------------------ */
 typedef struct {
     volatile uint32_t SR;
@@ -173,6 +175,7 @@ typedef struct __TIM_HandleTypeDef {
        : (ch) == TIM_CHANNEL_3 ? &(h)->Instance->CCR3                                          \
                                : &(h)->Instance->CCR4) = (v))
 
+HAL_StatusTypeDef HAL_TIM_Base_Init(TIM_HandleTypeDef *htim);
 HAL_StatusTypeDef HAL_TIM_Base_Start(TIM_HandleTypeDef *htim);
 void HAL_TIM_IRQHandler(TIM_HandleTypeDef *htim);
 void HAL_TIM_OC_DelayElapsedCallback(TIM_HandleTypeDef *htim); /* weak in the HAL */
@@ -189,11 +192,38 @@ typedef struct {
 } CRC_HandleTypeDef;
 
 /* Resets the unit to its initial value, feeds BufferLength words, returns the result. */
+HAL_StatusTypeDef HAL_CRC_Init(CRC_HandleTypeDef *hcrc);
 uint32_t HAL_CRC_Calculate(CRC_HandleTypeDef *hcrc, uint32_t pBuffer[], uint32_t BufferLength);
 /* Feeds BufferLength more words without resetting, returns the running result. */
 uint32_t HAL_CRC_Accumulate(CRC_HandleTypeDef *hcrc, uint32_t pBuffer[], uint32_t BufferLength);
 
 /* ---- system ---------------------------------------------------------------------------- */
+/* Interrupt numbers and peripheral addresses of an STM32F405/407 (the example's board). */
+typedef enum {
+    TIM2_IRQn = 28,
+    USART1_IRQn = 37,
+    DMA2_Stream2_IRQn = 58,
+    DMA2_Stream7_IRQn = 70
+} IRQn_Type;
+
+#define TIM2 ((TIM_TypeDef *)0x40000000u)
+#define USART1 ((USART_TypeDef *)0x40011000u)
+#define GPIOA ((GPIO_TypeDef *)0x40020000u)
+#define GPIOC ((GPIO_TypeDef *)0x40020800u)
+#define CRC ((CRC_TypeDef *)0x40023000u)
+#define DMA2_Stream2 ((DMA_Stream_TypeDef *)0x40026440u)
+#define DMA2_Stream7 ((DMA_Stream_TypeDef *)0x400264B8u)
+
+#define UART_WORDLENGTH_8B 0x00000000u
+#define UART_STOPBITS_1 0x00000000u
+#define UART_PARITY_NONE 0x00000000u
+#define UART_MODE_TX_RX 0x0000000Cu
+#define UART_HWCONTROL_NONE 0x00000000u
+#define UART_OVERSAMPLING_8 0x00008000u
+#define TIM_COUNTERMODE_UP 0x00000000u
+
+void HAL_NVIC_SetPriority(IRQn_Type IRQn, uint32_t PreemptPriority, uint32_t SubPriority);
+void HAL_NVIC_EnableIRQ(IRQn_Type IRQn);
 HAL_StatusTypeDef HAL_Init(void);
 uint32_t HAL_GetTick(void);
 

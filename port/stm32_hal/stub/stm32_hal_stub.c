@@ -1,0 +1,100 @@
+/*
+ * stm32_hal_stub.c - do-nothing bodies for the HAL slice declared in stm32_hal_stub.h, so that
+ * firmware built against the stub links (examples/stm32_hal). Nothing here touches hardware:
+ * the image shows that the port and the example compile and link for the target, it does not
+ * drive a UART. In a real project the STM32Cube HAL and CMSIS provide these functions and this
+ * file is not compiled.
+ */
+#include "stm32_hal_stub.h"
+
+HAL_StatusTypeDef HAL_Init(void) { return HAL_OK; }
+uint32_t HAL_GetTick(void) { return 0u; }
+void HAL_NVIC_SetPriority(IRQn_Type IRQn, uint32_t PreemptPriority, uint32_t SubPriority)
+{
+    (void)IRQn;
+    (void)PreemptPriority;
+    (void)SubPriority;
+}
+void HAL_NVIC_EnableIRQ(IRQn_Type IRQn) { (void)IRQn; }
+
+void HAL_GPIO_WritePin(GPIO_TypeDef *GPIOx, uint16_t GPIO_Pin, GPIO_PinState PinState)
+{
+    GPIOx->BSRR = (PinState == GPIO_PIN_SET) ? GPIO_Pin : ((uint32_t)GPIO_Pin << 16);
+}
+
+GPIO_PinState HAL_GPIO_ReadPin(GPIO_TypeDef *GPIOx, uint16_t GPIO_Pin)
+{
+    return ((GPIOx->ODR & GPIO_Pin) != 0u) ? GPIO_PIN_SET : GPIO_PIN_RESET;
+}
+
+void HAL_DMA_IRQHandler(DMA_HandleTypeDef *hdma) { (void)hdma; }
+
+HAL_StatusTypeDef HAL_HalfDuplex_Init(UART_HandleTypeDef *huart)
+{
+    huart->gState = HAL_UART_STATE_READY;
+    huart->RxState = HAL_UART_STATE_READY;
+    return HAL_OK;
+}
+HAL_StatusTypeDef HAL_HalfDuplex_EnableTransmitter(UART_HandleTypeDef *huart) { (void)huart; return HAL_OK; }
+HAL_StatusTypeDef HAL_HalfDuplex_EnableReceiver(UART_HandleTypeDef *huart) { (void)huart; return HAL_OK; }
+HAL_StatusTypeDef HAL_UART_Transmit_DMA(UART_HandleTypeDef *huart, const uint8_t *pData, uint16_t Size)
+{
+    huart->pTxBuffPtr = pData;
+    huart->TxXferSize = Size;
+    return HAL_OK;
+}
+HAL_StatusTypeDef HAL_UARTEx_ReceiveToIdle_DMA(UART_HandleTypeDef *huart, uint8_t *pData, uint16_t Size)
+{
+    huart->pRxBuffPtr = pData;
+    huart->RxXferSize = Size;
+    return HAL_OK;
+}
+HAL_StatusTypeDef HAL_UART_AbortReceive(UART_HandleTypeDef *huart) { (void)huart; return HAL_OK; }
+void HAL_UART_IRQHandler(UART_HandleTypeDef *huart) { (void)huart; }
+
+HAL_StatusTypeDef HAL_TIM_Base_Init(TIM_HandleTypeDef *htim) { (void)htim; return HAL_OK; }
+HAL_StatusTypeDef HAL_TIM_Base_Start(TIM_HandleTypeDef *htim) { (void)htim; return HAL_OK; }
+void HAL_TIM_IRQHandler(TIM_HandleTypeDef *htim) { (void)htim; }
+
+HAL_StatusTypeDef HAL_CRC_Init(CRC_HandleTypeDef *hcrc) { (void)hcrc; return HAL_OK; }
+
+uint32_t HAL_CRC_Accumulate(CRC_HandleTypeDef *hcrc, uint32_t pBuffer[], uint32_t BufferLength)
+{
+    for (uint32_t i = 0; i < BufferLength; i++) {
+        hcrc->Instance->DR = pBuffer[i];
+    }
+    return hcrc->Instance->DR;
+}
+
+uint32_t HAL_CRC_Calculate(CRC_HandleTypeDef *hcrc, uint32_t pBuffer[], uint32_t BufferLength)
+{
+    hcrc->Instance->CR = 1u; /* reset to the initial value */
+    return HAL_CRC_Accumulate(hcrc, pBuffer, BufferLength);
+}
+
+#if defined(__arm__)
+uint32_t __get_PRIMASK(void)
+{
+    uint32_t r;
+    __asm volatile("mrs %0, primask" : "=r"(r));
+    return r;
+}
+void __set_PRIMASK(uint32_t priMask) { __asm volatile("msr primask, %0" : : "r"(priMask) : "memory"); }
+void __disable_irq(void) { __asm volatile("cpsid i" : : : "memory"); }
+#else
+static uint32_t primask_shadow;
+uint32_t __get_PRIMASK(void) { return primask_shadow; }
+void __set_PRIMASK(uint32_t priMask) { primask_shadow = priMask; }
+void __disable_irq(void) { primask_shadow = 1u; }
+#endif
+
+void SCB_CleanDCache_by_Addr(volatile void *addr, int32_t dsize)
+{
+    (void)addr;
+    (void)dsize;
+}
+void SCB_InvalidateDCache_by_Addr(volatile void *addr, int32_t dsize)
+{
+    (void)addr;
+    (void)dsize;
+}
