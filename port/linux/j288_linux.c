@@ -138,6 +138,10 @@ static int take_exclusive(j288_linux_t *lp, const char *dev)
     /* TIOCEXCL makes further open() calls fail with EBUSY (except for root, which the
      * flock above still stops). */
     if (ioctl(lp->fd, TIOCEXCL) != 0) {
+        if (errno == ENOTTY || errno == EINVAL) {
+            set_err(lp, "%s is not a serial device", dev);
+            return J288_ERR_BAD_CONFIG;
+        }
         set_err(lp, "%s: cannot get exclusive access: %s", dev, strerror(errno));
         return J288_ERR_PORT;
     }
@@ -468,14 +472,23 @@ static int write_all(j288_linux_t *lp, const uint8_t *data, size_t len)
 static int port_start_tx(void *ctx, const uint8_t *data, size_t len)
 {
     j288_linux_t *lp = ctx;
-    int rc;
-    if (lp->fd < 0 || lp->gone)
-        return J288_ERR_OFFLINE;
+    bool was_gone = lp->gone;
+    int rc = J288_ERR_OFFLINE;
+    if (lp->fd < 0)
+        return J288_ERR_PORT;
     /* Nothing received before this command can be its reply: drop it here, where it cannot
      * be mistaken for one. */
-    if (drain_input(lp, false) < 0)
-        return J288_ERR_OFFLINE;
-    rc = write_all(lp, data, len);
+    if (!was_gone && drain_input(lp, false) >= 0)
+        rc = write_all(lp, data, len);
+    if (rc == J288_ERR_OFFLINE) {
+        /* The attempt learns of it through the bus's line-gone event, which ends it with
+         * J288_ERR_OFFLINE at once (an error return would read as a generic J288_ERR_PORT).
+         * mark_gone() sent the event if the loss was found just now; a device lost
+         * earlier needs one for this attempt. */
+        if (was_gone && lp->bus != NULL)
+            j288_bus_on_error(lp->bus, J288_LINE_GONE);
+        return J288_OK;
+    }
     if (rc != J288_OK)
         return rc;
     lp->idle_pending = false;
