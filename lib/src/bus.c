@@ -1,75 +1,750 @@
-/* bus.c - the half-duplex bus engine (stub: full implementation follows). */
+/* The half-duplex bus engine; see j288/bus.h for the contract and the state diagram. */
 #include "j288/bus.h"
 
 #include <string.h>
 
-int j288_bus_init(j288_bus_t *bus, const j288_port_t *port, void *port_ctx,
-                  const j288_bus_config_t *cfg)
+#define RING_MASK (J288_CONFIG_RX_RING_SIZE - 1u)
+#define MAX_CFG_US 60000000u /* longest turnaround, margin or guard: 1 minute */
+#define MAX_STEPS 16u        /* transitions per advance call; more is a bug, not a hang */
+
+/* Failure ranking at the deadline: the most specific observation names the result. */
+static unsigned fail_rank(int err)
 {
-    (void)port_ctx;
-    (void)cfg;
-    if (bus == NULL || port == NULL) return J288_ERR_NULL;
-    memset(bus, 0, sizeof *bus);
-    return J288_ERR_PORT_OPS;
+    switch (err) {
+    case J288_ERR_WRONG_ID:
+        return 4u;
+    case J288_ERR_LINE:
+        return 3u;
+    case J288_ERR_CRC:
+    case J288_ERR_TRUNCATED:
+        return 2u;
+    default:
+        return 0u;
+    }
 }
 
-int j288_bus_submit(j288_bus_t *bus, const j288_cmd_raw_t *cmd, uint32_t now_us,
-                    j288_bus_done_fn done, void *user)
+/* Wrap-safe "now is at or after t", for intervals below 2^31 us. */
+static bool time_reached(uint32_t now, uint32_t t) { return (uint32_t)(now - t) < 0x80000000u; }
+
+static bool is_active(uint8_t state)
 {
-    (void)now_us;
-    (void)done;
-    (void)user;
-    if (bus == NULL || cmd == NULL) return J288_ERR_NULL;
-    return J288_ERR_BUSY;
+    return (state == J288_BUS_TX) || (state == J288_BUS_ECHO) || (state == J288_BUS_WAIT_REPLY);
 }
 
-void j288_bus_poll(j288_bus_t *bus, uint32_t now_us) { (void)bus; (void)now_us; }
-void j288_bus_on_tx_done(j288_bus_t *bus) { (void)bus; }
-void j288_bus_on_rx(j288_bus_t *bus, const uint8_t *data, size_t len)
+static void port_lock(const j288_bus_t *bus)
 {
-    (void)bus;
-    (void)data;
-    (void)len;
-}
-void j288_bus_on_rx_idle(j288_bus_t *bus) { (void)bus; }
-void j288_bus_on_error(j288_bus_t *bus, uint32_t line_flags) { (void)bus; (void)line_flags; }
-void j288_bus_on_timer(j288_bus_t *bus) { (void)bus; }
-
-int j288_bus_estop(j288_bus_t *bus, uint32_t now_us)
-{
-    (void)now_us;
-    return bus == NULL ? J288_ERR_NULL : J288_OK;
+    if (bus->cfg.advance_in_isr && !bus->in_advance && (bus->port->lock != NULL)) {
+        bus->port->lock(bus->port_ctx);
+    }
 }
 
-int j288_bus_transfer_blocking(j288_bus_t *bus, const j288_cmd_raw_t *cmd, j288_txn_t *txn)
+static void port_unlock(const j288_bus_t *bus)
 {
-    (void)txn;
-    if (bus == NULL || cmd == NULL) return J288_ERR_NULL;
-    return J288_ERR_PORT_OPS;
+    if (bus->cfg.advance_in_isr && !bus->in_advance && (bus->port->unlock != NULL)) {
+        bus->port->unlock(bus->port_ctx);
+    }
 }
 
-j288_bus_state_t j288_bus_state(const j288_bus_t *bus)
+static void arm_at(j288_bus_t *bus, uint32_t t)
 {
-    return bus == NULL ? J288_BUS_IDLE : (j288_bus_state_t)bus->state;
+    bus->timer_at = t;
+    if (bus->port->arm_timeout != NULL) {
+        bus->port->arm_timeout(bus->port_ctx, t);
+    }
 }
-bool j288_bus_is_idle(const j288_bus_t *bus) { return j288_bus_state(bus) == J288_BUS_IDLE; }
-const j288_bus_stats_t *j288_bus_stats(const j288_bus_t *bus)
+
+static void note_fail(j288_bus_t *bus, int err)
 {
-    return bus == NULL ? NULL : &bus->stats;
-}
-const j288_parser_stats_t *j288_bus_parser_stats(const j288_bus_t *bus)
-{
-    return bus == NULL ? NULL : &bus->parser.stats;
+    if (fail_rank(err) > fail_rank(bus->attempt_fail)) {
+        bus->attempt_fail = err;
+    }
 }
 
 uint32_t j288_wire_time_us(uint32_t baud, uint32_t nbytes)
 {
-    uint64_t bits = (uint64_t)nbytes * 10u * 1000000u;
-    if (baud == 0u) return 0u;
-    return (uint32_t)((bits + baud - 1u) / baud);
+    uint64_t bit_us = (uint64_t)nbytes * 10u * 1000000u;
+    uint64_t b = (baud == 0u) ? J288_DEFAULT_BAUD : baud;
+    return (uint32_t)((bit_us + b - 1u) / b);
 }
 
 uint32_t j288_bus_reply_budget_us(const j288_bus_t *bus)
 {
-    return bus == NULL ? 0u : bus->reply_budget_us;
+    return (bus == NULL) ? 0u : bus->reply_budget_us;
+}
+
+static int check_config(const j288_bus_config_t *c)
+{
+    if (c->retries > J288_CONFIG_MAX_RETRIES) {
+        return J288_ERR_BAD_CONFIG;
+    }
+    if ((c->baud != 0u) && (c->baud < 9600u)) {
+        return J288_ERR_BAD_CONFIG;
+    }
+    if ((c->turnaround_us > MAX_CFG_US) || (c->margin_us > MAX_CFG_US) ||
+        (c->guard_us > MAX_CFG_US)) {
+        return J288_ERR_BAD_CONFIG;
+    }
+    return J288_OK;
+}
+
+static void apply_defaults(j288_bus_config_t *c)
+{
+    if (c->baud == 0u) {
+        c->baud = J288_DEFAULT_BAUD;
+    }
+    if (c->turnaround_us == 0u) {
+        c->turnaround_us = J288_DEFAULT_TURNAROUND_US;
+    }
+    if (c->margin_us == 0u) {
+        c->margin_us = J288_DEFAULT_MARGIN_US;
+    }
+    if (c->guard_us == 0u) {
+        c->guard_us = J288_DEFAULT_GUARD_US;
+    }
+}
+
+int j288_bus_init(j288_bus_t *bus, const j288_port_t *port, void *port_ctx,
+                  const j288_bus_config_t *cfg)
+{
+    j288_bus_config_t c;
+    int err;
+
+    if ((bus == NULL) || (port == NULL)) {
+        return J288_ERR_NULL;
+    }
+    if ((port->start_tx == NULL) || (port->now_us == NULL) ||
+        ((port->lock == NULL) != (port->unlock == NULL))) {
+        return J288_ERR_PORT_OPS;
+    }
+    if (cfg != NULL) {
+        c = *cfg;
+    } else {
+        memset(&c, 0, sizeof c);
+    }
+    err = check_config(&c);
+    if (err != J288_OK) {
+        return err;
+    }
+    apply_defaults(&c);
+
+    memset(bus, 0, sizeof *bus);
+    bus->port = port;
+    bus->port_ctx = port_ctx;
+    bus->crc.fn = port->crc32;
+    bus->crc.ctx = port_ctx;
+    bus->cfg = c;
+    bus->reply_budget_us = j288_wire_time_us(c.baud, J288_CMD_LEN + J288_REPLY_LEN) +
+                           c.turnaround_us + c.margin_us;
+    bus->state = (uint8_t)J288_BUS_IDLE;
+    bus->attempt_fail = J288_OK;
+    return j288_parser_init(&bus->parser, J288_PARSE_REPLY, &bus->crc);
+}
+
+/* ---- receive ring: on_rx is the only producer, the advancing context the only consumer */
+
+static void ring_put(j288_bus_t *bus, const uint8_t *data, size_t len)
+{
+    uint32_t head = bus->ring_head;
+    uint32_t room = J288_CONFIG_RX_RING_SIZE - (uint32_t)(head - bus->ring_tail);
+    size_t n = (len < room) ? len : room;
+    size_t i;
+
+    for (i = 0u; i < n; i++) {
+        bus->ring[(head + (uint32_t)i) & RING_MASK] = data[i];
+    }
+    if (n < len) {
+        bus->stats.rx_overflows += (uint32_t)(len - n);
+    }
+    bus->ring_head = head + (uint32_t)n; /* publish after the bytes are in place */
+}
+
+/* ---- attempts and completion */
+
+static void enter_guard(j288_bus_t *bus, uint32_t now, uint32_t gap)
+{
+    bus->state = (uint8_t)J288_BUS_GUARD;
+    bus->guard_end = now + gap;
+    arm_at(bus, bus->guard_end);
+    bus->again = true;
+}
+
+static void finish(j288_bus_t *bus, int result, uint32_t now)
+{
+    j288_txn_t *t = &bus->txn[bus->cur];
+    j288_bus_done_fn done = bus->done;
+    void *user = bus->done_user;
+    bool was_estop = bus->estop_active;
+
+    if (!was_estop && bus->estop_pending) {
+        result = J288_ERR_ABORTED;
+    }
+    t->result = result;
+    t->latency_us = (t->attempts != 0u) ? (uint32_t)(now - t->start_us) : 0u;
+    if (result == J288_OK) {
+        bus->stats.ok++;
+    } else if (result == J288_ERR_ABORTED) {
+        bus->stats.aborted++;
+    }
+    bus->queued = false;
+    bus->retry_pending = false;
+    bus->estop_active = false;
+    bus->done = NULL;
+    enter_guard(bus, now, (result == J288_OK) ? bus->cfg.guard_us : bus->reply_budget_us);
+    if (!was_estop && (done != NULL)) {
+        done(user, t);
+    }
+}
+
+static void count_result(j288_bus_t *bus, int result)
+{
+    switch (result) {
+    case J288_ERR_TIMEOUT:
+    case J288_ERR_TX_TIMEOUT:
+        bus->stats.timeouts++;
+        break;
+    case J288_ERR_COLLISION:
+        bus->stats.collisions++;
+        break;
+    default:
+        break;
+    }
+}
+
+/* An attempt ended: keep its reason, then retry after a guard or finish. */
+static void end_attempt(j288_bus_t *bus, int result, uint32_t now)
+{
+    j288_txn_t *t = &bus->txn[bus->cur];
+    bool final = (result == J288_OK) || (result == J288_ERR_OFFLINE) || bus->estop_pending ||
+                 (t->attempts > bus->cfg.retries);
+
+    if (t->attempts != 0u) {
+        t->attempt_result[t->attempts - 1u] = result;
+    }
+    count_result(bus, result);
+    if (final) {
+        finish(bus, result, now);
+        return;
+    }
+    bus->retry_pending = true;
+    enter_guard(bus, now, bus->reply_budget_us);
+}
+
+static void start_attempt(j288_bus_t *bus, uint32_t now)
+{
+    j288_txn_t *t = &bus->txn[bus->cur];
+    int rc;
+
+    /* Whatever arrived before this transmit belongs to nobody. */
+    bus->stats.stale_bytes += (uint32_t)(bus->ring_head - bus->ring_tail);
+    bus->ring_tail = bus->ring_head;
+    j288_parser_reset(&bus->parser);
+    bus->seen_tx_done = bus->ev_tx_done;
+    bus->seen_idle = bus->ev_idle;
+    bus->seen_line = bus->ev_line;
+    bus->seen_gone = bus->ev_gone;
+    bus->echo_pos = 0u;
+    bus->tx_complete = false;
+    bus->collided = false;
+    bus->attempt_fail = J288_OK;
+
+    t->attempts++;
+    t->start_us = now;
+    bus->stats.attempts++;
+    bus->deadline = now + bus->reply_budget_us;
+    /* State first: the port may report tx done from inside start_tx. */
+    bus->state = (uint8_t)J288_BUS_TX;
+    bus->again = true;
+    arm_at(bus, bus->deadline);
+    if (bus->port->set_dir != NULL) {
+        bus->port->set_dir(bus->port_ctx, J288_DIR_TX);
+    }
+    if (bus->cfg.echo && (bus->port->start_rx != NULL)) {
+        bus->port->start_rx(bus->port_ctx); /* the echo must be heard */
+    }
+    rc = bus->port->start_tx(bus->port_ctx, bus->tx_buf, J288_CMD_LEN);
+    if (rc < 0) {
+        bus->stats.port_errors++;
+        end_attempt(bus, J288_ERR_PORT, now);
+    }
+}
+
+static void begin_txn(j288_bus_t *bus, uint8_t id, j288_bus_done_fn done, void *user)
+{
+    j288_txn_t *t;
+
+    bus->cur ^= 1u; /* the previous txn stays intact for a callback still looking at it */
+    t = &bus->txn[bus->cur];
+    memset(t, 0, sizeof *t);
+    t->id = id;
+    t->result = J288_ERR_BUSY;
+    bus->tx_id = id;
+    bus->done = done;
+    bus->done_user = user;
+    bus->stats.transactions++;
+}
+
+static void send_estop(j288_bus_t *bus, uint32_t now)
+{
+    j288_cmd_raw_t stop;
+
+    memset(&stop, 0, sizeof stop);
+    stop.id = J288_BROADCAST_ID;
+    stop.status = J288_MODE_LOCK;
+    stop.watchdog = true;
+    (void)j288_cmd_encode(&stop, bus->tx_buf, &bus->crc); /* constant, valid fields */
+    bus->estop_pending = false;
+    bus->estop_active = true;
+    begin_txn(bus, J288_BROADCAST_ID, NULL, NULL);
+    bus->stats.transactions--; /* the stop is counted in estops, not as a user transaction */
+    bus->stats.estops++;
+    start_attempt(bus, now);
+}
+
+/* ---- byte consumption */
+
+static void take_frame(j288_bus_t *bus, const uint8_t *frame, uint32_t now)
+{
+    uint8_t id = (uint8_t)(frame[2] & 0x0Fu);
+
+    if (id != bus->tx_id) {
+        bus->stats.wrong_id++;
+        note_fail(bus, J288_ERR_WRONG_ID);
+        return;
+    }
+    j288_reply_unpack(frame, &bus->txn[bus->cur].reply);
+    end_attempt(bus, J288_OK, now);
+}
+
+/* Reply window: through the parser. Returns bytes consumed (stops after a frame). */
+static uint32_t take_reply_bytes(j288_bus_t *bus, const uint8_t *p, uint32_t n, uint32_t now)
+{
+    uint32_t crc_before = bus->parser.stats.crc_errors;
+    size_t used = 0u;
+    int rc = j288_parser_feed(&bus->parser, p, n, &used);
+    uint32_t crc_new = bus->parser.stats.crc_errors - crc_before;
+
+    if (crc_new != 0u) {
+        bus->stats.crc_errors += crc_new;
+        note_fail(bus, J288_ERR_CRC);
+    }
+    if (rc == J288_PARSE_FRAME) {
+        take_frame(bus, j288_parser_frame(&bus->parser), now);
+    }
+    return (uint32_t)used;
+}
+
+/* Echo window: compare with what we sent. */
+static uint32_t take_echo_bytes(j288_bus_t *bus, const uint8_t *p, uint32_t n)
+{
+    uint32_t want = J288_CMD_LEN - (uint32_t)bus->echo_pos;
+    uint32_t k = (n < want) ? n : want;
+    uint32_t i;
+
+    for (i = 0u; i < k; i++) {
+        if (p[i] != bus->tx_buf[bus->echo_pos + i]) {
+            bus->collided = true;
+        }
+    }
+    bus->echo_pos = (uint8_t)(bus->echo_pos + k);
+    return k;
+}
+
+/* Bytes at ring index pos: stale, echo or reply, by state. Returns bytes consumed. */
+static uint32_t take_bytes(j288_bus_t *bus, uint32_t pos, const uint8_t *p, uint32_t n,
+                           uint32_t now)
+{
+    if (!is_active(bus->state) || bus->collided) {
+        bus->stats.stale_bytes += n;
+        return n;
+    }
+    if (bus->cfg.echo) {
+        if (bus->echo_pos < J288_CMD_LEN) {
+            return take_echo_bytes(bus, p, n);
+        }
+    } else if (!bus->tx_complete) {
+        bus->stats.stale_bytes += n; /* heard before our transmit ended: not a reply */
+        return n;
+    } else {
+        uint32_t before = bus->txdone_mark - pos; /* bytes received before tx done */
+        if ((before != 0u) && (before <= J288_CONFIG_RX_RING_SIZE)) {
+            uint32_t k = (n < before) ? n : before;
+            bus->stats.stale_bytes += k;
+            return k;
+        }
+    }
+    if (bus->tx_id == J288_BROADCAST_ID) {
+        bus->stats.stale_bytes += n; /* nobody answers a broadcast */
+        return n;
+    }
+    return take_reply_bytes(bus, p, n, now);
+}
+
+/* Consume the ring up to index limit (not beyond what has been received). */
+static void consume_to(j288_bus_t *bus, uint32_t limit, uint32_t now)
+{
+    uint32_t tail = bus->ring_tail;
+
+    if ((uint32_t)(limit - tail) > J288_CONFIG_RX_RING_SIZE) {
+        return; /* limit is behind the tail: already consumed */
+    }
+    while (tail != limit) {
+        uint32_t off = tail & RING_MASK;
+        uint32_t n = limit - tail;
+        uint32_t used;
+        if (n > J288_CONFIG_RX_RING_SIZE - off) {
+            n = J288_CONFIG_RX_RING_SIZE - off;
+        }
+        used = take_bytes(bus, tail, &bus->ring[off], n, now);
+        tail += used;
+        bus->ring_tail = tail;
+    }
+}
+
+static bool in_reply_window(const j288_bus_t *bus)
+{
+    return (bus->state == J288_BUS_WAIT_REPLY) ||
+           (bus->tx_complete && !bus->cfg.echo && is_active(bus->state));
+}
+
+static void flush_partial(j288_bus_t *bus)
+{
+    if (j288_parser_flush(&bus->parser) == J288_ERR_TRUNCATED) {
+        bus->stats.crc_errors++;
+        note_fail(bus, J288_ERR_TRUNCATED);
+    }
+}
+
+/* Take what the event calls recorded, in the order it happened. */
+static void take_events(j288_bus_t *bus, uint32_t now)
+{
+    uint32_t n;
+
+    if (bus->ev_tx_done != bus->seen_tx_done) {
+        bus->seen_tx_done = bus->ev_tx_done;
+        if (is_active(bus->state)) {
+            bus->tx_complete = true;
+        }
+    }
+    n = bus->ev_line;
+    if (n != bus->seen_line) {
+        bus->seen_line = n;
+        if (is_active(bus->state)) {
+            note_fail(bus, J288_ERR_LINE);
+        }
+    }
+    n = bus->ev_idle;
+    if (n != bus->seen_idle) {
+        bus->seen_idle = n;
+        consume_to(bus, bus->idle_mark, now);
+        if (in_reply_window(bus)) {
+            flush_partial(bus);
+        }
+    }
+    consume_to(bus, bus->ring_head, now);
+}
+
+/* After the transmit (and its echo): collision, broadcast done, or wait for the reply. */
+static void after_transmit(j288_bus_t *bus, uint32_t now)
+{
+    if (bus->collided) {
+        end_attempt(bus, J288_ERR_COLLISION, now);
+    } else if (bus->cfg.echo && (bus->echo_pos < J288_CMD_LEN)) {
+        if (bus->state != J288_BUS_ECHO) {
+            bus->state = (uint8_t)J288_BUS_ECHO;
+            bus->again = true;
+        }
+    } else if (bus->tx_id == J288_BROADCAST_ID) {
+        end_attempt(bus, (bus->attempt_fail == J288_ERR_LINE) ? J288_ERR_LINE : J288_OK, now);
+    } else {
+        bus->state = (uint8_t)J288_BUS_WAIT_REPLY;
+        bus->again = true;
+    }
+}
+
+static void on_deadline(j288_bus_t *bus, uint32_t now)
+{
+    if (!bus->tx_complete) {
+        end_attempt(bus, J288_ERR_TX_TIMEOUT, now);
+    } else if (bus->state == J288_BUS_ECHO) {
+        end_attempt(bus, J288_ERR_COLLISION, now); /* our own frame never came back whole */
+    } else {
+        flush_partial(bus);
+        end_attempt(bus, (bus->attempt_fail != J288_OK) ? bus->attempt_fail : J288_ERR_TIMEOUT,
+                    now);
+    }
+}
+
+static void step_active(j288_bus_t *bus, uint32_t now)
+{
+    if (bus->ev_gone != bus->seen_gone) {
+        bus->seen_gone = bus->ev_gone;
+        end_attempt(bus, J288_ERR_OFFLINE, now);
+        return;
+    }
+    take_events(bus, now);
+    if (!is_active(bus->state)) {
+        return; /* a reply ended the attempt */
+    }
+    if (bus->tx_complete && (bus->state != J288_BUS_WAIT_REPLY)) {
+        after_transmit(bus, now);
+        if (!is_active(bus->state)) {
+            return;
+        }
+    }
+    if (time_reached(now, bus->deadline)) {
+        on_deadline(bus, now);
+    }
+}
+
+static void step_quiet(j288_bus_t *bus, uint32_t now)
+{
+    consume_to(bus, bus->ring_head, now); /* late replies and noise: stale */
+    if (bus->estop_pending) {
+        if (bus->queued || bus->retry_pending) {
+            finish(bus, J288_ERR_ABORTED, now); /* calls back; the stop goes next time round */
+            return;
+        }
+        send_estop(bus, now);
+        return;
+    }
+    if ((bus->state == J288_BUS_IDLE) || time_reached(now, bus->guard_end)) {
+        if (bus->queued || bus->retry_pending) {
+            bus->queued = false;
+            bus->retry_pending = false;
+            start_attempt(bus, now);
+        } else {
+            bus->state = (uint8_t)J288_BUS_IDLE;
+        }
+    }
+}
+
+static void advance(j288_bus_t *bus, uint32_t now)
+{
+    unsigned steps = 0u;
+
+    if (bus->in_advance) {
+        return; /* an event reported from inside a port call: the outer loop takes it */
+    }
+    bus->in_advance = true;
+    do {
+        bus->again = false;
+        if (is_active(bus->state)) {
+            step_active(bus, now);
+        } else {
+            step_quiet(bus, now);
+        }
+        steps++;
+    } while (bus->again && (steps < MAX_STEPS));
+    bus->in_advance = false;
+}
+
+static void advance_from_event(j288_bus_t *bus)
+{
+    if (bus->cfg.advance_in_isr) {
+        advance(bus, bus->port->now_us(bus->port_ctx));
+    }
+}
+
+/* ---- public entry points */
+
+int j288_bus_submit(j288_bus_t *bus, const j288_cmd_raw_t *cmd, uint32_t now_us,
+                    j288_bus_done_fn done, void *user)
+{
+    int err;
+    uint8_t st;
+
+    if ((bus == NULL) || (cmd == NULL)) {
+        return J288_ERR_NULL;
+    }
+    port_lock(bus);
+    st = bus->state;
+    if (bus->estop_pending || bus->estop_active || bus->queued || bus->retry_pending ||
+        ((st != J288_BUS_IDLE) && (st != J288_BUS_GUARD))) {
+        port_unlock(bus);
+        return J288_ERR_BUSY;
+    }
+    /* The transmit buffer is free: the previous transmit has completed. */
+    err = j288_cmd_encode(cmd, bus->tx_buf, &bus->crc);
+    if (err != J288_OK) {
+        port_unlock(bus);
+        return err;
+    }
+    begin_txn(bus, cmd->id, done, user);
+    bus->queued = true;
+    if (bus->in_advance) {
+        bus->again = true; /* from a callback: the running advance starts it */
+    } else {
+        advance(bus, now_us);
+    }
+    port_unlock(bus);
+    return J288_OK;
+}
+
+void j288_bus_poll(j288_bus_t *bus, uint32_t now_us)
+{
+    if (bus == NULL) {
+        return;
+    }
+    port_lock(bus);
+    advance(bus, now_us);
+    port_unlock(bus);
+}
+
+void j288_bus_on_tx_done(j288_bus_t *bus)
+{
+    if (bus == NULL) {
+        return;
+    }
+    bus->txdone_mark = bus->ring_head;
+    bus->ev_tx_done++;
+    /* Listen at once: the servo answers within microseconds. */
+    if (bus->port->set_dir != NULL) {
+        bus->port->set_dir(bus->port_ctx, J288_DIR_RX);
+    }
+    if (!bus->cfg.echo && (bus->port->start_rx != NULL)) {
+        bus->port->start_rx(bus->port_ctx);
+    }
+    advance_from_event(bus);
+}
+
+void j288_bus_on_rx(j288_bus_t *bus, const uint8_t *data, size_t len)
+{
+    if ((bus == NULL) || (data == NULL) || (len == 0u)) {
+        return;
+    }
+    ring_put(bus, data, len);
+    advance_from_event(bus);
+}
+
+void j288_bus_on_rx_idle(j288_bus_t *bus)
+{
+    if (bus == NULL) {
+        return;
+    }
+    bus->idle_mark = bus->ring_head;
+    bus->ev_idle++;
+    advance_from_event(bus);
+}
+
+void j288_bus_on_error(j288_bus_t *bus, uint32_t line_flags)
+{
+    if (bus == NULL) {
+        return;
+    }
+    bus->line_flags |= line_flags;
+    bus->stats.line_errors++;
+    if ((line_flags & J288_LINE_GONE) != 0u) {
+        bus->ev_gone++;
+    } else {
+        bus->ev_line++;
+    }
+    advance_from_event(bus);
+}
+
+void j288_bus_on_timer(j288_bus_t *bus)
+{
+    if (bus != NULL) {
+        advance_from_event(bus);
+    }
+}
+
+int j288_bus_estop(j288_bus_t *bus, uint32_t now_us)
+{
+    if (bus == NULL) {
+        return J288_ERR_NULL;
+    }
+    port_lock(bus);
+    if (!bus->estop_active) {
+        bus->estop_pending = true;
+    }
+    if (bus->in_advance) {
+        bus->again = true;
+    } else {
+        advance(bus, now_us);
+    }
+    port_unlock(bus);
+    return J288_OK;
+}
+
+/* Force the transaction in progress (or queued) to end, e.g. the device went away. */
+static void abort_txn(j288_bus_t *bus, int result, uint32_t now)
+{
+    if (is_active(bus->state)) {
+        end_attempt(bus, result, now);
+    } else if (bus->queued || bus->retry_pending) {
+        finish(bus, result, now);
+    }
+}
+
+typedef struct {
+    bool done;
+    int result;
+    j288_txn_t *out;
+} blocking_t;
+
+static void blocking_done(void *user, const j288_txn_t *txn)
+{
+    blocking_t *b = (blocking_t *)user;
+    b->done = true;
+    b->result = txn->result;
+    if (b->out != NULL) {
+        *b->out = *txn;
+    }
+}
+
+int j288_bus_transfer_blocking(j288_bus_t *bus, const j288_cmd_raw_t *cmd, j288_txn_t *txn)
+{
+    blocking_t b;
+    int rc;
+
+    if ((bus == NULL) || (cmd == NULL)) {
+        return J288_ERR_NULL;
+    }
+    if (bus->port->wait == NULL) {
+        return J288_ERR_PORT_OPS;
+    }
+    if (bus->in_advance) {
+        return J288_ERR_BUSY; /* not from a completion callback */
+    }
+    b.done = false;
+    b.result = J288_ERR_BUSY;
+    b.out = txn;
+    rc = j288_bus_submit(bus, cmd, bus->port->now_us(bus->port_ctx), blocking_done, &b);
+    if (rc != J288_OK) {
+        return rc;
+    }
+    for (;;) {
+        j288_bus_poll(bus, bus->port->now_us(bus->port_ctx));
+        if (b.done) {
+            break;
+        }
+        rc = bus->port->wait(bus->port_ctx, bus->timer_at);
+        if (rc < 0) {
+            port_lock(bus);
+            abort_txn(bus, J288_ERR_OFFLINE, bus->port->now_us(bus->port_ctx));
+            port_unlock(bus);
+            if (!b.done) {
+                return J288_ERR_OFFLINE; /* unreachable: abort_txn always completes it */
+            }
+            break;
+        }
+    }
+    return b.result;
+}
+
+j288_bus_state_t j288_bus_state(const j288_bus_t *bus)
+{
+    return (bus == NULL) ? J288_BUS_IDLE : (j288_bus_state_t)bus->state;
+}
+
+bool j288_bus_is_idle(const j288_bus_t *bus) { return j288_bus_state(bus) == J288_BUS_IDLE; }
+
+const j288_bus_stats_t *j288_bus_stats(const j288_bus_t *bus)
+{
+    return (bus == NULL) ? NULL : &bus->stats;
+}
+
+const j288_parser_stats_t *j288_bus_parser_stats(const j288_bus_t *bus)
+{
+    return (bus == NULL) ? NULL : &bus->parser.stats;
 }

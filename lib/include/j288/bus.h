@@ -20,7 +20,15 @@
  *   or before a transmit completes, is discarded and counted as stale: a late reply is
  *   never credited to a later transaction.
  * - Retries (config.retries): a failed attempt is re-sent after the guard; each attempt's
- *   reason is kept in the j288_txn_t.
+ *   reason is kept in the j288_txn_t. J288_ERR_OFFLINE and an emergency stop end it at once.
+ * - Line errors (j288_bus_on_error) during an attempt mark it: when no good reply comes, the
+ *   result is J288_ERR_LINE (ranked wrong id > line > crc/truncated > timeout); a reply whose
+ *   CRC checks out after a line error is still taken. J288_LINE_GONE ends the attempt at once
+ *   with J288_ERR_OFFLINE, without retries. Outside an attempt they are only counted.
+ * - A reply frame cut short (the line went idle inside it, or the deadline came with a part
+ *   of a frame held) is J288_ERR_TRUNCATED; it counts as a crc error in the statistics.
+ * - Bytes the machine looks at during poll were received before that poll: they are examined
+ *   before the deadline is checked, so a late poll does not turn a good reply into a timeout.
  *
  * Events come from the port, usually in interrupt context, and only record (the receive path
  * copies into a ring inside the bus object). The machine advances in j288_bus_poll() (thread
@@ -30,7 +38,8 @@
  * and thread-context calls are wrapped in the port's lock/unlock.
  *
  * Zero allocation; the bus object is caller-allocated and must not move while in use.
- * Several buses are independent.
+ * Several buses are independent. Event recording is lock-free (each field has one writer);
+ * it assumes 32-bit loads and stores are atomic, as on every Cortex-M.
  */
 #ifndef J288_BUS_H
 #define J288_BUS_H
@@ -91,45 +100,64 @@ typedef struct {
     bool advance_in_isr;    /* event calls advance the machine (see above) */
 } j288_bus_config_t;
 
-/* Bus-wide counters (per-servo ones live in the scheduler). */
+/* Bus-wide counters (per-servo ones live in the scheduler). Attempt outcomes and what was
+ * seen on the wire are counted where they happen, whatever the transaction's final result. */
 typedef struct {
     uint32_t transactions; /* submits accepted */
-    uint32_t attempts;
-    uint32_t ok;
-    uint32_t timeouts;
-    uint32_t crc_errors;
-    uint32_t wrong_id;
-    uint32_t collisions;
-    uint32_t line_errors;
-    uint32_t port_errors;
-    uint32_t aborted;
+    uint32_t attempts;     /* frames handed to start_tx (stop frames included) */
+    uint32_t ok;           /* transactions that ended J288_OK */
+    uint32_t timeouts;     /* attempts ended by the deadline (reply or tx done) */
+    uint32_t crc_errors;   /* corrupt or truncated frames in a reply window */
+    uint32_t wrong_id;     /* good frames from another id in a reply window */
+    uint32_t collisions;   /* attempts whose echo differed or never came back */
+    uint32_t line_errors;  /* line error reports, any state */
+    uint32_t port_errors;  /* start_tx failures */
+    uint32_t aborted;      /* transactions ended J288_ERR_ABORTED by an estop */
     uint32_t stale_bytes;   /* discarded outside a reply window (late replies, noise) */
     uint32_t rx_overflows;  /* bytes lost because the ring was full */
     uint32_t estops;
 } j288_bus_stats_t;
 
 typedef struct j288_bus {
-    /* Private: read through the functions below. */
+    /* Private: read through the functions below. Fields marked (ev) are written only by the
+     * event calls (producer side), the rest only by the context that advances the machine,
+     * so that recording needs no lock. */
     const j288_port_t *port;
     void *port_ctx;
     j288_crc_t crc;
     j288_bus_config_t cfg;
     uint32_t reply_budget_us;
     volatile uint8_t state;
-    uint8_t tx_buf[J288_CMD_LEN];
+    uint8_t tx_buf[J288_CMD_LEN]; /* owned by the port from start_tx until tx done */
+    uint8_t tx_id;                /* id addressed by tx_buf */
     j288_parser_t parser;
-    /* receive ring: written by on_rx (producer), read by the advancing context */
+    /* receive ring: free-running indexes, masked on use */
     uint8_t ring[J288_CONFIG_RX_RING_SIZE];
-    volatile uint32_t ring_head;
+    volatile uint32_t ring_head;   /* (ev) */
     volatile uint32_t ring_tail;
-    volatile uint32_t ev_flags;
-    volatile uint32_t line_flags;
-    uint8_t echo_pos;
-    uint32_t t_start;
-    uint32_t deadline;
-    int attempt_fail;
-    bool estop_pending;
-    j288_txn_t txn;
+    volatile uint32_t ev_tx_done;  /* (ev) event counters: compared with the seen_* copies */
+    volatile uint32_t ev_idle;     /* (ev) */
+    volatile uint32_t ev_line;     /* (ev) */
+    volatile uint32_t ev_gone;     /* (ev) */
+    volatile uint32_t txdone_mark; /* (ev) ring_head when the transmit completed */
+    volatile uint32_t idle_mark;   /* (ev) ring_head at the latest idle */
+    volatile uint32_t line_flags;  /* (ev) OR of every line flag reported (diagnostic) */
+    uint32_t seen_tx_done, seen_idle, seen_line, seen_gone;
+    uint8_t echo_pos;     /* echo bytes matched so far */
+    uint8_t cur;          /* txn[cur] is the transaction in progress */
+    bool tx_complete;     /* this attempt's transmit has completed */
+    bool collided;        /* this attempt's echo differed */
+    bool in_advance;      /* the machine is advancing (re-entry guard) */
+    bool again;           /* advance once more: something changed */
+    bool queued;          /* an accepted submit waits for the guard to end */
+    bool retry_pending;   /* the failed attempt is re-sent when the guard ends */
+    bool estop_pending;   /* a stop was requested and is not on the wire yet */
+    bool estop_active;    /* the frame in flight is the stop frame */
+    int attempt_fail;     /* most specific failure seen in this attempt, or J288_OK */
+    uint32_t deadline;    /* reply deadline of the attempt in flight */
+    uint32_t guard_end;
+    uint32_t timer_at;    /* the next time the machine needs to look (deadline/guard end) */
+    j288_txn_t txn[2];    /* two, so a callback's txn survives a submit made inside it */
     j288_bus_done_fn done;
     void *done_user;
     j288_bus_stats_t stats;
@@ -137,13 +165,17 @@ typedef struct j288_bus {
 
 /* Set up a bus. cfg may be NULL (defaults). Errors: J288_ERR_NULL, J288_ERR_PORT_OPS
  * (start_tx or now_us missing, or only one of lock/unlock), J288_ERR_BAD_CONFIG (retries
- * above J288_CONFIG_MAX_RETRIES, baud below 9600). Thread only, before any event. */
+ * above J288_CONFIG_MAX_RETRIES, baud below 9600, turnaround, margin or guard above 60 s).
+ * Thread only, before any event. */
 int j288_bus_init(j288_bus_t *bus, const j288_port_t *port, void *port_ctx,
                   const j288_bus_config_t *cfg);
 
-/* Start a transaction: encode cmd and transmit it. done may be NULL. Errors, nothing sent:
- * J288_ERR_NULL, the encoder's codes (J288_ERR_BAD_ID, ...), J288_ERR_BUSY (not idle, or an
- * estop is pending). Thread only, or ISR with advance_in_isr (e.g. from a done callback). */
+/* Start a transaction: encode cmd and transmit it. done may be NULL. Accepted while idle
+ * (transmits at once) or during the guard after the previous transaction (transmits when
+ * the guard ends; this is how a done callback submits the next one). Errors, nothing sent:
+ * J288_ERR_NULL, the encoder's codes (J288_ERR_BAD_ID, ...), J288_ERR_BUSY (a transaction in
+ * flight or already queued, or an estop pending). Thread only, or ISR with advance_in_isr
+ * (e.g. from a done callback). */
 int j288_bus_submit(j288_bus_t *bus, const j288_cmd_raw_t *cmd, uint32_t now_us,
                     j288_bus_done_fn done, void *user);
 
@@ -152,7 +184,11 @@ int j288_bus_submit(j288_bus_t *bus, const j288_cmd_raw_t *cmd, uint32_t now_us,
 void j288_bus_poll(j288_bus_t *bus, uint32_t now_us);
 
 /* Port events. ISR-safe: they record and return (and advance the machine when
- * advance_in_isr). data is copied; it may be reused as soon as on_rx returns. */
+ * advance_in_isr). data is copied; it may be reused as soon as on_rx returns; bytes beyond
+ * the ring's free space are dropped and counted (rx_overflows). on_tx_done also switches
+ * the port to receive at once (set_dir(RX), then start_rx unless config.echo, whose receiver
+ * was started before the transmit); it may be called from inside start_tx. on_timer only
+ * matters with advance_in_isr (in poll mode the next poll looks at the clock itself). */
 void j288_bus_on_tx_done(j288_bus_t *bus);
 void j288_bus_on_rx(j288_bus_t *bus, const uint8_t *data, size_t len);
 void j288_bus_on_rx_idle(j288_bus_t *bus);
@@ -160,15 +196,20 @@ void j288_bus_on_error(j288_bus_t *bus, uint32_t line_flags);
 void j288_bus_on_timer(j288_bus_t *bus);
 
 /* Emergency stop: broadcast lock (id 15, status 0, watchdog on, all fields 0) as soon as the
- * line is free, ahead of anything else. A transaction in flight is not cut mid-frame; it ends
- * with J288_ERR_ABORTED once its transmit completes, and submits are refused until the stop
- * frame is out. Returns J288_OK or J288_ERR_NULL. Thread only (or the owning ISR). */
+ * line is free, ahead of anything else. A transaction in flight is not cut mid-frame and its
+ * reply is not talked over: it ends with J288_ERR_ABORTED when its attempt ends (reply taken,
+ * deadline, collision; at most one reply budget), without retries, its real reason kept in
+ * attempt_result[]; a submit queued behind a guard ends J288_ERR_ABORTED with 0 attempts.
+ * The stop frame then goes out at once (skipping the guard). Submits are refused
+ * (J288_ERR_BUSY) until the stop frame is out; a second estop meanwhile changes nothing.
+ * Returns J288_OK or J288_ERR_NULL. Thread only (or the owning ISR). */
 int j288_bus_estop(j288_bus_t *bus, uint32_t now_us);
 
 /* Blocking transfer for OS ports: submit, then loop on port->wait() and j288_bus_poll()
  * until done. The same engine, not a second one. txn may be NULL. Returns the transaction's
- * result, or J288_ERR_PORT_OPS (no wait op), J288_ERR_BUSY, the encoder's codes, or
- * J288_ERR_OFFLINE. Thread only. */
+ * result, or J288_ERR_PORT_OPS (no wait op), J288_ERR_BUSY (also when called from a done
+ * callback), the encoder's codes, or J288_ERR_OFFLINE (wait failed: the transaction is
+ * ended). Right after a previous transaction it first waits out the guard. Thread only. */
 int j288_bus_transfer_blocking(j288_bus_t *bus, const j288_cmd_raw_t *cmd, j288_txn_t *txn);
 
 /* Inspection. Thread or ISR. */
@@ -177,7 +218,8 @@ bool j288_bus_is_idle(const j288_bus_t *bus);
 const j288_bus_stats_t *j288_bus_stats(const j288_bus_t *bus);
 const j288_parser_stats_t *j288_bus_parser_stats(const j288_bus_t *bus);
 
-/* Wire time of nbytes at baud, 8N1 (10 bits per byte), rounded up to whole microseconds. */
+/* Wire time of nbytes at baud (0: 6000000), 8N1 (10 bits per byte), rounded up to whole
+ * microseconds. */
 uint32_t j288_wire_time_us(uint32_t baud, uint32_t nbytes);
 
 /* The reply deadline budget this bus uses, in microseconds from the start of transmit. */
