@@ -109,3 +109,29 @@ $(STM32_EX_ELF): $(STM32_EX_OBJ) $(STM32_EX_DIR)/stm32f407.ld
 .PHONY: stm32-example
 stm32-example: $(STM32_EX_ELF)
 arm: stm32-example
+
+# ---- bench-target: instructions per transaction on Cortex-M4 (QEMU -icount) -------------
+# $(1): optimisation level tag (O2 / Os)
+TGT_BENCH_FLAGS := -mcpu=cortex-m4 -mthumb -mfloat-abi=hard -mfpu=fpv4-sp-d16 -DJ288_CONFIG_SI_FLOAT=1
+TGT_BENCH_SRC := $(LIB_SRC) $(STM32_PORT_SRC) $(STM32_STUB_DIR)/stm32_hal_stub.c test/target/bench.c test/target/startup.c
+define TGT_BENCH_RULES
+$(BUILD)/bench/$(1)/obj/%.o: %.c $(TGT_HDRS)
+	@mkdir -p $$(@D)
+	$(ARM_CC) $(TGT_BENCH_FLAGS) $(CPPFLAGS_LIB) -I$(STM32_PORT_DIR) -I$(STM32_STUB_DIR) -DJ288_STUB_OMIT_CRC \
+	    -std=c99 $(WARN) -$(1) -g -ffunction-sections -fdata-sections -c $$< -o $$@
+
+$(BUILD)/bench/bench_m4_$(1).elf: $(TGT_BENCH_SRC:%.c=$(BUILD)/bench/$(1)/obj/%.o) test/target/sections.ld test/target/mem_mps2.ld
+	$(ARM_CC) $(TGT_BENCH_FLAGS) $(TGT_LDFLAGS) -T mem_mps2.ld $$(filter %.o,$$^) -o $$@ -lm
+endef
+$(eval $(call TGT_BENCH_RULES,O2))
+$(eval $(call TGT_BENCH_RULES,Os))
+
+.PHONY: bench-target
+bench-target: $(BUILD)/bench/bench_m4_O2.elf $(BUILD)/bench/bench_m4_Os.elf
+	@command -v qemu-system-arm >/dev/null || { echo "bench-target: qemu-system-arm not found; install the Debian package qemu-system-arm" >&2; exit 1; }
+	@for o in O2 Os; do \
+	    echo "Cortex-M4 (mps2-an386, QEMU -icount shift=0), -$$o:"; \
+	    timeout 120 qemu-system-arm -M mps2-an386 -cpu cortex-m4 -icount shift=0 -nographic -monitor none \
+	        -serial none -semihosting-config enable=on,target=native -kernel $(BUILD)/bench/bench_m4_$$o.elf || exit 1; \
+	    echo; \
+	done
