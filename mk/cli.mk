@@ -1,17 +1,22 @@
 # The j288 command-line tool (examples/cli) and its end-to-end tests (test/e2e/cli_*.sh).
 # Owner: cli. `make demo` lives in mk/demo.mk.
+#   $(BIN)/j288    offline frame calculator + bus commands over the Linux port
+#   make cli       just the tool
 
 CLI_SRC := $(sort $(wildcard examples/cli/*.c))
 CLI_OBJ := $(CLI_SRC:%.c=$(OBJ)/%.o)
 CLI_HDR := $(wildcard examples/cli/*.h)
-# The tool is a POSIX program (signals, poll, fork for gnuplot); lib/ stays pure C99.
-CLI_CPPFLAGS := $(CPPFLAGS_LIB) -D_POSIX_C_SOURCE=200809L
+# Spelled out rather than $(LINUX_A): mk/linux.mk is included after this file, and a rule's
+# prerequisites are expanded when it is read. The rule that builds it lives there.
+CLI_LINUX_A := $(BUILD)/lib/libj288_linux.a
+# The tool is a POSIX program (signals, realpath, popen for gnuplot); lib/ stays pure C99.
+CLI_CPPFLAGS := $(CPPFLAGS_LIB) -Iport/linux -D_XOPEN_SOURCE=700
 
-$(OBJ)/examples/cli/%.o: examples/cli/%.c $(CLI_HDR) $(LIB_HDR)
+$(OBJ)/examples/cli/%.o: examples/cli/%.c $(CLI_HDR) $(LIB_HDR) port/linux/j288_linux.h
 	@mkdir -p $(@D)
 	$(CC) $(CLI_CPPFLAGS) $(CFLAGS_COMMON) -c $< -o $@
 
-$(BIN)/j288: $(CLI_OBJ) $(LIB_A)
+$(BIN)/j288: $(CLI_OBJ) $(CLI_LINUX_A) $(LIB_A)
 	@mkdir -p $(@D)
 	$(CC) $(CFLAGS_COMMON) $^ -o $@ $(LDFLAGS_COMMON) -lm
 

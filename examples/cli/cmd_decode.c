@@ -177,7 +177,10 @@ int cli_cmd_decode(int argc, char **argv, const cli_global_t *g)
             cli_json_end_object(&j);
             cli_json_newline(&j);
         } else {
-            cli_show_reply(stdout, &r, j288_frame_crc_field(bytes, J288_REPLY_LEN));
+            char title[64];
+            snprintf(title, sizeof title, "reply frame: 26 bytes, CRC 0x%08lx ok",
+                     (unsigned long)j288_frame_crc_field(bytes, J288_REPLY_LEN));
+            cli_show_reply(stdout, &r, title);
         }
     } else {
         j288_cmd_raw_t c;
@@ -190,7 +193,10 @@ int cli_cmd_decode(int argc, char **argv, const cli_global_t *g)
             cli_json_end_object(&j);
             cli_json_newline(&j);
         } else {
-            cli_show_cmd(stdout, &c, j288_frame_crc_field(bytes, J288_CMD_LEN));
+            char title[64];
+            snprintf(title, sizeof title, "command frame: 20 bytes, CRC 0x%08lx ok",
+                     (unsigned long)j288_frame_crc_field(bytes, J288_CMD_LEN));
+            cli_show_cmd(stdout, &c, title);
         }
     }
     return CLI_EXIT_OK;

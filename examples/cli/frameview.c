@@ -91,9 +91,9 @@ static void show_quantity_header(FILE *f)
     fprintf(f, "  %-13s %11s   %-22s %s\n", "", "raw", "rotor side", "output side");
 }
 
-void cli_show_cmd(FILE *f, const j288_cmd_raw_t *c, uint32_t crc)
+void cli_show_cmd(FILE *f, const j288_cmd_raw_t *c, const char *title)
 {
-    fprintf(f, "command frame: 20 bytes, CRC 0x%08lx ok\n", (unsigned long)crc);
+    fprintf(f, "%s\n", title);
     fprintf(f, "  %-13s %u%s\n", "id", (unsigned)c->id, c->id == J288_BROADCAST_ID ?
             " (broadcast)" : "");
     fprintf(f, "  %-13s %u (%s)\n", "mode", (unsigned)c->status, cli_mode_name(c->status));
@@ -108,10 +108,10 @@ void cli_show_cmd(FILE *f, const j288_cmd_raw_t *c, uint32_t crc)
     show_quantity(f, "kd", c->kd, j288_kd_from_raw, "N*m*s/rad");
 }
 
-void cli_show_reply(FILE *f, const j288_reply_raw_t *r, uint32_t crc)
+void cli_show_reply(FILE *f, const j288_reply_raw_t *r, const char *title)
 {
     char list[512];
-    fprintf(f, "reply frame: 26 bytes, CRC 0x%08lx ok\n", (unsigned long)crc);
+    fprintf(f, "%s\n", title);
     fprintf(f, "  %-13s %u\n", "id", (unsigned)r->id);
     fprintf(f, "  %-13s %u (%s)\n", "mode", (unsigned)r->status, cli_mode_name(r->status));
     fprintf(f, "  %-13s %u (%s)\n", "watchdog", r->watchdog_tripped ? 1u : 0u,

@@ -18,9 +18,9 @@ const char *cli_mode_name(unsigned status);
 const char *cli_fault_list(uint32_t faults, char *buf, size_t len);
 const char *cli_warning_list(unsigned warnings, char *buf, size_t len);
 
-/* Human tables. crc: the CRC field of the frame, printed in the title line. */
-void cli_show_cmd(FILE *f, const j288_cmd_raw_t *cmd, uint32_t crc);
-void cli_show_reply(FILE *f, const j288_reply_raw_t *r, uint32_t crc);
+/* Human tables under a title line (e.g. "reply frame: 26 bytes, CRC 0x... ok"). */
+void cli_show_cmd(FILE *f, const j288_cmd_raw_t *cmd, const char *title);
+void cli_show_reply(FILE *f, const j288_reply_raw_t *r, const char *title);
 
 /* JSON members for an object the caller has opened: every raw field under the keys the
  * issue fixes (frame, id, mode, watchdog, ...), plus names and SI values under "rotor" and

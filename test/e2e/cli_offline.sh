@@ -114,7 +114,7 @@ else
 fi
 
 # --- help -----------------------------------------------------------------------------------
-for c in "" encode decode; do
+for c in "" encode decode scan status hold move torque stop log plot; do
     expect_true "help_${c:-main}" bash -c "out=\$('$J288' $c --help) && grep -q 'usage: j288' <<<\"\$out\""
 done
 expect_true help_command_form bash -c "'$J288' help encode | grep -q 'usage: j288 encode'"

@@ -1,0 +1,215 @@
+/* Shared plumbing of the bus commands; see cli_bus.h. */
+#include "cli_bus.h"
+
+#include <limits.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+volatile sig_atomic_t cli_stop_signal = 0;
+
+/* A pseudo-terminal answers within microseconds; a USB adapter needs its latency timer. */
+#define PTY_MARGIN_US 3000u
+#define LOCK_ATTEMPTS 3
+
+void cli_bus_opts_init(cli_bus_opts_t *o, const cli_global_t *g)
+{
+    memset(o, 0, sizeof *o);
+    o->port = g->port;
+    o->baud = g->baud;
+    o->retries = -1;
+}
+
+int cli_bus_common_opt(cli_bus_opts_t *o, int key, const char *value)
+{
+    long long v;
+    switch (key) {
+    case CLI_OPT_PORT:
+        o->port = value;
+        return 0;
+    case CLI_OPT_BAUD:
+        if (cli_parse_int("--baud", value, 9600, 100000000, &v) != 0) {
+            return -1;
+        }
+        o->baud = (uint32_t)v;
+        return 0;
+    case CLI_OPT_MARGIN:
+        if (cli_parse_int("--margin-us", value, 1, 1000000, &v) != 0) {
+            return -1;
+        }
+        o->margin_us = (uint32_t)v;
+        return 0;
+    case CLI_OPT_ECHO:
+        o->echo = true;
+        return 0;
+    case CLI_OPT_RETRIES:
+        if (cli_parse_int("--retries", value, 0, J288_CONFIG_MAX_RETRIES, &v) != 0) {
+            return -1;
+        }
+        o->retries = (int)v;
+        return 0;
+    case CLI_OPT_JSON:
+        o->json = true;
+        return 0;
+    default:
+        return 1;
+    }
+}
+
+static void on_signal(int sig)
+{
+    if (cli_stop_signal == 0) {
+        cli_stop_signal = sig;
+    }
+}
+
+void cli_signals_install(void)
+{
+    struct sigaction sa;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = on_signal;
+    sigemptyset(&sa.sa_mask);
+    sa.sa_flags = 0; /* no SA_RESTART: a blocking call returns EINTR at once */
+    sigaction(SIGINT, &sa, NULL);
+    sigaction(SIGTERM, &sa, NULL);
+}
+
+int cli_signal_exit_code(void)
+{
+    return cli_stop_signal == SIGTERM ? CLI_EXIT_SIGTERM : CLI_EXIT_SIGINT;
+}
+
+static bool is_pseudo_terminal(const char *dev)
+{
+    char real[PATH_MAX];
+    if (realpath(dev, real) == NULL) {
+        return false;
+    }
+    return strncmp(real, "/dev/pts/", 9) == 0;
+}
+
+int cli_bus_open(cli_bus_t *b, const cli_bus_opts_t *o, int default_retries)
+{
+    j288_linux_options_t lo;
+    j288_bus_config_t cfg;
+    const char *dev = o->port;
+    int rc;
+
+    memset(b, 0, sizeof *b);
+    if (dev == NULL || dev[0] == '\0') {
+        dev = getenv("J288_PORT");
+    }
+    if (dev == NULL || dev[0] == '\0') {
+        cli_error("no device: give --port DEV (or set J288_PORT)");
+        return CLI_EXIT_USAGE;
+    }
+    b->dev = dev;
+    memset(&lo, 0, sizeof lo);
+    lo.echo = o->echo;
+    lo.margin_us = o->margin_us != 0u ? o->margin_us
+                                      : (is_pseudo_terminal(dev) ? PTY_MARGIN_US : 0u);
+    rc = j288_linux_open(&b->lp, dev, o->baud, &lo);
+    if (rc != J288_OK) {
+        cli_error("%s", j288_linux_error(&b->lp));
+        return CLI_EXIT_FAIL;
+    }
+    if (getenv("J288_VERBOSE") != NULL && j288_linux_notices(&b->lp)[0] != '\0') {
+        fprintf(stderr, "%s", j288_linux_notices(&b->lp));
+    }
+    j288_linux_bus_config(&b->lp, &cfg);
+    cfg.retries = (uint8_t)(o->retries >= 0 ? o->retries : default_retries);
+    rc = j288_linux_bus_init(&b->lp, &b->bus, &cfg);
+    if (rc != J288_OK) {
+        cli_error("%s: cannot start the bus: %s", dev, j288_strerror(rc));
+        j288_linux_close(&b->lp);
+        return CLI_EXIT_FAIL;
+    }
+    j288_linux_set_stop_flag(&b->lp, &cli_stop_signal);
+    b->open = true;
+    return CLI_EXIT_OK;
+}
+
+void cli_bus_close(cli_bus_t *b)
+{
+    if (b->open) {
+        j288_linux_close(&b->lp);
+        b->open = false;
+    }
+}
+
+int cli_bus_transfer(cli_bus_t *b, const j288_cmd_raw_t *cmd, j288_txn_t *txn)
+{
+    /* Marked before sending: even unconfirmed, the servo may have obeyed, so it is owed a
+     * lock. */
+    if (cmd->status != J288_MODE_LOCK && cmd->id <= J288_MAX_ID) {
+        b->driven = (uint16_t)(b->driven | (1u << cmd->id));
+    }
+    return j288_bus_transfer_blocking(&b->bus, cmd, txn);
+}
+
+void cli_lock_cmd(uint8_t id, j288_cmd_raw_t *cmd)
+{
+    memset(cmd, 0, sizeof *cmd);
+    cmd->id = id;
+    cmd->status = J288_MODE_LOCK;
+    cmd->watchdog = false;
+}
+
+int cli_bus_lock_driven(cli_bus_t *b)
+{
+    int silent = 0;
+    uint8_t id;
+    j288_cmd_raw_t cmd;
+    j288_txn_t txn;
+
+    if (!b->open || j288_linux_offline(&b->lp)) {
+        return b->driven != 0u ? 1 : 0;
+    }
+    for (id = 0; id <= J288_MAX_ID; id++) {
+        int attempt, rc = J288_ERR_TIMEOUT;
+        if ((b->driven & (1u << id)) == 0u) {
+            continue;
+        }
+        cli_lock_cmd(id, &cmd);
+        for (attempt = 0; attempt < LOCK_ATTEMPTS && rc != J288_OK; attempt++) {
+            rc = j288_bus_transfer_blocking(&b->bus, &cmd, &txn);
+            if (rc == J288_ERR_OFFLINE) {
+                return 1;
+            }
+        }
+        if (rc == J288_OK) {
+            b->driven = (uint16_t)(b->driven & ~(1u << id));
+        } else {
+            silent++;
+        }
+    }
+    if (silent > 0) {
+        /* Someone did not confirm: tell every servo at once (no reply to a broadcast). */
+        cli_lock_cmd(J288_BROADCAST_ID, &cmd);
+        (void)j288_bus_transfer_blocking(&b->bus, &cmd, &txn);
+    }
+    return silent;
+}
+
+void cli_report_txn_failure(cli_bus_t *b, uint8_t id, int rc)
+{
+    if (rc == J288_ERR_OFFLINE || j288_linux_offline(&b->lp)) {
+        cli_error("%s", j288_linux_error(&b->lp));
+    } else if (rc == J288_ERR_TIMEOUT) {
+        cli_error("no reply from servo %u on %s (check id, power, wiring and --baud)",
+                  (unsigned)id, b->dev);
+    } else if (rc == J288_ERR_PORT) {
+        cli_error("%s: %s", b->dev, j288_linux_error(&b->lp)[0] != '\0'
+                                        ? j288_linux_error(&b->lp)
+                                        : j288_strerror(rc));
+    } else {
+        cli_error("servo %u on %s: %s", (unsigned)id, b->dev, j288_strerror(rc));
+    }
+}
+
+int cli_bus_sleep_until(cli_bus_t *b, uint32_t until_us)
+{
+    int rc = j288_linux_run(&b->lp, NULL, until_us, 0u);
+    return rc == J288_ERR_TIMEOUT ? J288_OK : rc;
+}

@@ -1,0 +1,698 @@
+/* The one-shot and drive bus commands: scan, status, stop, hold, move, torque. */
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "cli_bus.h"
+#include "frameview.h"
+#include "json.h"
+
+#define FAILS_BEFORE_GIVING_UP 25 /* consecutive failed refreshes of a driven servo */
+
+/* Default gains, output side: stiff enough to follow a slow trajectory, well inside the
+ * wire range (kp 0..2128 N*m/rad, kd 0..21.28 N*m*s/rad on the output side). */
+#define DEFAULT_KP_OUTPUT 20.0
+#define DEFAULT_KD_OUTPUT 0.5
+#define DEFAULT_RATE_HZ 200.0
+#define DEFAULT_MOVE_SPEED_OUTPUT 1.0 /* rad/s */
+
+/* Parse loop shared by every bus command: common options are handled here, the command's
+ * own keys are passed to fn. Returns -1 (exit code in *exit_code) to stop, 0 when done. */
+typedef int (*own_opt_fn)(void *ctx, int key, const char *value);
+
+static int parse_bus_args(int argc, char **argv, const cli_opt_t *opts, const char *help,
+                          cli_bus_opts_t *o, own_opt_fn fn, void *ctx, int *exit_code)
+{
+    cli_args_t a;
+    const char *v;
+    int key, rc;
+    cli_args_init(&a, argc, argv);
+    while ((key = cli_args_next(&a, opts, &v)) != CLI_ARG_END) {
+        if (key == CLI_ARG_HELP) {
+            fputs(help, stdout);
+            *exit_code = CLI_EXIT_OK;
+            return -1;
+        }
+        if (key == CLI_ARG_ERROR) {
+            *exit_code = CLI_EXIT_USAGE;
+            return -1;
+        }
+        rc = key == CLI_ARG_POSITIONAL ? 1 : cli_bus_common_opt(o, key, v);
+        if (rc == 1) {
+            rc = fn != NULL ? fn(ctx, key, v) : 1;
+            if (rc == 1) {
+                cli_error("unexpected argument '%s' (try --help)", v != NULL ? v : "");
+                rc = -1;
+            }
+        }
+        if (rc != 0) {
+            *exit_code = CLI_EXIT_USAGE;
+            return -1;
+        }
+    }
+    return 0;
+}
+
+/* ---- scan ----------------------------------------------------------------------------------- */
+
+static const char scan_help[] =
+    "usage: j288 [--port DEV] scan [--json]\n"
+    "\n"
+    "Address every id 0-14 once and list the servos that answer: mode, temperatures,\n"
+    "voltage and faults. The protocol has no read-only query, so each id receives a lock\n"
+    "command (watchdog bit 0): a servo that was moving stops.\n"
+    "--json prints one array of objects with the keys of `j288 decode --json` (id, mode,\n"
+    "case_temp_c, voltage_v, faults, ...) plus latency_us.\n"
+    "Exit status: 0 at least one servo answered; 1 silent bus or device error.\n"
+    "\n" CLI_BUS_COMMON_HELP;
+
+int cli_cmd_scan(int argc, char **argv, const cli_global_t *g)
+{
+    static const cli_opt_t opts[] = {CLI_BUS_COMMON_OPTS, {NULL, false, 0}};
+    cli_bus_opts_t o;
+    cli_bus_t b;
+    j288_txn_t txn[J288_MAX_ID + 1u];
+    int result[J288_MAX_ID + 1u];
+    j288_cmd_raw_t cmd;
+    unsigned found = 0;
+    int ec;
+    uint8_t id;
+
+    cli_bus_opts_init(&o, g);
+    if (parse_bus_args(argc, argv, opts, scan_help, &o, NULL, NULL, &ec) != 0) {
+        return ec;
+    }
+    cli_signals_install();
+    if ((ec = cli_bus_open(&b, &o, 1)) != CLI_EXIT_OK) {
+        return ec;
+    }
+    for (id = 0; id <= J288_MAX_ID; id++) {
+        cli_lock_cmd(id, &cmd);
+        result[id] = cli_bus_transfer(&b, &cmd, &txn[id]);
+        if (result[id] == J288_ERR_OFFLINE) {
+            cli_report_txn_failure(&b, id, result[id]);
+            cli_bus_close(&b);
+            return CLI_EXIT_FAIL;
+        }
+        if (result[id] == J288_OK) {
+            found++;
+        }
+        if (cli_stop_signal != 0) {
+            cli_bus_close(&b);
+            return cli_signal_exit_code();
+        }
+    }
+    if (found == 0u) {
+        cli_error("no servo answered on %s (ids 0-14 tried): check power, wiring and --baud",
+                  b.dev);
+        cli_bus_close(&b);
+        return CLI_EXIT_FAIL;
+    }
+    if (o.json) {
+        cli_json_t j;
+        cli_json_init(&j, stdout);
+        cli_json_begin_array(&j, NULL);
+        for (id = 0; id <= J288_MAX_ID; id++) {
+            if (result[id] == J288_OK) {
+                cli_json_begin_object(&j, NULL);
+                cli_json_reply_members(&j, &txn[id].reply);
+                cli_json_uint(&j, "latency_us", txn[id].latency_us);
+                cli_json_end_object(&j);
+            }
+        }
+        cli_json_end_array(&j);
+        cli_json_newline(&j);
+    } else {
+        char list[512];
+        printf("%-3s %-5s %9s %9s %8s  %s\n", "id", "mode", "case", "winding", "voltage",
+               "faults");
+        for (id = 0; id <= J288_MAX_ID; id++) {
+            const j288_reply_raw_t *r = &txn[id].reply;
+            if (result[id] != J288_OK) {
+                continue;
+            }
+            printf("%-3u %-5s %7d C %7u C %6.1f V  %s%s\n", (unsigned)id,
+                   cli_mode_name(r->status), (int)r->case_temp_c, (unsigned)r->winding_temp_c,
+                   (double)r->voltage_raw * J288_SCALE_VOLTAGE,
+                   cli_fault_list(r->faults, list, sizeof list),
+                   r->watchdog_tripped ? " (watchdog had tripped)" : "");
+        }
+        printf("%u servo%s answered on %s\n", found, found == 1u ? "" : "s", b.dev);
+    }
+    for (id = 0; id <= J288_MAX_ID; id++) {
+        if (result[id] != J288_OK && result[id] != J288_ERR_TIMEOUT) {
+            fprintf(stderr, "note: id %u: %s (a servo may be there; the line is noisy)\n",
+                    (unsigned)id, j288_strerror(result[id]));
+        }
+    }
+    cli_bus_close(&b);
+    return CLI_EXIT_OK;
+}
+
+/* ---- status --------------------------------------------------------------------------------- */
+
+static const char status_help[] =
+    "usage: j288 [--port DEV] status --id N [--json]\n"
+    "\n"
+    "Read one servo's reply and decode it as `j288 decode` does (same JSON keys). The\n"
+    "protocol has no read-only query: the servo receives a lock command (watchdog bit 0).\n"
+    "Exit status: 0 the servo answered; 1 no reply or device error.\n"
+    "\n" CLI_BUS_COMMON_HELP;
+
+enum { OPT_ID = 0, OPT_KP, OPT_KD, OPT_POS, OPT_SPEED, OPT_TAU, OPT_SIDE, OPT_RATE,
+       OPT_DURATION, OPT_WATCHDOG, OPT_KEEP };
+
+typedef struct {
+    long long id;
+} id_ctx_t;
+
+static int parse_id_opt(void *ctx, int key, const char *v)
+{
+    id_ctx_t *c = ctx;
+    if (key == OPT_ID) {
+        return cli_parse_int("--id", v, 0, J288_MAX_ID, &c->id);
+    }
+    return 1;
+}
+
+int cli_cmd_status(int argc, char **argv, const cli_global_t *g)
+{
+    static const cli_opt_t opts[] = {{"--id", true, OPT_ID}, CLI_BUS_COMMON_OPTS,
+                                     {NULL, false, 0}};
+    cli_bus_opts_t o;
+    cli_bus_t b;
+    id_ctx_t c = {-1};
+    j288_cmd_raw_t cmd;
+    j288_txn_t txn;
+    int ec, rc;
+
+    cli_bus_opts_init(&o, g);
+    if (parse_bus_args(argc, argv, opts, status_help, &o, parse_id_opt, &c, &ec) != 0) {
+        return ec;
+    }
+    if (c.id < 0) {
+        cli_error("--id is required (0-14)");
+        return CLI_EXIT_USAGE;
+    }
+    cli_signals_install();
+    if ((ec = cli_bus_open(&b, &o, 2)) != CLI_EXIT_OK) {
+        return ec;
+    }
+    cli_lock_cmd((uint8_t)c.id, &cmd);
+    rc = cli_bus_transfer(&b, &cmd, &txn);
+    if (rc != J288_OK) {
+        cli_report_txn_failure(&b, (uint8_t)c.id, rc);
+        cli_bus_close(&b);
+        return CLI_EXIT_FAIL;
+    }
+    if (o.json) {
+        cli_json_t j;
+        cli_json_init(&j, stdout);
+        cli_json_begin_object(&j, NULL);
+        cli_json_reply_members(&j, &txn.reply);
+        cli_json_uint(&j, "latency_us", txn.latency_us);
+        cli_json_end_object(&j);
+        cli_json_newline(&j);
+    } else {
+        char title[160];
+        snprintf(title, sizeof title, "servo %u on %s: reply after %lu us", (unsigned)c.id,
+                 b.dev, (unsigned long)txn.latency_us);
+        cli_show_reply(stdout, &txn.reply, title);
+    }
+    cli_bus_close(&b);
+    return CLI_EXIT_OK;
+}
+
+/* ---- stop ----------------------------------------------------------------------------------- */
+
+static const char stop_help[] =
+    "usage: j288 [--port DEV] stop [--id N]\n"
+    "\n"
+    "Lock (no torque) servo N, confirmed by its reply; without --id, broadcast lock to every\n"
+    "servo on the bus (id 15: nobody replies). The lock goes out with the watchdog bit 0.\n"
+    "Exit status: 0 sent (and confirmed with --id); 1 no reply or device error.\n"
+    "\n" CLI_BUS_COMMON_HELP;
+
+int cli_cmd_stop(int argc, char **argv, const cli_global_t *g)
+{
+    static const cli_opt_t opts[] = {{"--id", true, OPT_ID}, CLI_BUS_COMMON_OPTS,
+                                     {NULL, false, 0}};
+    cli_bus_opts_t o;
+    cli_bus_t b;
+    id_ctx_t c = {-1};
+    j288_cmd_raw_t cmd;
+    j288_txn_t txn;
+    int ec, rc;
+
+    cli_bus_opts_init(&o, g);
+    if (parse_bus_args(argc, argv, opts, stop_help, &o, parse_id_opt, &c, &ec) != 0) {
+        return ec;
+    }
+    if ((ec = cli_bus_open(&b, &o, 2)) != CLI_EXIT_OK) {
+        return ec;
+    }
+    cli_lock_cmd(c.id < 0 ? (uint8_t)J288_BROADCAST_ID : (uint8_t)c.id, &cmd);
+    rc = cli_bus_transfer(&b, &cmd, &txn);
+    if (rc != J288_OK) {
+        cli_report_txn_failure(&b, cmd.id, rc);
+        cli_bus_close(&b);
+        return CLI_EXIT_FAIL;
+    }
+    if (o.json) {
+        printf("{\"stopped\": %s, \"confirmed\": %s}\n", c.id < 0 ? "\"all\"" : "\"one\"",
+               c.id < 0 ? "false" : "true");
+    } else if (c.id < 0) {
+        printf("lock broadcast to every servo on %s\n", b.dev);
+    } else {
+        printf("servo %u locked (mode %s)\n", (unsigned)c.id, cli_mode_name(txn.reply.status));
+    }
+    cli_bus_close(&b);
+    return CLI_EXIT_OK;
+}
+
+/* ---- hold, move, torque: a refresh loop -------------------------------------------------------- */
+
+typedef enum { DRIVE_HOLD, DRIVE_MOVE, DRIVE_TORQUE } drive_kind_t;
+
+typedef struct {
+    drive_kind_t kind;
+    long long id;
+    int side; /* 0 rotor, 1 output */
+    bool have_kp, have_kd, have_pos, have_speed, have_tau;
+    double kp, kd, pos, speed, tau;
+    double rate_hz;
+    double duration_s; /* < 0: until a signal */
+    bool watchdog;
+    bool keep;
+} drive_args_t;
+
+static int parse_drive_opt(void *ctx, int key, const char *v)
+{
+    static const char *const sides[] = {"rotor", "output", NULL};
+    static const char *const onoff[] = {"off", "on", NULL};
+    drive_args_t *d = ctx;
+    int choice;
+    switch (key) {
+    case OPT_ID:
+        return cli_parse_int("--id", v, 0, J288_MAX_ID, &d->id);
+    case OPT_KP:
+        d->have_kp = true;
+        return cli_parse_real("--kp", v, &d->kp);
+    case OPT_KD:
+        d->have_kd = true;
+        return cli_parse_real("--kd", v, &d->kd);
+    case OPT_POS:
+        d->have_pos = true;
+        return cli_parse_real("--pos", v, &d->pos);
+    case OPT_SPEED:
+        d->have_speed = true;
+        return cli_parse_real("--speed", v, &d->speed);
+    case OPT_TAU:
+        d->have_tau = true;
+        return cli_parse_real("--tau", v, &d->tau);
+    case OPT_SIDE:
+        return cli_parse_choice("--side", v, sides, &d->side);
+    case OPT_RATE:
+        if (cli_parse_real("--rate", v, &d->rate_hz) != 0) {
+            return -1;
+        }
+        if (d->rate_hz < 1.0 || d->rate_hz > 5000.0) {
+            cli_error("--rate: %s is out of range 1..5000 Hz", v);
+            return -1;
+        }
+        return 0;
+    case OPT_DURATION:
+        if (cli_parse_real("--duration", v, &d->duration_s) != 0) {
+            return -1;
+        }
+        if (d->duration_s < 0.0 || d->duration_s > 86400.0) {
+            cli_error("--duration: %s is out of range 0..86400 s", v);
+            return -1;
+        }
+        return 0;
+    case OPT_WATCHDOG:
+        if (cli_parse_choice("--watchdog", v, onoff, &choice) != 0) {
+            return -1;
+        }
+        d->watchdog = choice == 1;
+        return 0;
+    case OPT_KEEP:
+        d->keep = true;
+        return 0;
+    default:
+        return 1;
+    }
+}
+
+/* Gains and fields, validated and converted once. */
+typedef struct {
+    j288_cmd_raw_t base; /* id, FOC, watchdog, gains, tau */
+    int32_t start_pos;   /* rotor raw, from the first reply */
+    int32_t target_pos;  /* rotor raw */
+    double ramp_lsb_per_s; /* move: setpoint speed in position LSB per second */
+    int16_t ramp_speed_raw;
+    double ramp_time_s;
+} drive_plan_t;
+
+static j288_side_t side_of(const drive_args_t *d)
+{
+    return d->side == 0 ? J288_SIDE_ROTOR : J288_SIDE_OUTPUT;
+}
+
+static int si_error(const char *opt, double v, int rc)
+{
+    if (rc == J288_ERR_NEG_GAIN) {
+        cli_error("%s: %g is negative; gains must be >= 0", opt, v);
+    } else {
+        cli_error("%s: %g is out of range for the wire (%s)", opt, v, j288_strerror(rc));
+    }
+    return -1;
+}
+
+/* Everything that can be checked before touching the bus. */
+static int plan_fields(const drive_args_t *d, drive_plan_t *p)
+{
+    j288_side_t side = side_of(d);
+    int rc;
+    memset(p, 0, sizeof *p);
+    p->base.id = (uint8_t)d->id;
+    p->base.status = J288_MODE_FOC;
+    p->base.watchdog = d->watchdog;
+    if (d->kind != DRIVE_TORQUE) {
+        double kp = d->have_kp ? d->kp : DEFAULT_KP_OUTPUT;
+        double kd = d->have_kd ? d->kd : DEFAULT_KD_OUTPUT;
+        j288_side_t gain_side = d->have_kp ? side : J288_SIDE_OUTPUT;
+        rc = j288_kp_to_raw((j288_real_t)kp, gain_side, &p->base.kp);
+        if (rc != J288_OK) {
+            return si_error("--kp", kp, rc);
+        }
+        gain_side = d->have_kd ? side : J288_SIDE_OUTPUT;
+        rc = j288_kd_to_raw((j288_real_t)kd, gain_side, &p->base.kd);
+        if (rc != J288_OK) {
+            return si_error("--kd", kd, rc);
+        }
+    }
+    if (d->kind == DRIVE_TORQUE) {
+        rc = j288_torque_to_raw((j288_real_t)d->tau, side, &p->base.tau);
+        if (rc != J288_OK) {
+            return si_error("--tau", d->tau, rc);
+        }
+    }
+    if (d->kind == DRIVE_MOVE) {
+        double v = d->have_speed ? fabs(d->speed)
+                                 : (side == J288_SIDE_OUTPUT ? DEFAULT_MOVE_SPEED_OUTPUT
+                                                            : DEFAULT_MOVE_SPEED_OUTPUT *
+                                                                  J288_GEAR_RATIO);
+        rc = j288_pos_to_raw((j288_real_t)d->pos, side, &p->target_pos);
+        if (rc != J288_OK) {
+            return si_error("--pos", d->pos, rc);
+        }
+        if (v <= 0.0) {
+            cli_error("--speed: must be above 0");
+            return -1;
+        }
+        rc = j288_speed_to_raw((j288_real_t)v, side, &p->ramp_speed_raw);
+        if (rc != J288_OK) {
+            return si_error("--speed", v, rc);
+        }
+        p->ramp_lsb_per_s = v * J288_SCALE_POS * (side == J288_SIDE_OUTPUT ? J288_GEAR_RATIO : 1.0);
+    }
+    return 0;
+}
+
+/* The command at time t since the start. */
+static void drive_setpoint(const drive_args_t *d, const drive_plan_t *p, double t,
+                           j288_cmd_raw_t *cmd)
+{
+    *cmd = p->base;
+    if (d->kind == DRIVE_HOLD) {
+        cmd->pos = p->start_pos;
+    } else if (d->kind == DRIVE_MOVE) {
+        double dist = (double)p->target_pos - (double)p->start_pos;
+        double travelled = p->ramp_lsb_per_s * t;
+        if (travelled >= fabs(dist)) {
+            cmd->pos = p->target_pos;
+            cmd->speed = 0;
+        } else {
+            double sp = (double)p->start_pos + (dist < 0.0 ? -travelled : travelled);
+            cmd->pos = (int32_t)lround(sp);
+            cmd->speed = (int16_t)(dist < 0.0 ? -p->ramp_speed_raw : p->ramp_speed_raw);
+        }
+    }
+}
+
+typedef struct {
+    uint32_t sent, ok, failed, overruns;
+    j288_reply_raw_t last;
+    bool have_last;
+    j288_cmd_raw_t last_cmd;
+} drive_result_t;
+
+static void drive_report(const drive_args_t *d, const drive_result_t *r, cli_bus_t *b,
+                         const char *how, bool json)
+{
+    j288_side_t side = side_of(d);
+    const char *unit_side = side == J288_SIDE_ROTOR ? "rotor" : "output";
+    if (json) {
+        cli_json_t j;
+        cli_json_init(&j, stdout);
+        cli_json_begin_object(&j, NULL);
+        cli_json_str(&j, "ended", how);
+        cli_json_int(&j, "id", d->id);
+        cli_json_uint(&j, "commands", r->sent);
+        cli_json_uint(&j, "replies", r->ok);
+        cli_json_uint(&j, "failures", r->failed);
+        cli_json_uint(&j, "overruns", r->overruns);
+        cli_json_bool(&j, "locked", !d->keep || cli_stop_signal != 0);
+        cli_json_str(&j, "side", unit_side);
+        cli_json_real(&j, "target_pos", (double)j288_pos_from_raw(r->last_cmd.pos, side));
+        if (r->have_last) {
+            cli_json_begin_object(&j, "last_reply");
+            cli_json_reply_members(&j, &r->last);
+            cli_json_end_object(&j);
+        }
+        cli_json_end_object(&j);
+        cli_json_newline(&j);
+        (void)b;
+        return;
+    }
+    if (r->have_last) {
+        char list[512];
+        printf("servo %lld: pos %.5g rad, speed %.5g rad/s, torque %.5g N*m (%s side); "
+               "target %.5g rad; faults %s\n",
+               d->id, (double)j288_pos_from_raw(r->last.pos, side),
+               (double)j288_speed_from_raw(r->last.speed, side),
+               (double)j288_torque_from_raw(r->last.torque, side), unit_side,
+               (double)j288_pos_from_raw(r->last_cmd.pos, side),
+               cli_fault_list(r->last.faults, list, sizeof list));
+    }
+    printf("%s: %lu commands, %lu replies, %lu failed, %lu late cycles; %s\n", how,
+           (unsigned long)r->sent, (unsigned long)r->ok, (unsigned long)r->failed,
+           (unsigned long)r->overruns,
+           (d->keep && cli_stop_signal == 0) ? "last command left in force (--keep)"
+                                             : "servo locked");
+}
+
+static int run_drive(drive_args_t *d, const cli_bus_opts_t *o)
+{
+    cli_bus_t b;
+    drive_plan_t plan;
+    drive_result_t res;
+    j288_cmd_raw_t cmd;
+    j288_txn_t txn;
+    uint32_t t0, next, period_us;
+    int ec, rc, fails = 0;
+    const char *how = "done";
+
+    if (d->id < 0) {
+        cli_error("--id is required (0-14)");
+        return CLI_EXIT_USAGE;
+    }
+    if (d->kind == DRIVE_MOVE && !d->have_pos) {
+        cli_error("--pos is required");
+        return CLI_EXIT_USAGE;
+    }
+    if (d->kind == DRIVE_TORQUE && !d->have_tau) {
+        cli_error("--tau is required");
+        return CLI_EXIT_USAGE;
+    }
+    if (plan_fields(d, &plan) != 0) {
+        return CLI_EXIT_USAGE;
+    }
+    cli_signals_install();
+    if ((ec = cli_bus_open(&b, o, 1)) != CLI_EXIT_OK) {
+        return ec;
+    }
+    memset(&res, 0, sizeof res);
+    /* Where is it now? (A lock: the protocol has no read-only query.) */
+    cli_lock_cmd((uint8_t)d->id, &cmd);
+    rc = cli_bus_transfer(&b, &cmd, &txn);
+    if (rc != J288_OK) {
+        cli_report_txn_failure(&b, (uint8_t)d->id, rc);
+        cli_bus_close(&b);
+        return CLI_EXIT_FAIL;
+    }
+    plan.start_pos = txn.reply.pos;
+    res.last = txn.reply;
+    res.have_last = true;
+
+    period_us = (uint32_t)lround(1e6 / d->rate_hz);
+    t0 = j288_linux_now_us();
+    next = t0;
+    ec = CLI_EXIT_OK;
+    for (;;) {
+        uint32_t now = j288_linux_now_us();
+        double t = (double)(uint32_t)(now - t0) / 1e6;
+        if (cli_stop_signal != 0) {
+            how = "stopped by signal";
+            break;
+        }
+        if (d->duration_s >= 0.0 && t >= d->duration_s) {
+            break;
+        }
+        drive_setpoint(d, &plan, t, &cmd);
+        res.last_cmd = cmd;
+        res.sent++;
+        rc = cli_bus_transfer(&b, &cmd, &txn);
+        if (rc == J288_OK) {
+            res.ok++;
+            res.last = txn.reply;
+            fails = 0;
+        } else if (rc == J288_ERR_OFFLINE) {
+            cli_report_txn_failure(&b, (uint8_t)d->id, rc);
+            ec = CLI_EXIT_FAIL;
+            how = NULL;
+            break;
+        } else {
+            res.failed++;
+            if (++fails >= FAILS_BEFORE_GIVING_UP) {
+                (void)cli_bus_lock_driven(&b);
+                cli_error("servo %lld stopped answering (%d commands in a row failed, last: "
+                          "%s); lock sent",
+                          d->id, fails, j288_strerror(rc));
+                cli_bus_close(&b);
+                return CLI_EXIT_FAIL;
+            }
+        }
+        next += period_us;
+        now = j288_linux_now_us();
+        if ((int32_t)(next - now) < 0) {
+            res.overruns++;
+            next = now; /* never burst to catch up */
+        }
+        rc = cli_bus_sleep_until(&b, next);
+        if (rc == J288_ERR_OFFLINE) {
+            cli_report_txn_failure(&b, (uint8_t)d->id, rc);
+            ec = CLI_EXIT_FAIL;
+            how = NULL;
+            break;
+        }
+    }
+    if (how == NULL) { /* device gone: nothing can be sent any more */
+        cli_bus_close(&b);
+        return ec;
+    }
+    if (cli_stop_signal != 0 || !d->keep) {
+        if (cli_bus_lock_driven(&b) != 0) {
+            cli_error("servo %lld did not confirm the lock (a broadcast lock was sent)", d->id);
+            cli_bus_close(&b);
+            return cli_stop_signal != 0 ? cli_signal_exit_code() : CLI_EXIT_FAIL;
+        }
+    }
+    drive_report(d, &res, &b, how, o->json);
+    cli_bus_close(&b);
+    return cli_stop_signal != 0 ? cli_signal_exit_code() : CLI_EXIT_OK;
+}
+
+#define DRIVE_COMMON_HELP                                                                      \
+    "  --rate HZ        command refresh rate, default 200\n"                                   \
+    "  --duration S     stop after S seconds; default: run until Ctrl-C or SIGTERM\n"         \
+    "  --watchdog W     on (default): the servo locks itself if commands stop for 1 s\n"      \
+    "  --keep           at the end of --duration leave the last command in force instead\n"  \
+    "                   of locking (with the watchdog on the servo locks itself 1 s later)\n" \
+    "  --side S         SI values on the output side (default) or the rotor side\n"         \
+    "Ctrl-C or SIGTERM: the servo is sent lock before exiting (exit 130 / 143).\n"            \
+    "Exit status: 0 done; 1 no reply, servo stopped answering or device error; 2 bad\n"      \
+    "arguments.\n"
+
+#define DRIVE_OPTS                                                                             \
+    {"--id", true, OPT_ID}, {"--side", true, OPT_SIDE}, {"--rate", true, OPT_RATE},          \
+        {"--duration", true, OPT_DURATION}, {"--watchdog", true, OPT_WATCHDOG},              \
+        {"--keep", false, OPT_KEEP}, CLI_BUS_COMMON_OPTS
+
+static void drive_args_init(drive_args_t *d, drive_kind_t kind)
+{
+    memset(d, 0, sizeof *d);
+    d->kind = kind;
+    d->id = -1;
+    d->side = 1;
+    d->rate_hz = DEFAULT_RATE_HZ;
+    d->duration_s = -1.0;
+    d->watchdog = true;
+}
+
+static const char hold_help[] =
+    "usage: j288 [--port DEV] hold --id N [--kp NM_RAD] [--kd NMS_RAD] [options]\n"
+    "\n"
+    "Hold servo N at the position it is at now (FOC, stiffness kp, damping kd), refreshing\n"
+    "the command at --rate. Default gains on the output side: kp 20 N*m/rad, kd 0.5\n"
+    "N*m*s/rad.\n" DRIVE_COMMON_HELP "\n" CLI_BUS_COMMON_HELP;
+
+int cli_cmd_hold(int argc, char **argv, const cli_global_t *g)
+{
+    static const cli_opt_t opts[] = {{"--kp", true, OPT_KP}, {"--kd", true, OPT_KD},
+                                     DRIVE_OPTS, {NULL, false, 0}};
+    drive_args_t d;
+    cli_bus_opts_t o;
+    int ec;
+    drive_args_init(&d, DRIVE_HOLD);
+    cli_bus_opts_init(&o, g);
+    if (parse_bus_args(argc, argv, opts, hold_help, &o, parse_drive_opt, &d, &ec) != 0) {
+        return ec;
+    }
+    return run_drive(&d, &o);
+}
+
+static const char move_help[] =
+    "usage: j288 [--port DEV] move --id N --pos RAD [--speed RAD_S] [--kp NM_RAD]\n"
+    "                 [--kd NMS_RAD] [--side output|rotor] [options]\n"
+    "\n"
+    "Move servo N from where it is to --pos along a ramp at --speed (default 1 rad/s on the\n"
+    "output side), then hold there. Default gains on the output side: kp 20 N*m/rad, kd 0.5\n"
+    "N*m*s/rad.\n" DRIVE_COMMON_HELP "\n" CLI_BUS_COMMON_HELP;
+
+int cli_cmd_move(int argc, char **argv, const cli_global_t *g)
+{
+    static const cli_opt_t opts[] = {{"--pos", true, OPT_POS}, {"--speed", true, OPT_SPEED},
+                                     {"--kp", true, OPT_KP},   {"--kd", true, OPT_KD},
+                                     DRIVE_OPTS,               {NULL, false, 0}};
+    drive_args_t d;
+    cli_bus_opts_t o;
+    int ec;
+    drive_args_init(&d, DRIVE_MOVE);
+    cli_bus_opts_init(&o, g);
+    if (parse_bus_args(argc, argv, opts, move_help, &o, parse_drive_opt, &d, &ec) != 0) {
+        return ec;
+    }
+    return run_drive(&d, &o);
+}
+
+static const char torque_help[] =
+    "usage: j288 [--port DEV] torque --id N --tau NM [--side output|rotor] [options]\n"
+    "\n"
+    "Apply a constant feed-forward torque (FOC, kp = kd = 0) to servo N.\n" DRIVE_COMMON_HELP
+    "\n" CLI_BUS_COMMON_HELP;
+
+int cli_cmd_torque(int argc, char **argv, const cli_global_t *g)
+{
+    static const cli_opt_t opts[] = {{"--tau", true, OPT_TAU}, DRIVE_OPTS, {NULL, false, 0}};
+    drive_args_t d;
+    cli_bus_opts_t o;
+    int ec;
+    drive_args_init(&d, DRIVE_TORQUE);
+    cli_bus_opts_init(&o, g);
+    if (parse_bus_args(argc, argv, opts, torque_help, &o, parse_drive_opt, &d, &ec) != 0) {
+        return ec;
+    }
+    return run_drive(&d, &o);
+}
