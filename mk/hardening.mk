@@ -113,8 +113,25 @@ test-valgrind: $(HOST_TESTS) $(TEST_DEPS)
 lint:
 	BUILD=$(BUILD) bash scripts/lint.sh
 
+# The host archive, and lib/ built for Cortex-M0 (soft float: libgcc helpers only) when
+# arm-none-eabi-gcc is there.
+HARD_ARM_CC ?= arm-none-eabi-gcc
+HARD_ARM_FLAGS := -mcpu=cortex-m0 -mthumb -Os -ffunction-sections -fdata-sections
+HARD_ARM_A := $(BUILD)/hard-arm/libj288.a
+
+$(BUILD)/hard-arm/%.o: lib/src/%.c $(LIB_HDR)
+	@mkdir -p $(@D)
+	$(HARD_ARM_CC) $(HARD_ARM_FLAGS) $(CPPFLAGS_LIB) $(CSTD) $(WARN) -c $< -o $@
+
+$(HARD_ARM_A): $(LIB_SRC:lib/src/%.c=$(BUILD)/hard-arm/%.o)
+	rm -f $@
+	arm-none-eabi-ar rcs $@ $^
+
 check-symbols: $(LIB_A)
 	bash scripts/check-symbols.sh $(LIB_A)
+	@$(call HARD_REQUIRE,$(HARD_ARM_CC),gcc-arm-none-eabi libnewlib-arm-none-eabi); \
+	 $(MAKE) --no-print-directory $(HARD_ARM_A) && \
+	 bash scripts/check-symbols.sh $(HARD_ARM_A) arm-none-eabi-nm
 
 # ---------------------------------------------------------------------------------------------
 # Big-endian and 32-bit: the unit tests and the corpus replays, cross-built and run under

@@ -70,54 +70,57 @@ static const uint32_t crc_table256[256] = {
     0xBCB4666Du, 0xB8757BDAu, 0xB5365D03u, 0xB1F740B4u,
 };
 
-static const uint32_t crc_table16[16] = {
-    0x00000000u, 0x04C11DB7u, 0x09823B6Eu, 0x0D4326D9u,
-    0x130476DCu, 0x17C56B6Bu, 0x1A864DB2u, 0x1E475005u,
-    0x2608EDB8u, 0x22C9F00Fu, 0x2F8AD6D6u, 0x2B4BCB61u,
-    0x350C9B64u, 0x31CD86D3u, 0x3C8EA00Au, 0x384FBDBDu,
-};
-
 /* The wire's words are little-endian, and the CRC eats a word MSB first: byte 3 first. */
 uint32_t j288_crc32_update_table(uint32_t crc, const uint8_t *data, size_t nwords)
 {
+    uint32_t c = crc;
     size_t w;
     for (w = 0; w < nwords; w++) {
-        const uint8_t *p = data + 4u * w;
+        const uint8_t *p = &data[4u * w];
         unsigned k;
-        for (k = 4u; k-- > 0u;) {
-            crc = (crc << 8) ^ crc_table256[(crc >> 24) ^ p[k]];
+        for (k = 0u; k < 4u; k++) {
+            c = (c << 8) ^ crc_table256[(c >> 24) ^ p[3u - k]];
         }
     }
-    return crc;
+    return c;
 }
 
 uint32_t j288_crc32_update_nibble(uint32_t crc, const uint8_t *data, size_t nwords)
 {
+    static const uint32_t crc_table16[16] = {
+        0x00000000u, 0x04C11DB7u, 0x09823B6Eu, 0x0D4326D9u,
+        0x130476DCu, 0x17C56B6Bu, 0x1A864DB2u, 0x1E475005u,
+        0x2608EDB8u, 0x22C9F00Fu, 0x2F8AD6D6u, 0x2B4BCB61u,
+        0x350C9B64u, 0x31CD86D3u, 0x3C8EA00Au, 0x384FBDBDu,
+    };
+    uint32_t c = crc;
     size_t w;
     for (w = 0; w < nwords; w++) {
-        const uint8_t *p = data + 4u * w;
+        const uint8_t *p = &data[4u * w];
         unsigned k;
-        for (k = 4u; k-- > 0u;) {
-            crc = (crc << 4) ^ crc_table16[(crc >> 28) ^ ((uint32_t)p[k] >> 4)];
-            crc = (crc << 4) ^ crc_table16[(crc >> 28) ^ ((uint32_t)p[k] & 0x0Fu)];
+        for (k = 0u; k < 4u; k++) {
+            uint32_t b = p[3u - k];
+            c = (c << 4) ^ crc_table16[(c >> 28) ^ (b >> 4)];
+            c = (c << 4) ^ crc_table16[(c >> 28) ^ (b & 0x0Fu)];
         }
     }
-    return crc;
+    return c;
 }
 
 uint32_t j288_crc32_update_bitwise(uint32_t crc, const uint8_t *data, size_t nwords)
 {
+    uint32_t c = crc;
     size_t w;
     for (w = 0; w < nwords; w++) {
-        const uint8_t *p = data + 4u * w;
+        const uint8_t *p = &data[4u * w];
         unsigned bit;
-        crc ^= ((uint32_t)p[0]) | ((uint32_t)p[1] << 8) | ((uint32_t)p[2] << 16) |
-               ((uint32_t)p[3] << 24);
+        c ^= ((uint32_t)p[0]) | ((uint32_t)p[1] << 8) | ((uint32_t)p[2] << 16) |
+             ((uint32_t)p[3] << 24);
         for (bit = 0; bit < 32u; bit++) {
-            crc = ((crc & 0x80000000u) != 0u) ? ((crc << 1) ^ J288_CRC32_POLY) : (crc << 1);
+            c = ((c & 0x80000000u) != 0u) ? ((c << 1) ^ J288_CRC32_POLY) : (c << 1);
         }
     }
-    return crc;
+    return c;
 }
 
 #if J288_CONFIG_CRC_BACKEND == J288_CRC_BACKEND_HW

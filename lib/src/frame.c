@@ -28,7 +28,11 @@ static bool mode_timeout(uint8_t mode) { return (mode & 0x80u) != 0u; }
 /* Two's complement from the unsigned wire pattern, without implementation-defined casts. */
 static int16_t as_i16(uint16_t u)
 {
-    return (u < 0x8000u) ? (int16_t)u : (int16_t)(-(int32_t)(0x10000u - (uint32_t)u));
+    int32_t v = (int32_t)u;
+    if (v >= 0x8000) {
+        v -= 0x10000;
+    }
+    return (int16_t)v;
 }
 
 static int32_t as_i32(uint32_t u)
@@ -36,7 +40,10 @@ static int32_t as_i32(uint32_t u)
     if (u < 0x80000000u) {
         return (int32_t)u;
     }
-    return (int32_t)(-(int32_t)(0xFFFFFFFFu - u)) - 1;
+    {
+        uint32_t m = 0xFFFFFFFFu - u; /* 0 .. 0x7FFFFFFF: fits */
+        return -(int32_t)m - 1;
+    }
 }
 
 static uint16_t from_i16(int16_t v) { return (uint16_t)v; }
@@ -80,7 +87,7 @@ int j288_cmd_encode(const j288_cmd_raw_t *cmd, uint8_t out[J288_CMD_LEN], const 
     j288_put_u16le(&f[CMD_KP], from_i16(cmd->kp));
     j288_put_u16le(&f[CMD_KD], from_i16(cmd->kd));
     j288_put_u32le(&f[CMD_CRC], j288_crc32_run(crc, f, CMD_CRC_WORDS));
-    memcpy(out, f, sizeof f);
+    (void)memcpy(out, f, sizeof f);
     return J288_OK;
 }
 
@@ -154,7 +161,7 @@ int j288_reply_encode(const j288_reply_raw_t *reply, uint8_t out[J288_REPLY_LEN]
                    (uint16_t)(reply->out_pos | ((unsigned)reply->warnings << EXFLAG_SHIFT)));
     j288_put_u16le(&f[RPL_RES], reply->reserved);
     j288_put_u32le(&f[RPL_CRC], j288_crc32_run(crc, &f[RPL_CRC_FIRST], RPL_CRC_WORDS));
-    memcpy(out, f, sizeof f);
+    (void)memcpy(out, f, sizeof f);
     return J288_OK;
 }
 
@@ -199,33 +206,32 @@ int j288_reply_decode(const uint8_t in[J288_REPLY_LEN], j288_reply_raw_t *reply,
     return J288_OK;
 }
 
-static const char *const fault_names[J288_FAULT_COUNT] = {
-    "over-current",
-    "transient over-voltage",
-    "sustained over-voltage",
-    "under-voltage",
-    "chip over-temperature",
-    "MOSFET over/under-temperature",
-    "MOSFET temperature abnormal",
-    "case over/under-temperature",
-    "case temperature abnormal",
-    "winding over-temperature",
-    "rotor encoder 1 error",
-    "rotor encoder 2 error",
-    "output encoder error",
-    "stored data error",
-    "abnormal reset",
-    "waiting for unlock",
-    "driver verification error",
-    "calibration mode",
-    "communication checksum error",
-    "driver version too low",
-    "firmware model error",
-    "encoder angle abnormal",
-};
-
 const char *j288_fault_name(unsigned bit)
 {
+    static const char *const fault_names[J288_FAULT_COUNT] = {
+        "over-current",
+        "transient over-voltage",
+        "sustained over-voltage",
+        "under-voltage",
+        "chip over-temperature",
+        "MOSFET over/under-temperature",
+        "MOSFET temperature abnormal",
+        "case over/under-temperature",
+        "case temperature abnormal",
+        "winding over-temperature",
+        "rotor encoder 1 error",
+        "rotor encoder 2 error",
+        "output encoder error",
+        "stored data error",
+        "abnormal reset",
+        "waiting for unlock",
+        "driver verification error",
+        "calibration mode",
+        "communication checksum error",
+        "driver version too low",
+        "firmware model error",
+        "encoder angle abnormal",
+    };
     return (bit < J288_FAULT_COUNT) ? fault_names[bit] : "unknown fault";
 }
 

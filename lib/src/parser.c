@@ -11,7 +11,7 @@ int j288_parser_init(j288_parser_t *p, j288_parse_kind_t kind, const j288_crc_t 
     if ((kind != J288_PARSE_REPLY) && (kind != J288_PARSE_COMMAND)) {
         return J288_ERR_BAD_ARG;
     }
-    memset(p, 0, sizeof *p);
+    (void)memset(p, 0, sizeof *p);
     p->kind = kind;
     p->crc = crc;
     p->head0 = (kind == J288_PARSE_REPLY) ? J288_REPLY_HEAD0 : J288_CMD_HEAD0;
@@ -33,13 +33,13 @@ static void resync(j288_parser_t *p)
     uint8_t i;
     for (i = 1u; i < p->len; i++) {
         if ((p->buf[i] == p->head0) &&
-            ((i + 1u == p->len) || (p->buf[i + 1u] == J288_REPLY_HEAD1))) {
+            (((i + 1u) == p->len) || (p->buf[i + 1u] == J288_REPLY_HEAD1))) {
             break;
         }
     }
     p->stats.dropped_bytes += i;
     p->len = (uint8_t)(p->len - i);
-    memmove(p->buf, &p->buf[i], p->len);
+    (void)memmove(p->buf, &p->buf[i], p->len);
 }
 
 /* One byte in; true when a good frame completes. Both heads end in 0xEE. */
@@ -47,7 +47,8 @@ static bool take_byte(j288_parser_t *p, uint8_t b)
 {
     if (p->len == 0u) {
         if (b == p->head0) {
-            p->buf[p->len++] = b;
+            p->buf[0] = b;
+            p->len = 1u;
         } else {
             p->stats.garbage_bytes++;
         }
@@ -62,7 +63,8 @@ static bool take_byte(j288_parser_t *p, uint8_t b)
         }
         return false;
     }
-    p->buf[p->len++] = b;
+    p->buf[p->len] = b;
+    p->len++;
     if (p->len < p->frame_len) {
         return false;
     }

@@ -49,6 +49,8 @@ static int64_t round_half_away(j288_real_t v)
         t++;
     } else if (frac <= (j288_real_t)-0.5) {
         t--;
+    } else {
+        /* |frac| < 0.5: truncation already rounded to nearest */
     }
     return t;
 }
@@ -145,7 +147,9 @@ static int cmd_from_si(const j288_cmd_si_t *si, j288_side_t side, j288_cmd_raw_t
         return err;
     }
     for (i = 0u; i < 5u; i++) {
-        mask |= c[i] ? (1u << i) : 0u;
+        if (c[i]) {
+            mask |= (1u << i);
+        }
     }
     if (clamped != NULL) {
         *clamped = mask;
@@ -244,7 +248,8 @@ j288_real_t j288_kd_from_raw(int32_t raw, j288_side_t side) { return from_raw(ra
 
 j288_real_t j288_out_pos_to_rad(uint16_t out_pos)
 {
-    return (j288_real_t)(out_pos & (J288_OUT_POS_COUNTS - 1u)) *
+    unsigned counts = (unsigned)out_pos & (J288_OUT_POS_COUNTS - 1u);
+    return (j288_real_t)counts *
            (j288_real_t)(2.0 * J288_PI / (double)J288_OUT_POS_COUNTS);
 }
 
