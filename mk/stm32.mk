@@ -135,3 +135,32 @@ bench-target: $(BUILD)/bench/bench_m4_O2.elf $(BUILD)/bench/bench_m4_Os.elf
 	        -serial none -semihosting-config enable=on,target=native -kernel $(BUILD)/bench/bench_m4_$$o.elf || exit 1; \
 	    echo; \
 	done
+
+# ---- make size: flash/RAM per module and stack per public call, M0 and M4F at -Os --------
+SIZE_CORES := m0 m4f
+SIZE_BACKENDS := table nibble hw
+SIZE_table_DEFS := -DJ288_CONFIG_CRC_BACKEND=J288_CRC_BACKEND_TABLE -DJ288_STM32_HW_CRC=0
+SIZE_nibble_DEFS := -DJ288_CONFIG_CRC_BACKEND=J288_CRC_BACKEND_NIBBLE -DJ288_STM32_HW_CRC=0
+SIZE_hw_DEFS := -DJ288_CONFIG_CRC_BACKEND=J288_CRC_BACKEND_HW -DJ288_CONFIG_CRC_HW_FUNCTION=j288_stm32_crc32_default
+SIZE_SRC := $(LIB_SRC) $(STM32_PORT_SRC) $(STM32_STUB_DIR)/stm32_hal_stub.c test/target/size_probe.c
+
+# $(1): core, $(2): backend
+define SIZE_RULES
+$(BUILD)/size/$(1)-$(2)/obj/%.o: %.c $(TGT_HDRS)
+	@mkdir -p $$(@D)
+	$(ARM_CC) $(TGT_$(1)_FLAGS) $(SIZE_$(2)_DEFS) $(CPPFLAGS_LIB) -I$(STM32_PORT_DIR) -I$(STM32_STUB_DIR) \
+	    -std=c99 $(WARN) -Os -ffunction-sections -fdata-sections -fstack-usage -fcallgraph-info=su -c $$< -o $$@
+
+$(BUILD)/size/$(1)-$(2)/probe.elf: $(SIZE_SRC:%.c=$(BUILD)/size/$(1)-$(2)/obj/%.o) test/target/sections.ld test/target/mem_mps2.ld
+	$(ARM_CC) $(TGT_$(1)_FLAGS) -nostartfiles --specs=nano.specs --specs=nosys.specs -Wl,--gc-sections \
+	    -Wl,-Map=$$(@D)/probe.map -Ltest/target -T mem_mps2.ld $$(filter %.o,$$^) -o $$@ -lm
+SIZE_DIRS += $(BUILD)/size/$(1)-$(2)
+SIZE_ELFS += $(BUILD)/size/$(1)-$(2)/probe.elf
+endef
+SIZE_DIRS :=
+SIZE_ELFS :=
+$(foreach c,$(SIZE_CORES),$(foreach b,$(SIZE_BACKENDS),$(eval $(call SIZE_RULES,$(c),$(b)))))
+
+.PHONY: size
+size: $(SIZE_ELFS)
+	@$(PYTHON) test/target/size_report.py $(SIZE_DIRS)

@@ -1,0 +1,76 @@
+/*
+ * A typical MCU user of j288, linked only to measure it (make size): the STM32 port on one
+ * UART, the bus engine, the cycle scheduler, SI conversion and error strings. Never run.
+ */
+#include <stdint.h>
+
+#include "j288/j288.h"
+#include "j288_stm32.h"
+
+extern uint32_t _estack;
+void Reset_Handler(void);
+int main(void);
+
+__attribute__((section(".isr_vector"), used)) void (*const probe_vectors[2])(void) = {
+    (void (*)(void))(uintptr_t)&_estack, Reset_Handler};
+
+void Reset_Handler(void)
+{
+    (void)main();
+    for (;;) {
+    }
+}
+
+/* Application state, kept apart so that its RAM shows per object (nm). */
+J288_STM32_DMA_BUFFER(probe_dma);
+j288_stm32_t probe_port;
+j288_sched_t probe_sched;
+
+static UART_HandleTypeDef huart;
+static TIM_HandleTypeDef htim;
+static CRC_HandleTypeDef hcrc;
+static volatile uint32_t tick;
+static volatile int sink;
+
+static uint32_t now_us(void) { return tick; }
+
+void HAL_UART_TxCpltCallback(UART_HandleTypeDef *h) { (void)j288_stm32_on_tx_cplt(h); }
+void HAL_UARTEx_RxEventCallback(UART_HandleTypeDef *h, uint16_t n) { (void)j288_stm32_on_rx_event(h, n); }
+void HAL_UART_ErrorCallback(UART_HandleTypeDef *h) { (void)j288_stm32_on_error(h); }
+void HAL_TIM_OC_DelayElapsedCallback(TIM_HandleTypeDef *h) { (void)j288_stm32_on_timer(h); }
+
+int main(void)
+{
+    j288_stm32_config_t pc = {0};
+    j288_cmd_raw_t cmd = {0};
+    pc.huart = &huart;
+    pc.dma = &probe_dma;
+    pc.now_us = now_us;
+    pc.htim = &htim;
+    pc.tim_channel = TIM_CHANNEL_1;
+    pc.hcrc = &hcrc;
+    if (j288_stm32_init(&probe_port, &pc, NULL) != J288_OK) {
+        return 1;
+    }
+    (void)j288_sched_init(&probe_sched, j288_stm32_bus(&probe_port), NULL);
+    (void)j288_sched_enable(&probe_sched, 0u, true);
+    (void)j288_sched_set_cmd(&probe_sched, &cmd);
+#if J288_CONFIG_SI
+    {
+        j288_cmd_si_t si = {0};
+        j288_reply_si_t rsi;
+        (void)j288_sched_set_cmd_si(&probe_sched, &si, J288_SIDE_OUTPUT);
+        sink = j288_reply_to_si(&j288_sched_slot(&probe_sched, 0u)->reply, J288_SIDE_OUTPUT, &rsi);
+    }
+#endif
+    for (;;) {
+        if (!j288_sched_busy(&probe_sched)) {
+            sink = j288_sched_start_sweep(&probe_sched, tick);
+        }
+        j288_sched_poll(&probe_sched, tick);
+        if (sink == J288_ERR_OFFLINE) {
+            (void)j288_sched_estop(&probe_sched, tick);
+            sink = (int)j288_strerror(sink)[0];
+        }
+    }
+}
