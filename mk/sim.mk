@@ -32,3 +32,4 @@ ifneq ($(wildcard test/sim/test_sim_model.c),)
 ALL_TARGETS += $(SIM_MODEL_TEST)
 HOST_TESTS += $(SIM_MODEL_TEST)
 endif
+TEST_SCRIPTS += test/e2e/sim_cli.sh

@@ -314,6 +314,8 @@ static void test_vanished_device_between_transfers(void)
     TEST_ASSERT_EQUAL_INT(J288_ERR_OFFLINE, j288_bus_transfer_blocking(&g_bus, &c, NULL));
     TEST_ASSERT_TRUE(j288_linux_offline(&g_lp));
     TEST_ASSERT_NOT_NULL(strstr(j288_linux_error(&g_lp), "vanished"));
+    /* The bus heard it as a line-gone event. */
+    TEST_ASSERT_TRUE(j288_bus_stats(&g_bus)->line_errors >= 1u);
     /* Stays offline, at once, without spinning. */
     TEST_ASSERT_EQUAL_INT(J288_ERR_OFFLINE, j288_bus_transfer_blocking(&g_bus, &c, NULL));
     TEST_ASSERT_EQUAL_INT(J288_ERR_OFFLINE,
@@ -436,6 +438,27 @@ static void test_injected_faults_give_bus_errors(void)
         TEST_ASSERT_EQUAL_INT(J288_OK, j288_bus_transfer_blocking(&g_bus, &c, NULL));
 }
 
+static void test_echoing_adapter(void)
+{
+    j288_linux_options_t opt;
+    j288_cmd_raw_t c = lock_cmd(1);
+    j288_txn_t txn;
+    int i;
+    sim_start("--echo", NULL);
+    memset(&opt, 0, sizeof opt);
+    opt.margin_us = 10000;
+    opt.echo = true;
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_linux_open(&g_lp, g_pty, 0, &opt));
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_linux_bus_init(&g_lp, &g_bus, NULL));
+    TEST_ASSERT_TRUE(g_bus.cfg.echo);
+    for (i = 0; i < 10; i++) {
+        TEST_ASSERT_EQUAL_INT(J288_OK, j288_bus_transfer_blocking(&g_bus, &c, &txn));
+        TEST_ASSERT_EQUAL_UINT(1, txn.reply.id);
+    }
+    TEST_ASSERT_EQUAL_UINT32(10u * (20u + 26u), j288_linux_stats(&g_lp)->rx_bytes);
+    TEST_ASSERT_EQUAL_UINT32(0, j288_bus_stats(&g_bus)->collisions);
+}
+
 int main(void)
 {
     UNITY_BEGIN();
@@ -450,5 +473,6 @@ int main(void)
     RUN_TEST(test_eintr_storm);
     RUN_TEST(test_stop_flag_aborts_run);
     RUN_TEST(test_injected_faults_give_bus_errors);
+    RUN_TEST(test_echoing_adapter);
     return UNITY_END();
 }

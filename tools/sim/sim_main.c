@@ -41,6 +41,7 @@ typedef struct {
     size_t qlen;
     uint64_t queue_full;
     uint64_t lost_no_client;
+    bool echo;
     FILE *log;
 } sim_io_t;
 
@@ -84,6 +85,7 @@ typedef struct {
     uint32_t faults[J288_MAX_SERVOS];
     uint16_t fault_set;
     bool quiet;
+    bool echo;
     j288_sim_bus_config_t bus;
     j288_sim_params_t prm;
 } options_t;
@@ -102,6 +104,8 @@ static void usage(FILE *f)
           "  --load-inertia J    extra inertia on each output shaft, kg m^2 (default 0)\n"
           "  --load-torque NM    constant torque on each output shaft, N m (default 0)\n"
           "  --turnaround-us N   reply delay (default 20)\n"
+          "  --echo              send every received byte straight back, as a single-wire\n"
+          "                      adapter that hears its own transmit does\n"
           "  --log FILE          one line per received command frame ('-' = stderr)\n"
           "  --exit-after S      exit after S seconds (for tests)\n"
           "  --quiet             no messages but errors and the statistics line\n"
@@ -175,6 +179,19 @@ static void parse_fault(options_t *o, const char *s)
     o->fault_set = (uint16_t)(o->fault_set | (1u << id));
 }
 
+static bool takes_value(const char *opt)
+{
+    static const char *const names[] = {
+        "--ids",     "--link",  "--log",  "--voltage", "--ambient",    "--load-inertia",
+        "--load-torque", "--turnaround-us", "--exit-after", "--seed", "--drop", "--corrupt",
+        "--late",    "--late-us", "--noise", "--dup", "--fault"};
+    size_t i;
+    for (i = 0; i < sizeof names / sizeof names[0]; i++)
+        if (strcmp(opt, names[i]) == 0)
+            return true;
+    return false;
+}
+
 static void parse_args(options_t *o, int argc, char **argv)
 {
     int i;
@@ -194,8 +211,14 @@ static void parse_args(options_t *o, int argc, char **argv)
             o->quiet = true;
             continue;
         }
+        if (strcmp(a, "--echo") == 0) {
+            o->echo = true;
+            continue;
+        }
         if (strncmp(a, "--", 2) != 0)
             die("unexpected argument '%s' (see --help)", a);
+        if (!takes_value(a))
+            die("unknown option '%s' (see --help)", a);
         if (v == NULL)
             die("%s needs a value (see --help)", a);
         i++;
@@ -404,7 +427,13 @@ static bool read_input(sim_io_t *io, j288_sim_bus_t *bus)
     for (;;) {
         ssize_t n = read(io->master, buf, sizeof buf);
         if (n > 0) {
-            j288_sim_bus_feed(bus, buf, (size_t)n, sim_now_us(io));
+            uint64_t now = sim_now_us(io);
+            size_t off;
+            /* The echo is on the wire before any reply can start. */
+            for (off = 0; io->echo && off < (size_t)n; off += CHUNK_MAX)
+                queue_send(io, now, buf + off,
+                           ((size_t)n - off < CHUNK_MAX) ? (size_t)n - off : CHUNK_MAX);
+            j288_sim_bus_feed(bus, buf, (size_t)n, now);
             continue;
         }
         if (n < 0 && errno == EINTR)
@@ -468,6 +497,7 @@ int main(int argc, char **argv)
 
     parse_args(&o, argc, argv);
     memset(&io, 0, sizeof io);
+    io.echo = o.echo;
     bus = calloc(1, sizeof *bus);
     if (bus == NULL)
         die("out of memory");

@@ -1,0 +1,99 @@
+#!/usr/bin/env bash
+# j288-sim as a program: --help, argument errors, the pty path line, --link, --log, exit on
+# SIGINT/SIGTERM and --exit-after with the statistics line, nothing left behind.
+# Run from the repo root with BIN set (make test does).
+set -u
+BIN=${BIN:-build/bin}
+SIM="$BIN/j288-sim"
+tmp=$(mktemp -d)
+pids=()
+cleanup() {
+    for p in "${pids[@]}"; do kill -KILL "$p" 2>/dev/null; wait "$p" 2>/dev/null; done
+    rm -rf "$tmp"
+}
+trap cleanup EXIT
+tests=0 failures=0
+check() { # name, then a command that must succeed
+    local name=$1; shift
+    tests=$((tests + 1))
+    if "$@"; then echo "sim_cli.sh:$name:PASS"; else echo "sim_cli.sh:$name:FAIL"; failures=$((failures + 1)); fi
+}
+
+# Start the simulator in the background; sets SIM_PID, SIM_PTY (waits for the path line).
+start_sim() {
+    "$SIM" "$@" >"$tmp/out" 2>"$tmp/err" &
+    SIM_PID=$!
+    pids+=("$SIM_PID")
+    SIM_PTY=
+    for _ in $(seq 1 100); do
+        SIM_PTY=$(head -n1 "$tmp/out" 2>/dev/null)
+        [ -n "$SIM_PTY" ] && break
+        sleep 0.05
+    done
+}
+
+# Wait up to 3 s for a pid to exit; returns its exit status, or 124 on time-out.
+wait_exit() {
+    for _ in $(seq 1 60); do
+        if ! kill -0 "$1" 2>/dev/null; then wait "$1"; return $?; fi
+        sleep 0.05
+    done
+    return 124
+}
+
+t_help() { "$SIM" --help | grep -q -- '--ids' && "$SIM" --help | grep -q -- '--exit-after'; }
+t_bad_option() {
+    "$SIM" --bogus >/dev/null 2>"$tmp/e"; local rc=$?
+    [ $rc -eq 2 ] && [ "$(wc -l <"$tmp/e")" -eq 1 ] && grep -q "unknown option '--bogus'" "$tmp/e"
+}
+t_bad_ids() {
+    "$SIM" --ids 1,15 >/dev/null 2>"$tmp/e"; [ $? -eq 2 ] && grep -q -- '--ids' "$tmp/e" || return 1
+    "$SIM" --ids 1 --dup 2 >/dev/null 2>"$tmp/e"; [ $? -eq 2 ] && grep -q -- '--dup' "$tmp/e" || return 1
+    "$SIM" --drop 1.5 >/dev/null 2>"$tmp/e"; [ $? -eq 2 ] && grep -q -- '--drop' "$tmp/e"
+}
+t_path_link_exit_after() {
+    start_sim --ids 1,2,3 --link "$tmp/bus" --exit-after 0.6 || return 1
+    [[ "$SIM_PTY" == /dev/pts/* ]] || return 1
+    [ -c "$SIM_PTY" ] && [ -L "$tmp/bus" ] && [ "$(readlink "$tmp/bus")" = "$SIM_PTY" ] || return 1
+    wait_exit "$SIM_PID" || return 1
+    [ ! -e "$tmp/bus" ] && grep -q '^j288-sim: stats: ' "$tmp/err"
+}
+t_signals() {
+    local sig
+    for sig in TERM INT; do
+        start_sim --exit-after 30 || return 1
+        [ -n "$SIM_PTY" ] || return 1
+        kill -s "$sig" "$SIM_PID"
+        wait_exit "$SIM_PID" || return 1
+        grep -q '^j288-sim: stats: ' "$tmp/err" || return 1
+    done
+}
+t_log_frames() {
+    start_sim --ids 0 --log "$tmp/log" --exit-after 10 || return 1
+    stty -F "$SIM_PTY" raw -echo || return 1
+    # The protocol's worked lock frame for servo 0, then the same with a broken CRC.
+    printf '\xfe\xee\x80\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x1d\x99\xfb\x6e' >"$SIM_PTY"
+    sleep 0.1
+    printf '\xfe\xee\x80\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x1d\x99\xfb\x6f' >"$SIM_PTY"
+    sleep 0.2
+    kill -s TERM "$SIM_PID"; wait_exit "$SIM_PID" || return 1
+    grep -q 'feee80000000000000000000000000001d99fb6e id=0 status=0 wd=1 ' "$tmp/log" &&
+        grep -q ' bad-crc id=0$' "$tmp/log" &&
+        grep -q 'commands 1 .*bad-crc 1 ' "$tmp/err" && grep -q ' replies 1 ' "$tmp/err"
+}
+t_link_refuses_file() {
+    echo keep >"$tmp/file"
+    "$SIM" --link "$tmp/file" --exit-after 1 >/dev/null 2>"$tmp/e"; local rc=$?
+    [ $rc -eq 2 ] && [ "$(cat "$tmp/file")" = keep ]
+}
+
+check help t_help
+check bad_option t_bad_option
+check bad_values t_bad_ids
+check path_link_exit_after t_path_link_exit_after
+check signals t_signals
+check log_frames t_log_frames
+check link_refuses_file t_link_refuses_file
+
+echo "$tests Tests $failures Failures 0 Ignored"
+[ $failures -eq 0 ]
