@@ -1,66 +1,332 @@
-/* sched.c - the cycle scheduler (stub: full implementation follows). */
+/* The cycle scheduler: slots, sweeps, statistics and events; see j288/sched.h. */
 #include "j288/sched.h"
 
 #include <string.h>
 
+/* Thread-side changes to state that the bus ISR reads (advance_in_isr only). */
+static void sched_lock(const j288_sched_t *s)
+{
+    const j288_bus_t *b = s->bus;
+    if (b->cfg.advance_in_isr && !b->in_advance && (b->port->lock != NULL)) {
+        b->port->lock(b->port_ctx);
+    }
+}
+
+static void sched_unlock(const j288_sched_t *s)
+{
+    const j288_bus_t *b = s->bus;
+    if (b->cfg.advance_in_isr && !b->in_advance && (b->port->unlock != NULL)) {
+        b->port->unlock(b->port_ctx);
+    }
+}
+
+static void lock_cmd(j288_cmd_raw_t *c, uint8_t id, bool watchdog)
+{
+    memset(c, 0, sizeof *c);
+    c->id = id;
+    c->status = J288_MODE_LOCK;
+    c->watchdog = watchdog;
+}
+
 int j288_sched_init(j288_sched_t *s, j288_bus_t *bus, const j288_sched_config_t *cfg)
 {
-    (void)cfg;
-    if (s == NULL || bus == NULL) return J288_ERR_NULL;
+    uint8_t i;
+
+    if ((s == NULL) || (bus == NULL)) {
+        return J288_ERR_NULL;
+    }
     memset(s, 0, sizeof *s);
     s->bus = bus;
+    if (cfg != NULL) {
+        s->cfg = *cfg;
+    }
+    if (s->cfg.offline_after == 0u) {
+        s->cfg.offline_after = (uint8_t)J288_DEFAULT_OFFLINE_AFTER;
+    }
+    for (i = 0u; i < J288_MAX_SERVOS; i++) {
+        lock_cmd(&s->slot[i].cmd, i, true);
+        s->slot[i].last_result = J288_OK;
+    }
     return J288_OK;
 }
 
 int j288_sched_enable(j288_sched_t *s, uint8_t id, bool enabled)
 {
-    if (s == NULL) return J288_ERR_NULL;
-    if (id > J288_MAX_ID) return J288_ERR_BAD_ID;
+    if (s == NULL) {
+        return J288_ERR_NULL;
+    }
+    if (id > J288_MAX_ID) {
+        return J288_ERR_BAD_ID;
+    }
     s->slot[id].enabled = enabled;
     return J288_OK;
 }
 
 int j288_sched_set_cmd(j288_sched_t *s, const j288_cmd_raw_t *cmd)
 {
-    if (s == NULL || cmd == NULL) return J288_ERR_NULL;
-    return J288_ERR_BAD_ID;
+    if ((s == NULL) || (cmd == NULL)) {
+        return J288_ERR_NULL;
+    }
+    /* The encoder's checks, in its order, so that a slot never holds a command the bus
+     * would refuse mid-sweep. */
+    if (cmd->id > J288_MAX_ID) {
+        return J288_ERR_BAD_ID;
+    }
+    if (cmd->status > J288_MODE_FOC) {
+        return J288_ERR_BAD_STATUS;
+    }
+    if ((cmd->kp < 0) || (cmd->kd < 0)) {
+        return J288_ERR_NEG_GAIN;
+    }
+    sched_lock(s);
+    s->slot[cmd->id].cmd = *cmd;
+    sched_unlock(s);
+    return J288_OK;
 }
 
 #if J288_CONFIG_SI
 int j288_sched_set_cmd_si(j288_sched_t *s, const j288_cmd_si_t *cmd, j288_side_t side)
 {
-    (void)side;
-    if (s == NULL || cmd == NULL) return J288_ERR_NULL;
-    return J288_ERR_BAD_ID;
+    j288_cmd_raw_t raw;
+    int err;
+
+    if ((s == NULL) || (cmd == NULL)) {
+        return J288_ERR_NULL;
+    }
+    err = j288_cmd_from_si(cmd, side, &raw);
+    if (err != J288_OK) {
+        return err;
+    }
+    return j288_sched_set_cmd(s, &raw);
 }
 #endif
 
-int j288_sched_start_sweep(j288_sched_t *s, uint32_t now_us)
+/* ---- events and statistics */
+
+static void emit(const j288_sched_t *s, j288_event_kind_t kind, uint8_t id, uint32_t old_bits,
+                 uint32_t new_bits)
 {
-    (void)now_us;
-    return s == NULL ? J288_ERR_NULL : J288_ERR_BUSY;
+    j288_event_t ev;
+    if (s->cfg.on_event == NULL) {
+        return;
+    }
+    ev.kind = kind;
+    ev.id = id;
+    ev.old_bits = old_bits;
+    ev.new_bits = new_bits;
+    s->cfg.on_event(s->cfg.user, &ev);
 }
 
-void j288_sched_poll(j288_sched_t *s, uint32_t now_us) { (void)s; (void)now_us; }
-bool j288_sched_busy(const j288_sched_t *s) { return s != NULL && s->sweeping; }
+static void take_reply(j288_sched_t *s, j288_slot_t *slot, const j288_txn_t *txn)
+{
+    const j288_reply_raw_t *r = &txn->reply;
+    uint32_t old_faults = slot->has_reply ? slot->reply.faults : 0u;
+    uint32_t old_warn = slot->has_reply ? slot->reply.warnings : 0u;
+    bool old_trip = slot->has_reply && slot->reply.watchdog_tripped;
+
+    slot->stats.successes++;
+    slot->stats.consecutive_failures = 0u;
+    slot->stats.last_latency_us = txn->latency_us;
+    if (txn->latency_us > slot->stats.worst_latency_us) {
+        slot->stats.worst_latency_us = txn->latency_us;
+    }
+    slot->reply = *r;
+    slot->has_reply = true;
+    slot->reply_us = txn->start_us + txn->latency_us;
+    if (s->wd_clear_in_flight) {
+        slot->clear_watchdog = false; /* the servo heard it: once is enough */
+    }
+    if (!slot->online) {
+        slot->online = true;
+        emit(s, J288_EV_ONLINE, txn->id, 0u, 0u);
+    }
+    if (r->faults != old_faults) {
+        emit(s, J288_EV_FAULTS_CHANGED, txn->id, old_faults, r->faults);
+    }
+    if (r->warnings != old_warn) {
+        emit(s, J288_EV_WARNINGS_CHANGED, txn->id, old_warn, r->warnings);
+    }
+    if (r->watchdog_tripped && !old_trip) {
+        emit(s, J288_EV_WATCHDOG_TRIPPED, txn->id, 0u, 1u);
+    } else if (!r->watchdog_tripped && old_trip) {
+        emit(s, J288_EV_WATCHDOG_CLEARED, txn->id, 1u, 0u);
+    }
+}
+
+static void take_failure(j288_sched_t *s, j288_slot_t *slot, uint8_t id, int result)
+{
+    j288_slot_stats_t *st = &slot->stats;
+
+    switch (result) {
+    case J288_ERR_TIMEOUT:
+        st->timeouts++;
+        break;
+    case J288_ERR_CRC:
+    case J288_ERR_TRUNCATED:
+        st->crc_errors++;
+        break;
+    case J288_ERR_WRONG_ID:
+        st->wrong_id++;
+        break;
+    case J288_ERR_COLLISION:
+        st->collisions++;
+        break;
+    default:
+        st->other_errors++;
+        break;
+    }
+    if (result == J288_ERR_ABORTED) {
+        return; /* an emergency stop says nothing about the servo */
+    }
+    st->consecutive_failures++;
+    if (slot->online && (st->consecutive_failures >= s->cfg.offline_after)) {
+        slot->online = false;
+        emit(s, J288_EV_OFFLINE, id, 0u, 0u);
+    }
+}
+
+/* ---- sweeps */
+
+static void sched_done(void *user, const j288_txn_t *txn);
+
+static void end_sweep(j288_sched_t *s, uint32_t now)
+{
+    s->sweeping = false;
+    s->sweeps++;
+    if (s->cfg.on_sweep != NULL) {
+        s->cfg.on_sweep(s->cfg.user, s->sweeps, now);
+    }
+}
+
+/* Submit the next enabled slot of this sweep; end the sweep (and start the next one when
+ * continuous) when none is left. Returns J288_ERR_BUSY if the bus refused the submit. */
+static int next_slot(j288_sched_t *s, uint32_t now)
+{
+    for (;;) {
+        while (s->cursor < J288_MAX_SERVOS) {
+            uint8_t id = s->cursor++;
+            j288_slot_t *slot = &s->slot[id];
+            j288_cmd_raw_t cmd;
+            int rc;
+            if (!slot->enabled) {
+                continue;
+            }
+            cmd = slot->cmd;
+            cmd.id = id;
+            s->wd_clear_in_flight = slot->clear_watchdog;
+            if (slot->clear_watchdog) {
+                cmd.watchdog = false;
+            }
+            s->sent++;
+            rc = j288_bus_submit(s->bus, &cmd, now, sched_done, s);
+            if (rc == J288_OK) {
+                return J288_OK; /* sched_done continues the sweep */
+            }
+            s->sent--;
+            slot->last_result = rc;
+            s->sweeping = false; /* busy (an estop) or refused: the sweep stops here */
+            return rc;
+        }
+        {
+            bool again = s->cfg.continuous && !s->stopped && (s->sent != 0u);
+            end_sweep(s, now);
+            if (!again || s->sweeping || s->stopped) {
+                return J288_OK; /* (on_sweep may have started or stopped a sweep itself) */
+            }
+        }
+        s->sweeping = true;
+        s->cursor = 0u;
+        s->sent = 0u;
+    }
+}
+
+static void sched_done(void *user, const j288_txn_t *txn)
+{
+    j288_sched_t *s = (j288_sched_t *)user;
+    j288_slot_t *slot;
+
+    if (txn->id > J288_MAX_ID) {
+        return;
+    }
+    slot = &s->slot[txn->id];
+    slot->stats.transactions++;
+    slot->last_result = txn->result;
+    if (txn->result == J288_OK) {
+        take_reply(s, slot, txn);
+    } else {
+        take_failure(s, slot, txn->id, txn->result);
+    }
+    s->wd_clear_in_flight = false;
+    if (s->sweeping && !s->stopped) {
+        (void)next_slot(s, txn->start_us + txn->latency_us);
+    }
+}
+
+int j288_sched_start_sweep(j288_sched_t *s, uint32_t now_us)
+{
+    int rc;
+
+    if (s == NULL) {
+        return J288_ERR_NULL;
+    }
+    if (s->sweeping) {
+        return J288_ERR_BUSY;
+    }
+    /* All sched state is set before the submit: the ISR may complete it at once. */
+    s->stopped = false;
+    s->cursor = 0u;
+    s->sent = 0u;
+    s->sweeping = true;
+    rc = next_slot(s, now_us);
+    return rc;
+}
+
+void j288_sched_poll(j288_sched_t *s, uint32_t now_us)
+{
+    if (s != NULL) {
+        j288_bus_poll(s->bus, now_us);
+    }
+}
+
+bool j288_sched_busy(const j288_sched_t *s) { return (s != NULL) && s->sweeping; }
 
 int j288_sched_clear_watchdog(j288_sched_t *s, uint8_t id)
 {
-    if (s == NULL) return J288_ERR_NULL;
-    if (id > J288_MAX_ID) return J288_ERR_BAD_ID;
+    if (s == NULL) {
+        return J288_ERR_NULL;
+    }
+    if (id > J288_MAX_ID) {
+        return J288_ERR_BAD_ID;
+    }
+    sched_lock(s);
+    s->slot[id].clear_watchdog = true;
+    sched_unlock(s);
     return J288_OK;
 }
 
 int j288_sched_estop(j288_sched_t *s, uint32_t now_us)
 {
-    (void)now_us;
-    return s == NULL ? J288_ERR_NULL : J288_OK;
+    uint8_t i;
+
+    if (s == NULL) {
+        return J288_ERR_NULL;
+    }
+    sched_lock(s);
+    s->sweeping = false;
+    s->stopped = true;
+    for (i = 0u; i < J288_MAX_SERVOS; i++) {
+        lock_cmd(&s->slot[i].cmd, i, s->slot[i].cmd.watchdog);
+    }
+    sched_unlock(s);
+    return j288_bus_estop(s->bus, now_us);
 }
 
 const j288_slot_t *j288_sched_slot(const j288_sched_t *s, uint8_t id)
 {
-    if (s == NULL || id > J288_MAX_ID) return NULL;
+    if ((s == NULL) || (id > J288_MAX_ID)) {
+        return NULL;
+    }
     return &s->slot[id];
 }
 
-uint32_t j288_sched_sweeps(const j288_sched_t *s) { return s == NULL ? 0u : s->sweeps; }
+uint32_t j288_sched_sweeps(const j288_sched_t *s) { return (s == NULL) ? 0u : s->sweeps; }

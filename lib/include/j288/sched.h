@@ -90,8 +90,10 @@ typedef struct {
     j288_sched_config_t cfg;
     j288_slot_t slot[J288_MAX_SERVOS];
     uint8_t cursor;        /* next slot to visit in this sweep */
+    uint8_t sent;          /* transactions submitted in this sweep */
     bool sweeping;
     bool stopped;          /* after an estop, until the next start */
+    bool wd_clear_in_flight; /* the command in flight has its watchdog bit cleared */
     uint32_t sweeps;
 } j288_sched_t;
 
