@@ -55,6 +55,16 @@ TGT_UNIT_NAMES := $(notdir $(basename $(UNIT_TEST_SRC)))
 TGT_COMMON_SRC := $(LIB_SRC) $(TEST_SUPPORT_SRC) test/target/startup.c
 TGT_HDRS := $(LIB_HDR) $(STM32_HDRS) $(wildcard test/support/*.h test/vectors/*.h)
 
+# Link $(3) from objects $(2) for core $(1). A Cortex-M0 image whose RAM does not fit the
+# micro:bit's 16K is linked for the MPS2 memory map instead and runs, same ARMv6-M code, on
+# the mps2-an385 machine (a Cortex-M3 executes the ARMv6-M instruction set unchanged); a
+# file <elf>.qemu next to the image then names that machine, and the runner says so.
+TGT_LINK = rm -f $(3).qemu; \
+    $(ARM_CC) $(TGT_$(1)_FLAGS) $(TGT_LDFLAGS) -T $(TGT_$(1)_MEM) $(2) -o $(3) -lm $(if $(filter m0,$(1)),2>/dev/null || \
+    { echo "$(3): over the micro:bit's 16K RAM; linked for mps2-an385 (M3 machine, M0 code)"; \
+      $(ARM_CC) $(TGT_$(1)_FLAGS) $(TGT_LDFLAGS) -T mem_mps2.ld $(2) -o $(3) -lm && \
+      echo "mps2-an385:cortex-m3" > $(3).qemu; })
+
 # $(1): core
 define TGT_CORE_RULES
 $(BUILD)/target/$(1)/obj/%.o: %.c $(TGT_HDRS) $(UNITY)/unity.c
@@ -66,10 +76,10 @@ $(BUILD)/target/$(1)/obj/unity.o: $(UNITY)/unity.c
 	$(ARM_CC) $(TGT_$(1)_FLAGS) -std=c99 -O2 -g -ffunction-sections -I$(UNITY) -DUNITY_INCLUDE_DOUBLE -DUNITY_SUPPORT_64 -c $$< -o $$@
 
 $(BUILD)/target/$(1)/test_%.elf: $(BUILD)/target/$(1)/obj/test/unit/test_%.o $(TGT_COMMON_SRC:%.c=$(BUILD)/target/$(1)/obj/%.o) $(BUILD)/target/$(1)/obj/unity.o test/target/sections.ld test/target/$(TGT_$(1)_MEM)
-	$(ARM_CC) $(TGT_$(1)_FLAGS) $(TGT_LDFLAGS) -T $(TGT_$(1)_MEM) $$(filter %.o,$$^) -o $$@ -lm
+	$$(call TGT_LINK,$(1),$$(filter %.o,$$^),$$@)
 
 $(BUILD)/target/$(1)/test_stm32_port.elf: $(addprefix $(BUILD)/target/$(1)/obj/,test/stm32/test_stm32_port.o test/stm32/fake_hal.o port/stm32_hal/j288_stm32.o) $(TGT_COMMON_SRC:%.c=$(BUILD)/target/$(1)/obj/%.o) $(BUILD)/target/$(1)/obj/unity.o test/target/sections.ld test/target/$(TGT_$(1)_MEM)
-	$(ARM_CC) $(TGT_$(1)_FLAGS) $(TGT_LDFLAGS) -T $(TGT_$(1)_MEM) $$(filter %.o,$$^) -o $$@ -lm
+	$$(call TGT_LINK,$(1),$$(filter %.o,$$^),$$@)
 
 TGT_$(1)_ELFS := $(TGT_UNIT_NAMES:%=$(BUILD)/target/$(1)/%.elf) $(BUILD)/target/$(1)/test_stm32_port.elf
 TGT_ALL_ELFS += $$(TGT_$(1)_ELFS)
@@ -149,7 +159,7 @@ define SIZE_RULES
 $(BUILD)/size/$(1)-$(2)/obj/%.o: %.c $(TGT_HDRS)
 	@mkdir -p $$(@D)
 	$(ARM_CC) $(TGT_$(1)_FLAGS) $(SIZE_$(2)_DEFS) $(CPPFLAGS_LIB) -I$(STM32_PORT_DIR) -I$(STM32_STUB_DIR) \
-	    -std=c99 $(WARN) -Os -ffunction-sections -fdata-sections -fstack-usage -fcallgraph-info=su -c $$< -o $$@
+	    -std=c99 $(WARN) -Wcast-align=strict -Os -ffunction-sections -fdata-sections -fstack-usage -fcallgraph-info=su -c $$< -o $$@
 
 $(BUILD)/size/$(1)-$(2)/probe.elf: $(SIZE_SRC:%.c=$(BUILD)/size/$(1)-$(2)/obj/%.o) test/target/sections.ld test/target/mem_mps2.ld
 	$(ARM_CC) $(TGT_$(1)_FLAGS) -nostartfiles --specs=nano.specs --specs=nosys.specs -Wl,--gc-sections \

@@ -12,6 +12,8 @@ per_test_timeout=${TARGET_TIMEOUT:-120}
 passed=0 failed=0 failed_names=()
 for spec in "$@"; do
     IFS=: read -r core machine cpu elf <<<"$spec"
+    # An image too big for its board's RAM names the machine it was linked for instead.
+    [ -f "$elf.qemu" ] && IFS=: read -r machine cpu <"$elf.qemu"
     name="$core/$(basename "$elf" .elf)"
     log=$(mktemp)
     timeout -k 5 "$per_test_timeout" qemu-system-arm -M "$machine" -cpu "$cpu" -nographic \

@@ -25,6 +25,12 @@ void Reset_Handler(void)
     for (uint32_t *dst = &_sbss; dst < &_ebss; dst++) {
         *dst = 0u;
     }
+#if defined(__ARM_ARCH_6M__)
+    /* ARMv6-M code may run on the M3 machine when it needs more RAM than the micro:bit has:
+     * trap unaligned accesses there as a Cortex-M0 would (CCR.UNALIGN_TRP; read-only and
+     * already set on a real M0). */
+    *(volatile uint32_t *)0xE000ED14u |= (1u << 3);
+#endif
 #if defined(__ARM_FP)
     /* CP10 and CP11 full access, before any floating-point instruction runs. */
     *(volatile uint32_t *)0xE000ED88u |= (0xFu << 20);
