@@ -180,7 +180,7 @@ hard-cov-run: $(UNIT_TESTS)
 	find $(BUILD) -name '*.gcda' -delete
 	BUILD=$(BUILD) bash scripts/run-tests.sh $(UNIT_TESTS)
 	@mkdir -p $(BUILD)/coverage
-	$(HARD_GCOVR) --txt-metric branch --txt --print-summary \
+	$(HARD_GCOVR) --print-summary \
 	    --html-details $(BUILD)/coverage/index.html $(OBJ)/lib
 	@echo "coverage: HTML report in $(BUILD)/coverage/index.html"
 

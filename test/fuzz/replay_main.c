@@ -6,6 +6,7 @@
  * directory compiled in as FUZZ_CORPUS_DIR (a path relative to the repository root).
  */
 #define _POSIX_C_SOURCE 200809L
+#define _FILE_OFFSET_BITS 64 /* stat() on 32-bit hosts with 64-bit inode numbers */
 
 #include "fuzz_common.h"
 
