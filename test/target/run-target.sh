@@ -15,6 +15,12 @@ for spec in "$@"; do
     # An image too big for its board's RAM names the machine it was linked for instead.
     [ -f "$elf.qemu" ] && IFS=: read -r machine cpu <"$elf.qemu"
     name="$core/$(basename "$elf" .elf)"
+    if [ ! -f "$elf" ]; then
+        failed=$((failed + 1))
+        failed_names+=("$name")
+        echo "FAIL  $name  did not build"
+        continue
+    fi
     log=$(mktemp)
     timeout -k 5 "$per_test_timeout" qemu-system-arm -M "$machine" -cpu "$cpu" -nographic \
         -monitor none -serial none -semihosting-config enable=on,target=native \
