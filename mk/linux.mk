@@ -37,3 +37,14 @@ ALL_TARGETS += $(LINUX_PORT_TEST)
 HOST_TESTS += $(LINUX_PORT_TEST)
 TEST_DEPS += $(BIN)/j288-sim
 endif
+
+# `make bench-linux`: round-trip latency and sweep rate over the simulator's pty (indicative
+# wall-clock figures; see docs/performance.md).
+LINUX_BENCH := $(BUILD)/bench/bench_linux_port
+$(LINUX_BENCH): $(OBJ)/test/linux/bench_linux_port.o $(LINUX_A) $(LIB_A)
+	@mkdir -p $(@D)
+	$(CC) $(CFLAGS_COMMON) $^ -o $@ $(LDFLAGS_COMMON) -lm
+
+.PHONY: bench-linux
+bench-linux: $(LINUX_BENCH) $(BIN)/j288-sim
+	$(LINUX_BENCH) $(BIN)/j288-sim 5000
