@@ -24,5 +24,5 @@ $(BIN)/j288: $(CLI_OBJ) $(CLI_LINUX_A) $(LIB_A)
 cli: $(BIN)/j288
 
 ALL_TARGETS += $(BIN)/j288
-TEST_DEPS += $(BIN)/j288
-TEST_SCRIPTS += test/e2e/cli_offline.sh
+TEST_DEPS += $(BIN)/j288 $(BIN)/j288-sim
+TEST_SCRIPTS += test/e2e/cli_offline.sh test/e2e/cli_bus.sh

@@ -9,8 +9,10 @@
 
 volatile sig_atomic_t cli_stop_signal = 0;
 
-/* A pseudo-terminal answers within microseconds; a USB adapter needs its latency timer. */
-#define PTY_MARGIN_US 3000u
+/* A pseudo-terminal (the simulator) answers in a few hundred microseconds, but a loaded
+ * machine can stall either side for milliseconds; a USB adapter needs its latency timer
+ * (the port's default). */
+#define PTY_MARGIN_US 5000u
 #define LOCK_ATTEMPTS 3
 
 void cli_bus_opts_init(cli_bus_opts_t *o, const cli_global_t *g)

@@ -39,7 +39,7 @@ enum {
     "  --port DEV       serial device (or give it before the command; default $J288_PORT)\n" \
     "  --baud N         line rate, default 6000000\n"                                          \
     "  --margin-us N    reply deadline margin for host latency; default 20000 for a USB\n"     \
-    "                   adapter, 3000 for a pseudo-terminal (the simulator)\n"               \
+    "                   adapter, 5000 for a pseudo-terminal (the simulator)\n"               \
     "  --echo           the adapter hears its own transmit (skip and check the echo)\n"      \
     "  --retries N      re-send a failed command up to N times (0-3)\n"                     \
     "  --json           machine-readable output\n"

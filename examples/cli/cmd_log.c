@@ -241,6 +241,19 @@ static void csv_row(FILE *f, double t, uint8_t id, const j288_slot_t *sl, bool f
     }
 }
 
+#define PROBE_SWEEPS 5
+
+static bool all_answered(const j288_sched_t *s, uint32_t ids)
+{
+    uint8_t id;
+    for (id = 0; id <= J288_MAX_ID; id++) {
+        if ((ids & (1u << id)) != 0u && !j288_sched_slot(s, id)->has_reply) {
+            return false;
+        }
+    }
+    return true;
+}
+
 /* Run one sweep to its end, even after a stop signal when ignore_stop is set. */
 static int sweep(cli_bus_t *b, j288_sched_t *s, uint32_t timeout_us, bool ignore_stop)
 {
@@ -411,8 +424,9 @@ int cli_cmd_log(int argc, char **argv, const cli_global_t *g)
     /* The budget of one sweep: every servo's full reply window, plus slack. */
     sweep_timeout_us = 15u * (j288_bus_reply_budget_us(&b.bus) * 2u + 1000u) + 100000u;
 
-    /* First sweep: who is there and where they start. Retried once for a dropped reply. */
-    for (rc = 0; rc < 2; rc++) {
+    /* First sweeps: who is there and where they start; a few tries so that one dropped
+     * reply does not fail the whole log. */
+    for (rc = 0; rc < PROBE_SWEEPS && !all_answered(&s, a.ids); rc++) {
         int r = sweep(&b, &s, sweep_timeout_us, false);
         if (r == J288_ERR_OFFLINE || r == J288_ERR_ABORTED) {
             if (r == J288_ERR_OFFLINE) {
