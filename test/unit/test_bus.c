@@ -853,11 +853,14 @@ static int chain_left;
 static void on_done_chain(void *user, const j288_txn_t *txn)
 {
     j288_cmd_raw_t next = lock_cmd((uint8_t)(txn->id + 1u));
-    on_done(user, txn);
+    uint8_t id = txn->id;
     if (chain_left > 0) {
         chain_left--;
         TEST_ASSERT_EQUAL_INT(J288_OK, j288_bus_submit(&bus, &next, 0u, on_done_chain, user));
     }
+    /* txn is still this transaction's, although the next one was submitted */
+    TEST_ASSERT_EQUAL_UINT8(id, txn->id);
+    on_done(user, txn);
 }
 
 static void test_advance_in_isr_chains_without_poll(void)
@@ -891,6 +894,124 @@ static void test_advance_in_isr_chains_without_poll(void)
     /* back to back: frame 1 starts 2 us (guard) after reply 0 ended at 86.67 us */
     TEST_ASSERT_EQUAL_UINT32(88u, fake_port_frame(&fp, 1u)->start_us);
     TEST_ASSERT_TRUE(fp.timer_fires > 0u);
+}
+
+static void test_advance_in_isr_with_inline_tx_done(void)
+{
+    j288_bus_config_t cfg;
+    j288_cmd_raw_t cmd = lock_cmd(0u);
+    uint8_t i;
+    memset(&cfg, 0, sizeof cfg);
+    cfg.advance_in_isr = true;
+    setup_cfg(&cfg);
+    fp.poll_fn = NULL;
+    fp.txdone = FAKE_TXDONE_INLINE; /* tx done re-enters the bus from inside start_tx */
+    for (i = 0u; i < 4u; i++) {
+        j288_reply_raw_t r = reply_for(i, 2000 + i);
+        fake_port_add_servo(&fp, i, &r);
+    }
+    chain_left = 3;
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_bus_submit(&bus, &cmd, 0u, on_done_chain, &cb));
+    TEST_ASSERT_EQUAL_INT(J288_BUS_WAIT_REPLY, j288_bus_state(&bus));
+    TEST_ASSERT_TRUE(fake_port_run_until_idle(&fp, 5000u * US));
+    TEST_ASSERT_EQUAL_INT(4, cb.calls);
+    TEST_ASSERT_EQUAL_INT32(2003, cb.txn.reply.pos);
+    TEST_ASSERT_EQUAL_UINT32(4u, j288_bus_stats(&bus)->ok);
+    TEST_ASSERT_EQUAL_UINT32(4u, fp.start_rx_calls);
+    TEST_ASSERT_EQUAL_INT(0, fp.lock_errors);
+}
+
+static void test_failure_ranking(void)
+{
+    j288_cmd_raw_t cmd = lock_cmd(3u);
+    uint8_t bad[J288_REPLY_LEN], other[J288_REPLY_LEN];
+    j288_reply_raw_t r7 = reply_for(7u, 7);
+    fake_port_encode_reply(&r7, other);
+    memcpy(bad, other, sizeof bad);
+    bad[12] ^= 0x40u;
+
+    /* crc, then wrong id: wrong id */
+    setup();
+    fake_port_rx_at(&fp, 50u * US, bad, sizeof bad);
+    fake_port_rx_at(&fp, 90u * US, other, sizeof other);
+    submit_ok(&cmd);
+    fake_port_run_until(&fp, 400u * US);
+    TEST_ASSERT_EQUAL_INT(J288_ERR_WRONG_ID, cb.txn.result);
+
+    /* wrong id, then a line error: still wrong id */
+    setup();
+    fake_port_rx_at(&fp, 50u * US, other, sizeof other);
+    fake_port_error_at(&fp, 100u * US, J288_LINE_NOISE);
+    submit_ok(&cmd);
+    fake_port_run_until(&fp, 400u * US);
+    TEST_ASSERT_EQUAL_INT(J288_ERR_WRONG_ID, cb.txn.result);
+
+    /* crc, then a line error: line */
+    setup();
+    fake_port_rx_at(&fp, 50u * US, bad, sizeof bad);
+    fake_port_error_at(&fp, 100u * US, J288_LINE_NOISE);
+    submit_ok(&cmd);
+    fake_port_run_until(&fp, 400u * US);
+    TEST_ASSERT_EQUAL_INT(J288_ERR_LINE, cb.txn.result);
+
+    /* line, then crc: line */
+    setup();
+    fake_port_error_at(&fp, 40u * US, J288_LINE_FRAMING);
+    fake_port_rx_at(&fp, 50u * US, bad, sizeof bad);
+    submit_ok(&cmd);
+    fake_port_run_until(&fp, 400u * US);
+    TEST_ASSERT_EQUAL_INT(J288_ERR_LINE, cb.txn.result);
+}
+
+static void test_noise_while_idle_is_not_echo(void)
+{
+    static const uint8_t noise[3] = {0xfe, 0xee, 0x01};
+    j288_bus_config_t cfg;
+    j288_cmd_raw_t cmd = lock_cmd(4u);
+    j288_reply_raw_t r = reply_for(4u, 4);
+    memset(&cfg, 0, sizeof cfg);
+    cfg.echo = true;
+    setup_cfg(&cfg);
+    fp.echo = true;
+    fake_port_add_servo(&fp, 4u, &r);
+    j288_bus_on_rx(&bus, noise, sizeof noise); /* recorded, nobody polled since */
+    submit_ok(&cmd);
+    TEST_ASSERT_TRUE(fake_port_run_until_idle(&fp, 5000u * US));
+    TEST_ASSERT_EQUAL_INT(J288_OK, cb.txn.result);
+    TEST_ASSERT_EQUAL_UINT32(3u, j288_bus_stats(&bus)->stale_bytes);
+}
+
+static void test_bytes_after_broadcast_in_same_poll(void)
+{
+    j288_cmd_raw_t cmd = lock_cmd(J288_BROADCAST_ID);
+    setup();
+    fp.poll_fn = NULL;
+    submit_ok(&cmd);
+    fake_port_rx_at(&fp, 50u * US, WORKED_REPLY3, J288_REPLY_LEN);
+    fake_port_run_until(&fp, 100u * US);
+    j288_bus_poll(&bus, fake_port_now_us(&fp));
+    TEST_ASSERT_EQUAL_INT(J288_OK, cb.txn.result);
+    TEST_ASSERT_EQUAL_UINT32(0u, j288_bus_stats(&bus)->wrong_id);
+    TEST_ASSERT_EQUAL_UINT32(0u, j288_bus_parser_stats(&bus)->frames);
+    TEST_ASSERT_EQUAL_UINT32(J288_REPLY_LEN, j288_bus_stats(&bus)->stale_bytes);
+}
+
+static void test_idle_splits_frames_in_order(void)
+{
+    /* One poll sees: 15 bytes, idle, a whole reply. The idle belongs between them. */
+    j288_cmd_raw_t cmd = worked_cmd();
+    setup();
+    fp.poll_fn = NULL;
+    submit_ok(&cmd);
+    fake_port_rx_at(&fp, 50u * US, WORKED_REPLY3, 15u);
+    fake_port_idle_at(&fp, 52u * US);
+    fake_port_rx_at(&fp, 90u * US, WORKED_REPLY3, J288_REPLY_LEN);
+    fake_port_run_until(&fp, 100u * US);
+    j288_bus_poll(&bus, fake_port_now_us(&fp));
+    TEST_ASSERT_EQUAL_INT(J288_OK, cb.txn.result);
+    TEST_ASSERT_EQUAL_UINT32(1u, j288_bus_parser_stats(&bus)->truncated);
+    TEST_ASSERT_EQUAL_UINT32(0u, j288_bus_parser_stats(&bus)->crc_errors);
+    TEST_ASSERT_EQUAL_UINT32(1u, j288_bus_stats(&bus)->crc_errors);
 }
 
 /* ---- time wrap-around */
@@ -1055,6 +1176,11 @@ int main(void)
     RUN_TEST(test_estop_while_busy);
     RUN_TEST(test_estop_idle_and_with_queued_work);
     RUN_TEST(test_advance_in_isr_chains_without_poll);
+    RUN_TEST(test_advance_in_isr_with_inline_tx_done);
+    RUN_TEST(test_failure_ranking);
+    RUN_TEST(test_noise_while_idle_is_not_echo);
+    RUN_TEST(test_bytes_after_broadcast_in_same_poll);
+    RUN_TEST(test_idle_splits_frames_in_order);
     RUN_TEST(test_time_wraps_at_2_pow_32);
     RUN_TEST(test_several_buses_are_independent);
     RUN_TEST(test_transfer_blocking);
