@@ -36,8 +36,7 @@
  * sleep is noticed promptly. */
 #define STOP_SLICE_US 20000u
 
-static void set_err(j288_linux_t *lp, const char *fmt, ...)
-    __attribute__((format(printf, 2, 3)));
+static void set_err(j288_linux_t *lp, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
 
 static void set_err(j288_linux_t *lp, const char *fmt, ...)
 {
@@ -76,7 +75,10 @@ uint32_t j288_linux_now_us(void)
 }
 
 /* Signed distance from now to t in the bus's wrapping microsecond clock. */
-static int32_t us_until(uint32_t t, uint32_t now) { return (int32_t)(t - now); }
+static int32_t us_until(uint32_t t, uint32_t now)
+{
+    return (int32_t)(t - now);
+}
 
 /* ---- open: exclusivity ------------------------------------------------------------------ */
 
@@ -184,8 +186,8 @@ static int set_raw_baud(j288_linux_t *lp, const char *dev, uint32_t baud)
     got = (uint32_t)t.c_ospeed;
     diff = (got > baud) ? got - baud : baud - got;
     if (got == 0u || (uint64_t)diff * 100u > (uint64_t)baud * J288_LINUX_BAUD_TOLERANCE_PCT) {
-        set_err(lp, "%s: the adapter cannot do %lu baud (it reports %lu)", dev,
-                (unsigned long)baud, (unsigned long)got);
+        set_err(lp, "%s: the adapter cannot do %lu baud (it reports %lu)", dev, (unsigned long)baud,
+                (unsigned long)got);
         return J288_ERR_BAD_CONFIG;
     }
     lp->baud_actual = got;
@@ -340,8 +342,8 @@ static void mark_gone(j288_linux_t *lp, const char *what, int e)
         return;
     lp->gone = true;
     if (e != 0)
-        set_err(lp, "%s vanished (%s: %s): adapter unplugged or simulator exited", lp->dev,
-                what, strerror(e));
+        set_err(lp, "%s vanished (%s: %s): adapter unplugged or simulator exited", lp->dev, what,
+                strerror(e));
     else
         set_err(lp, "%s vanished (%s): adapter unplugged or simulator exited", lp->dev, what);
     if (lp->bus != NULL)
@@ -675,7 +677,8 @@ int j288_linux_sweep(j288_linux_t *lp, j288_sched_t *s, uint32_t timeout_us)
     return j288_linux_run(lp, s, now + timeout_us, J288_LINUX_RUN_UNTIL_IDLE);
 }
 
-/* ---- inspection -------------------------------------------------------------------------------- */
+/* ---- inspection --------------------------------------------------------------------------------
+ */
 
 const char *j288_linux_error(const j288_linux_t *lp)
 {
@@ -692,7 +695,10 @@ uint32_t j288_linux_baud(const j288_linux_t *lp)
     return (lp == NULL || lp->fd < 0) ? 0u : lp->baud_actual;
 }
 
-bool j288_linux_offline(const j288_linux_t *lp) { return lp == NULL || lp->gone; }
+bool j288_linux_offline(const j288_linux_t *lp)
+{
+    return lp == NULL || lp->gone;
+}
 
 const j288_linux_stats_t *j288_linux_stats(const j288_linux_t *lp)
 {

@@ -64,11 +64,11 @@ extern "C" {
 
 /* All-zero means defaults. */
 typedef struct {
-    uint32_t margin_us;      /* reply margin for j288_linux_bus_config(); 0: 20 ms */
-    uint32_t idle_us;        /* line-idle report after bytes; 0: 2 ms */
-    bool echo;               /* the adapter hears its own transmit (many single-wire ones
-                                do): the bus then checks and skips our echoed command */
-    bool no_low_latency;     /* do not try ASYNC_LOW_LATENCY / the latency timer check */
+    uint32_t margin_us;  /* reply margin for j288_linux_bus_config(); 0: 20 ms */
+    uint32_t idle_us;    /* line-idle report after bytes; 0: 2 ms */
+    bool echo;           /* the adapter hears its own transmit (many single-wire ones
+                            do): the bus then checks and skips our echoed command */
+    bool no_low_latency; /* do not try ASYNC_LOW_LATENCY / the latency timer check */
 } j288_linux_options_t;
 
 /* Port counters (the bus keeps its own in j288_bus_stats()). */
@@ -87,12 +87,12 @@ typedef struct j288_linux {
     int fd;
     j288_bus_t *bus;
     j288_linux_options_t opt;
-    uint32_t baud;          /* requested */
-    uint32_t baud_actual;   /* read back from the driver */
-    bool gone;              /* the device vanished */
-    bool idle_pending;      /* bytes were delivered and no idle reported since */
+    uint32_t baud;        /* requested */
+    uint32_t baud_actual; /* read back from the driver */
+    bool gone;            /* the device vanished */
+    bool idle_pending;    /* bytes were delivered and no idle reported since */
     bool timer_armed;
-    bool low_latency;       /* ASYNC_LOW_LATENCY accepted */
+    bool low_latency; /* ASYNC_LOW_LATENCY accepted */
     uint32_t last_rx_us;
     uint32_t timer_us;
     const volatile sig_atomic_t *stop_flag;
@@ -142,7 +142,8 @@ uint32_t j288_linux_now_us(void);
 void j288_linux_set_stop_flag(j288_linux_t *lp, const volatile sig_atomic_t *flag);
 
 /* Flags for j288_linux_run(). */
-#define J288_LINUX_RUN_UNTIL_IDLE 0x1u  /* return as soon as the bus (and the scheduler, when
+#define J288_LINUX_RUN_UNTIL_IDLE                                                                  \
+    0x1u                                /* return as soon as the bus (and the scheduler, when      \
                                            given) has nothing in progress */
 #define J288_LINUX_RUN_IGNORE_STOP 0x2u /* ignore the stop flag: for flushing a stop frame */
 

@@ -245,8 +245,8 @@ static void test_scheduler_sweeps(void)
     next = j288_linux_now_us();
     /* A sweep started by hand, finished by run(UNTIL_IDLE). */
     TEST_ASSERT_EQUAL_INT(J288_OK, j288_sched_start_sweep(&s, next));
-    TEST_ASSERT_EQUAL_INT(J288_OK, j288_linux_run(&g_lp, &s, next + 100000u,
-                                                  J288_LINUX_RUN_UNTIL_IDLE));
+    TEST_ASSERT_EQUAL_INT(J288_OK,
+                          j288_linux_run(&g_lp, &s, next + 100000u, J288_LINUX_RUN_UNTIL_IDLE));
     for (i = 0; i < 200; i++) {
         TEST_ASSERT_EQUAL_INT(J288_OK, j288_linux_sweep(&g_lp, &s, 0));
         next += 1000u; /* 1 kHz ticks */
@@ -332,8 +332,7 @@ static void test_vanished_device_while_running(void)
     while (rc == J288_OK && loops < 100000) {
         rc = j288_bus_submit(&g_bus, &c, j288_linux_now_us(), NULL, NULL);
         TEST_ASSERT_EQUAL_INT(J288_OK, rc);
-        rc = j288_linux_run(&g_lp, NULL, j288_linux_now_us() + 100000u,
-                            J288_LINUX_RUN_UNTIL_IDLE);
+        rc = j288_linux_run(&g_lp, NULL, j288_linux_now_us() + 100000u, J288_LINUX_RUN_UNTIL_IDLE);
         if (rc == J288_OK) /* and sleep a little between transactions, like a control loop */
             rc = j288_linux_run(&g_lp, NULL, j288_linux_now_us() + 2000u, 0);
         loops++;

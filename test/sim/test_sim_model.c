@@ -169,8 +169,8 @@ static void test_foc_converges_to_target(void)
     s = j288_sim_bus_servo(&g_bus, 1);
     target = (int32_t)lround((s->p + 20.0) * J288_SCALE_POS); /* 20 rad rotor away */
     for (t = 0; t <= 3000000u; t += 1000u) {
-        j288_cmd_raw_t c = foc_cmd(1, target, 1280 /* 0.001 N m/rad */,
-                                   12800 /* 0.0001 N m s/rad */, true);
+        j288_cmd_raw_t c =
+            foc_cmd(1, target, 1280 /* 0.001 N m/rad */, 12800 /* 0.0001 N m s/rad */, true);
         send_cmd(&c, t);
     }
     r = last_reply();

@@ -9,11 +9,11 @@
 #define TWO_PI (2.0 * J288_PI)
 
 /* Thermal model: winding and case nodes. */
-#define C_WIND 15.0   /* J/K */
-#define R_WIND_CASE 1.5 /* K/W */
-#define C_CASE 150.0  /* J/K */
-#define R_CASE_AMB 3.0 /* K/W */
-#define P_IDLE 0.5    /* W, electronics */
+#define C_WIND      15.0  /* J/K */
+#define R_WIND_CASE 1.5   /* K/W */
+#define C_CASE      150.0 /* J/K */
+#define R_CASE_AMB  3.0   /* K/W */
+#define P_IDLE      0.5   /* W, electronics */
 
 /* Speeds below this count as standing still for stiction. */
 #define W_STILL 1e-6
@@ -116,8 +116,8 @@ static void step(j288_sim_servo_t *s, double dt)
     if (fabs(s->w) < W_STILL && fabs(drive) <= s->prm.coulomb) {
         s->w = 0.0; /* static friction holds */
     } else {
-        double dir = (fabs(s->w) >= W_STILL) ? (s->w > 0.0 ? 1.0 : -1.0)
-                                             : (drive > 0.0 ? 1.0 : -1.0);
+        double dir =
+            (fabs(s->w) >= W_STILL) ? (s->w > 0.0 ? 1.0 : -1.0) : (drive > 0.0 ? 1.0 : -1.0);
         w_new = s->w + (drive - dir * s->prm.coulomb) / j * dt;
         /* Dry friction stops the rotor; it never reverses it. */
         if (fabs(s->w) >= W_STILL && (w_new > 0.0) != (s->w > 0.0))
@@ -237,7 +237,10 @@ static uint64_t rng_next(uint64_t *state)
 }
 
 /* Uniform in [0, 1). */
-static double rng_unit(uint64_t *state) { return (double)(rng_next(state) >> 11) * 0x1.0p-53; }
+static double rng_unit(uint64_t *state)
+{
+    return (double)(rng_next(state) >> 11) * 0x1.0p-53;
+}
 
 int j288_sim_bus_init(j288_sim_bus_t *b, uint16_t ids, const j288_sim_bus_config_t *cfg,
                       const j288_sim_params_t *prm, j288_sim_send_fn send, j288_sim_log_fn log,

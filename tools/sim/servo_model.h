@@ -39,14 +39,14 @@
 #include "j288/frame.h"
 #include "j288/parser.h"
 
-#define J288_SIM_STEP_US 50u            /* integration step */
-#define J288_SIM_WATCHDOG_US 1000000u   /* the servo's communication watchdog */
-#define J288_SIM_WIND_LIMIT_C 150.0
-#define J288_SIM_CASE_LIMIT_C 100.0
-#define J288_SIM_TEMP_HYST_C 10.0
+#define J288_SIM_STEP_US         50u      /* integration step */
+#define J288_SIM_WATCHDOG_US     1000000u /* the servo's communication watchdog */
+#define J288_SIM_WIND_LIMIT_C    150.0
+#define J288_SIM_CASE_LIMIT_C    100.0
+#define J288_SIM_TEMP_HYST_C     10.0
 #define J288_SIM_UNDER_VOLTAGE_V 10.0
-#define J288_SIM_OVER_VOLTAGE_V 30.0
-#define J288_SIM_LOW_SUPPLY_V 11.0
+#define J288_SIM_OVER_VOLTAGE_V  30.0
+#define J288_SIM_LOW_SUPPLY_V    11.0
 
 /* Physical parameters, rotor side unless named otherwise. */
 typedef struct {
@@ -68,18 +68,18 @@ typedef struct {
     uint8_t id;
     j288_sim_params_t prm;
     /* physics */
-    double p;            /* rotor angle since power-up, rad (multi-turn) */
-    double w;            /* rotor speed, rad/s */
-    double tau;          /* motor torque applied in the last step, N m */
-    double out_offset;   /* output angle = out_offset + p / N */
+    double p;          /* rotor angle since power-up, rad (multi-turn) */
+    double w;          /* rotor speed, rad/s */
+    double tau;        /* motor torque applied in the last step, N m */
+    double out_offset; /* output angle = out_offset + p / N */
     double t_wind, t_case;
     /* protocol */
-    j288_cmd_raw_t cmd;  /* the last command obeyed */
-    uint8_t mode;        /* J288_MODE_LOCK or J288_MODE_FOC, as reported */
+    j288_cmd_raw_t cmd; /* the last command obeyed */
+    uint8_t mode;       /* J288_MODE_LOCK or J288_MODE_FOC, as reported */
     bool wd_enabled;
     bool wd_tripped;
     uint64_t last_cmd_us;
-    uint64_t now_us;     /* model time */
+    uint64_t now_us;          /* model time */
     uint32_t faults_latched;  /* reported once, then cleared (checksum) */
     uint32_t faults_active;   /* conditions (temperature, voltage) */
     uint32_t faults_injected; /* --fault */
@@ -125,11 +125,11 @@ typedef struct {
 
 typedef struct {
     uint64_t bytes;
-    uint64_t commands;      /* good frames */
+    uint64_t commands; /* good frames */
     uint64_t broadcasts;
     uint64_t bad_crc;
-    uint64_t for_others;    /* good frames for ids not on this bus */
-    uint64_t replies;       /* replies sent (duplicates included) */
+    uint64_t for_others; /* good frames for ids not on this bus */
+    uint64_t replies;    /* replies sent (duplicates included) */
     uint64_t dropped;
     uint64_t corrupted;
     uint64_t late;
@@ -149,7 +149,7 @@ typedef struct {
     j288_sim_bus_config_t cfg;
     j288_sim_servo_t servo[J288_MAX_SERVOS];
     j288_sim_servo_t dup[J288_MAX_SERVOS];
-    uint16_t present;       /* bit n: servo n is on the bus */
+    uint16_t present; /* bit n: servo n is on the bus */
     uint64_t rng;
     uint8_t window[J288_CMD_LEN]; /* the last 20 bytes fed, oldest first */
     uint64_t last_byte_us;

@@ -26,8 +26,8 @@
 
 #define QUEUE_LEN 64u
 #define CHUNK_MAX 32u
-#define TICK_US 10000u   /* model advance when the line is quiet */
-#define NAP_US 1000u     /* no client has the pty open: look again this often */
+#define TICK_US   10000u /* model advance when the line is quiet */
+#define NAP_US    1000u  /* no client has the pty open: look again this often */
 
 typedef struct {
     uint64_t at_us;
@@ -74,7 +74,10 @@ static uint64_t mono_ns(void)
     return (uint64_t)ts.tv_sec * 1000000000u + (uint64_t)ts.tv_nsec;
 }
 
-static uint64_t sim_now_us(const sim_io_t *io) { return (mono_ns() - io->t0_ns) / 1000u; }
+static uint64_t sim_now_us(const sim_io_t *io)
+{
+    return (mono_ns() - io->t0_ns) / 1000u;
+}
 
 /* ---- options ------------------------------------------------------------------------------ */
 
@@ -183,9 +186,10 @@ static void parse_fault(options_t *o, const char *s)
 static bool takes_value(const char *opt)
 {
     static const char *const names[] = {
-        "--ids",     "--link",  "--log",  "--voltage", "--ambient",    "--load-inertia",
-        "--load-torque", "--turnaround-us", "--exit-after", "--seed", "--drop", "--corrupt",
-        "--late",    "--late-us", "--noise", "--dup", "--fault"};
+        "--ids",          "--link",        "--log",           "--voltage",    "--ambient",
+        "--load-inertia", "--load-torque", "--turnaround-us", "--exit-after", "--seed",
+        "--drop",         "--corrupt",     "--late",          "--late-us",    "--noise",
+        "--dup",          "--fault"};
     size_t i;
     for (i = 0; i < sizeof names / sizeof names[0]; i++)
         if (strcmp(opt, names[i]) == 0)
@@ -329,14 +333,15 @@ static void log_frame(void *user, uint64_t now_us, const uint8_t frame[J288_CMD_
         fprintf(io->log, "%02x", frame[i]);
     if (cmd != NULL)
         fprintf(io->log, " id=%u status=%u wd=%u tau=%d speed=%d pos=%ld kp=%d kd=%d\n",
-                (unsigned)cmd->id, (unsigned)cmd->status, cmd->watchdog ? 1u : 0u,
-                (int)cmd->tau, (int)cmd->speed, (long)cmd->pos, (int)cmd->kp, (int)cmd->kd);
+                (unsigned)cmd->id, (unsigned)cmd->status, cmd->watchdog ? 1u : 0u, (int)cmd->tau,
+                (int)cmd->speed, (long)cmd->pos, (int)cmd->kp, (int)cmd->kd);
     else
         fprintf(io->log, " bad-crc id=%u\n", (unsigned)(frame[2] & 0x0Fu));
     fflush(io->log);
 }
 
-/* ---- pty -------------------------------------------------------------------------------------- */
+/* ---- pty --------------------------------------------------------------------------------------
+ */
 
 static int open_pty(char *path, size_t cap)
 {
