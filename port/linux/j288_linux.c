@@ -121,7 +121,8 @@ static int report_in_use(j288_linux_t *lp, const char *dev, int fd)
     else if (pid > 0)
         set_err(lp, "%s is already open in this process", dev);
     else
-        set_err(lp, "%s is in use by another program", dev);
+        set_err(lp, "%s is in use by another program (held exclusively; no lock holder found)",
+                dev);
     return J288_ERR_BUSY;
 }
 
