@@ -9,10 +9,11 @@
 
 #define FAILS_BEFORE_GIVING_UP 25 /* consecutive failed refreshes of a driven servo */
 
-/* Default gains, output side: stiff enough to follow a slow trajectory, well inside the
- * wire range (kp 0..2128 N*m/rad, kd 0..21.28 N*m*s/rad on the output side). */
+/* Default gains, output side: gentle (a first try on real hardware should not snap), well
+ * inside the wire range (kp 0..2128 N*m/rad, kd 0..21.28 N*m*s/rad on the output side);
+ * kd gives a damping ratio near 0.7 on the simulator's rotor (2e-6 kg m^2). */
 #define DEFAULT_KP_OUTPUT 20.0
-#define DEFAULT_KD_OUTPUT 0.5
+#define DEFAULT_KD_OUTPUT 2.5
 #define DEFAULT_RATE_HZ 200.0
 #define DEFAULT_MOVE_SPEED_OUTPUT 1.0 /* rad/s */
 
@@ -635,7 +636,7 @@ static const char hold_help[] =
     "usage: j288 [--port DEV] hold --id N [--kp NM_RAD] [--kd NMS_RAD] [options]\n"
     "\n"
     "Hold servo N at the position it is at now (FOC, stiffness kp, damping kd), refreshing\n"
-    "the command at --rate. Default gains on the output side: kp 20 N*m/rad, kd 0.5\n"
+    "the command at --rate. Default gains on the output side: kp 20 N*m/rad, kd 2.5\n"
     "N*m*s/rad.\n" DRIVE_COMMON_HELP "\n" CLI_BUS_COMMON_HELP;
 
 int cli_cmd_hold(int argc, char **argv, const cli_global_t *g)
@@ -658,7 +659,7 @@ static const char move_help[] =
     "                 [--kd NMS_RAD] [--side output|rotor] [options]\n"
     "\n"
     "Move servo N from where it is to --pos along a ramp at --speed (default 1 rad/s on the\n"
-    "output side), then hold there. Default gains on the output side: kp 20 N*m/rad, kd 0.5\n"
+    "output side), then hold there. Default gains on the output side: kp 20 N*m/rad, kd 2.5\n"
     "N*m*s/rad.\n" DRIVE_COMMON_HELP "\n" CLI_BUS_COMMON_HELP;
 
 int cli_cmd_move(int argc, char **argv, const cli_global_t *g)

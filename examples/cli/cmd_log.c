@@ -6,6 +6,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include <sys/prctl.h>
+
 #include "cli_bus.h"
 #include "frameview.h"
 #include "json.h"
@@ -29,10 +31,11 @@ static const char log_help[] =
     "  --swing AMP    move each servo from where it starts through\n"
     "                 p0 + AMP (1 - cos(2 pi t / period)) / 2 and back, speed fed forward\n"
     "  --period S     period of the swing (default: --duration, one swing)\n"
-    "  --kp, --kd     gains for --hold/--swing (default output side 20 N*m/rad, 0.5 N*m*s/rad)\n"
+    "  --kp, --kd     gains for --hold/--swing (default output side 20 N*m/rad, 2.5 N*m*s/rad)\n"
     "  --watchdog W   on (default when driving) or off\n"
     "  --side S       units of AMP, gains and CSV: output (default) or rotor\n"
-    "Prints the achieved rate, missed deadlines (sweeps that ended after the next tick),\n"
+    "Prints the achieved rate, missed deadlines (sweeps that ended after the next tick was\n"
+    "due: that tick starts late; ticks a whole period behind are skipped, never bunched),\n"
     "bus statistics and, when driving, the tracking error. Ctrl-C or SIGTERM: every driven\n"
     "servo is sent lock before exiting (exit 130 / 143).\n"
     "Exit status: 0 done; 1 a servo never answered, device error; 2 bad arguments.\n"
@@ -177,7 +180,7 @@ static int base_command(const log_args_t *a, j288_cmd_raw_t *cmd)
 {
     j288_side_t side = a->side == 0 ? J288_SIDE_ROTOR : J288_SIDE_OUTPUT;
     double kp = a->have_kp ? a->kp : 20.0;
-    double kd = a->have_kd ? a->kd : 0.5;
+    double kd = a->have_kd ? a->kd : 2.5;
     int rc;
     memset(cmd, 0, sizeof *cmd);
     cmd->status = J288_MODE_FOC;
@@ -268,7 +271,7 @@ static int sweep(cli_bus_t *b, j288_sched_t *s, uint32_t timeout_us, bool ignore
 }
 
 typedef struct {
-    uint32_t cycles, missed, rows;
+    uint32_t cycles, missed, skipped, rows;
     double elapsed_s;
 } run_stats_t;
 
@@ -290,6 +293,7 @@ static void print_summary(const log_args_t *a, cli_bus_t *b, const j288_sched_t 
         cli_json_real(&j, "rate_hz", a->rate_hz);
         cli_json_real(&j, "achieved_hz", achieved);
         cli_json_uint(&j, "missed_deadlines", rs->missed);
+        cli_json_uint(&j, "skipped_ticks", rs->skipped);
         cli_json_uint(&j, "csv_rows", rs->rows);
         cli_json_begin_object(&j, "bus");
         cli_json_uint(&j, "transactions", bs->transactions);
@@ -328,9 +332,9 @@ static void print_summary(const log_args_t *a, cli_bus_t *b, const j288_sched_t 
         return;
     }
     printf("log: %lu cycles in %.3f s: achieved %.1f Hz (asked %.1f Hz), %lu missed "
-           "deadlines\n",
+           "deadlines, %lu ticks skipped\n",
            (unsigned long)rs->cycles, rs->elapsed_s, achieved, a->rate_hz,
-           (unsigned long)rs->missed);
+           (unsigned long)rs->missed, (unsigned long)rs->skipped);
     printf("bus: %lu transactions, %lu ok, %lu timeouts, %lu CRC errors, %lu wrong id, "
            "%lu collisions, %lu line errors, %lu stale bytes, %lu garbage bytes\n",
            (unsigned long)bs->transactions, (unsigned long)bs->ok, (unsigned long)bs->timeouts,
@@ -398,6 +402,9 @@ int cli_cmd_log(int argc, char **argv, const cli_global_t *g)
         }
     }
     cli_signals_install();
+    /* Best effort: wake from the tick sleeps within a microsecond rather than the default
+     * 50 us timer slack. */
+    (void)prctl(PR_SET_TIMERSLACK, 1ul, 0ul, 0ul, 0ul);
     if ((ec = cli_bus_open(&b, &o, 0)) != CLI_EXIT_OK) {
         return ec;
     }
@@ -536,10 +543,12 @@ int cli_cmd_log(int argc, char **argv, const cli_global_t *g)
         next += period_us;
         now = j288_linux_now_us();
         if ((int32_t)(next - now) < 0) {
-            /* The sweep ran past the next tick: count it, and do not burst to catch up. */
+            /* The sweep ran past the next tick: that tick starts late, at once. Ticks a
+             * whole period or more behind are skipped rather than sent in a burst. */
             rs.missed++;
-            while ((int32_t)(next - now) < 0) {
+            while ((int32_t)(next + period_us - now) <= 0) {
                 next += period_us;
+                rs.skipped++;
             }
         }
         rc = cli_bus_sleep_until(&b, next);

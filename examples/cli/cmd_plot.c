@@ -41,10 +41,30 @@ static bool have_program(const char *name)
     return false;
 }
 
-/* The servo ids present in the CSV, as a bit mask; -1 when it is not a log CSV. */
-static int csv_ids(const char *file, uint32_t *ids, unsigned long *rows)
+/* One CSV line of `j288 log` split at commas (the fields hold no commas). */
+#define CSV_FIELDS 12
+static int split_csv(char *line, char *field[CSV_FIELDS])
+{
+    int n = 0;
+    char *p = line;
+    line[strcspn(line, "\r\n")] = '\0';
+    while (n < CSV_FIELDS) {
+        field[n++] = p;
+        p = strchr(p, ',');
+        if (p == NULL) {
+            break;
+        }
+        *p++ = '\0';
+    }
+    return n;
+}
+
+/* Check the CSV and find the servo ids with at least one reply; -1 when it is not a log
+ * CSV or holds nothing to plot. */
+static int csv_scan(const char *file, uint32_t *ids, unsigned long *rows)
 {
     char line[512];
+    char *field[CSV_FIELDS];
     FILE *f = fopen(file, "r");
     *ids = 0;
     *rows = 0;
@@ -58,12 +78,11 @@ static int csv_ids(const char *file, uint32_t *ids, unsigned long *rows)
         return -1;
     }
     while (fgets(line, sizeof line, f) != NULL) {
-        const char *comma = strchr(line, ',');
         long id;
-        if (comma == NULL) {
+        if (split_csv(line, field) < CSV_FIELDS || strcmp(field[2], "1") != 0) {
             continue;
         }
-        id = strtol(comma + 1, NULL, 10);
+        id = strtol(field[1], NULL, 10);
         if (id >= 0 && id <= (long)J288_MAX_ID) {
             *ids |= (uint32_t)(1ul << id);
             (*rows)++;
@@ -71,9 +90,33 @@ static int csv_ids(const char *file, uint32_t *ids, unsigned long *rows)
     }
     fclose(f);
     if (*rows == 0u) {
-        cli_error("%s holds no rows to plot", file);
+        cli_error("%s holds no replies to plot", file);
         return -1;
     }
+    return 0;
+}
+
+/* Servo id's rows as a gnuplot datablock $sID: time pos speed torque pos_des. Re-reading the
+ * file per id keeps memory constant whatever the log's length. */
+static int write_datablock(FILE *gp, const char *file, unsigned id)
+{
+    char line[512];
+    char *field[CSV_FIELDS];
+    FILE *f = fopen(file, "r");
+    if (f == NULL) {
+        return -1;
+    }
+    fprintf(gp, "$s%u << EOD\n", id);
+    while (fgets(line, sizeof line, f) != NULL) {
+        if (split_csv(line, field) < CSV_FIELDS || strcmp(field[2], "1") != 0 ||
+            strtol(field[1], NULL, 10) != (long)id) {
+            continue;
+        }
+        fprintf(gp, "%s %s %s %s %s\n", field[0], field[3], field[4], field[5],
+                field[11][0] != '\0' ? field[11] : "NaN");
+    }
+    fprintf(gp, "EOD\n");
+    fclose(f);
     return 0;
 }
 
@@ -95,41 +138,51 @@ static void id_list(uint32_t ids, char *out, size_t len)
     }
 }
 
-static void write_script(FILE *gp, const char *csv, const char *png, const char *idlist)
+static int write_script(FILE *gp, const char *csv, const char *png, uint32_t ids,
+                        const char *idlist)
 {
-    static const char *const panels[3][3] = {{"4", "position (rad)", "pos"},
-                                             {"5", "speed (rad/s)", "speed"},
-                                             {"6", "torque (N*m)", "torque"}};
+    static const char *const panels[3][2] = {
+        {"2", "position (rad)"}, {"3", "speed (rad/s)"}, {"4", "torque (N*m)"}};
+    unsigned id;
     int p;
+    for (id = 0; id <= J288_MAX_ID; id++) {
+        if ((ids & (1u << id)) != 0u && write_datablock(gp, csv, id) != 0) {
+            return -1;
+        }
+    }
     fprintf(gp, "if (strstrt(GPVAL_TERMINALS, 'pngcairo') > 0) {\n"
                 "  set terminal pngcairo size 1000,900\n"
                 "} else {\n"
                 "  set terminal png size 1000,900\n"
                 "}\n");
     fprintf(gp, "set output '%s'\n", png);
-    fprintf(gp, "set datafile separator ','\n"
-                "set datafile missing ''\n"
-                "set grid\nset key outside right\n");
-    fprintf(gp, "ids = '%s'\n", idlist);
-    fprintf(gp, "set multiplot layout 3,1 title 'j288 log: %s'\n", csv);
+    fprintf(gp, "set grid\nset key outside right\n");
+    fprintf(gp, "set multiplot layout 3,1 title 'j288 log: %s (servos %s)'\n", csv, idlist);
     for (p = 0; p < 3; p++) {
+        const char *sep = "plot ";
         fprintf(gp, "set ylabel '%s'\n", panels[p][1]);
         fprintf(gp, "%s", p == 2 ? "set xlabel 'time (s)'\n" : "unset xlabel\n");
-        fprintf(gp,
-                "plot for [k=1:words(ids)] '%s' every ::1 using 1:((column(2) == "
-                "word(ids,k)+0 && column(3) == 1) ? column(%s) : NaN) with lines lw 1.5 "
-                "title sprintf('servo %%s', word(ids,k))",
-                csv, panels[p][0]);
+        for (id = 0; id <= J288_MAX_ID; id++) {
+            if ((ids & (1u << id)) != 0u) {
+                fprintf(gp, "%s$s%u using 1:%s with lines lw 1.5 title 'servo %u'", sep, id,
+                        panels[p][0], id);
+                sep = ", ";
+            }
+        }
         if (p == 0) {
-            fprintf(gp,
-                    ", for [k=1:words(ids)] '%s' every ::1 using 1:(column(2) == "
-                    "word(ids,k)+0 ? column(12) : NaN) with lines dt 2 lc rgb 'gray40' "
-                    "title (k == 1 ? 'commanded' : '')",
-                    csv);
+            bool first = true;
+            for (id = 0; id <= J288_MAX_ID; id++) {
+                if ((ids & (1u << id)) != 0u) {
+                    fprintf(gp, ", $s%u using 1:5 with lines dt 2 lc rgb 'gray40' title '%s'",
+                            id, first ? "commanded" : "");
+                    first = false;
+                }
+            }
         }
         fprintf(gp, "\n");
     }
     fprintf(gp, "unset multiplot\nset output\n");
+    return 0;
 }
 
 int cli_cmd_plot(int argc, char **argv, const cli_global_t *g)
@@ -174,7 +227,7 @@ int cli_cmd_plot(int argc, char **argv, const cli_global_t *g)
         cli_error("file names with quotes or line breaks cannot be passed to gnuplot");
         return CLI_EXIT_USAGE;
     }
-    if (csv_ids(csv, &ids, &rows) != 0) {
+    if (csv_scan(csv, &ids, &rows) != 0) {
         return CLI_EXIT_FAIL;
     }
     if (!have_program("gnuplot")) {
@@ -198,7 +251,12 @@ int cli_cmd_plot(int argc, char **argv, const cli_global_t *g)
         return CLI_EXIT_FAIL;
     }
     id_list(ids, idlist, sizeof idlist);
-    write_script(gp, csv, png, idlist);
+    if (write_script(gp, csv, png, ids, idlist) != 0) {
+        cli_error("cannot read %s", csv);
+        (void)pclose(gp);
+        remove(errfile);
+        return CLI_EXIT_FAIL;
+    }
     status = pclose(gp);
     {
         FILE *ef = fopen(errfile, "r");
