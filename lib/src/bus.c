@@ -147,10 +147,14 @@ static void ring_put(j288_bus_t *bus, const uint8_t *data, size_t len)
     uint32_t head = bus->ring_head;
     uint32_t room = J288_CONFIG_RX_RING_SIZE - (uint32_t)(head - bus->ring_tail);
     size_t n = (len < room) ? len : room;
-    size_t i;
+    size_t off = head & RING_MASK;
+    size_t first = J288_CONFIG_RX_RING_SIZE - off; /* bytes before the end of the array */
 
-    for (i = 0u; i < n; i++) {
-        bus->ring[(head + (uint32_t)i) & RING_MASK] = data[i];
+    if (n <= first) {
+        memcpy(&bus->ring[off], data, n);
+    } else {
+        memcpy(&bus->ring[off], data, first);
+        memcpy(bus->ring, &data[first], n - first);
     }
     if (n < len) {
         bus->stats.rx_overflows += (uint32_t)(len - n);

@@ -90,6 +90,8 @@ struct fake_port {
     uint32_t echo_delay_ns;     /* receive path delay of the echo (e.g. a FIFO) */
     bool idle;                  /* report rx idle one byte time after each reply; default on */
     uint32_t turnaround_ns;     /* default servo turnaround: 10000 (10 us) */
+    uint32_t rx_latency_ns;     /* servo reply bytes reach the bus this much later (an
+                                   idle-line DMA interrupt, ISR latency); idle too */
     int start_tx_fail;          /* > 0: that many next start_tx calls return J288_ERR_PORT */
     bool gone;                  /* wait() returns J288_ERR_OFFLINE */
     fake_poll_fn poll_fn;
@@ -174,6 +176,11 @@ void fake_port_encode_reply(const j288_reply_raw_t *reply, uint8_t out[J288_REPL
 /* Ready-made poll hooks: poll_user is the j288_bus_t* (or the j288_sched_t*). */
 void fake_port_poll_bus(void *bus, uint32_t now_us);
 void fake_port_poll_sched(void *sched, uint32_t now_us);
+
+/* The one place where the fake calls into the bus (kind: internal event kind; 0 = timer).
+ * Exposed so that benchmarks can count the instructions spent inside the library. */
+void fake_port_deliver(fake_port_t *fp, int kind, const uint8_t *data, size_t len,
+                       uint32_t flags);
 
 /* A crc32 op (software, counting calls) to test the port's CRC hook. */
 uint32_t fake_port_crc32(void *ctx, const uint8_t *data, size_t nwords);

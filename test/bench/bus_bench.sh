@@ -1,0 +1,52 @@
+#!/usr/bin/env bash
+# Bus timing model and instructions per transaction; run by `make bench-bus`.
+set -euo pipefail
+bin=${BIN:-build/bin}/bus_timing
+turn=${ENGINE_BENCH_TURNAROUND:-0 10 20 50}
+out=${BUILD:-build}/bench-bus
+mkdir -p "$out"
+
+echo "### Sweep time against wire time (virtual clock, 6 Mbps 8N1, guard 2 us)"
+echo
+"$bin" --turnaround "$turn"
+echo
+echo "### The same with the reply handed over one character time late (idle-line DMA)"
+echo
+"$bin" --turnaround "10" --rx-latency 1667
+
+echo
+if ! command -v valgrind >/dev/null 2>&1; then
+    if [ "${CI:-}" = true ]; then echo "bench-bus: valgrind not found (CI=true: failure)" >&2; exit 1; fi
+    echo "bench-bus: skipping instruction counts; install with: apt-get install -y --no-install-recommends valgrind"
+    exit 0
+fi
+# Collected only inside the library's entry points (fake_port_deliver: the port's events;
+# bench_poll/bench_start: the application's calls). Two run lengths, the difference divided by
+# the difference in transactions, so set-up costs cancel.
+count() { # count MODE N -> "transactions Ir_total Ir_in_fake_port"
+    local f="$out/callgrind.$1.$2"
+    valgrind --tool=callgrind --callgrind-out-file="$f" --toggle-collect=fake_port_deliver \
+        --toggle-collect=bench_poll --toggle-collect=bench_start \
+        "$bin" --count "$2" $([ "$1" = poll ] && echo --poll) >"$f.txt" 2>/dev/null
+    local n ir fake
+    n=$(awk '/transactions/ {print $1}' "$f.txt")
+    ir=$(awk '/^summary:/ {print $2}' "$f")
+    # self cost of the fake port's own functions (its ops, called from inside the library)
+    fake=$(callgrind_annotate --threshold=100 "$f" 2>/dev/null |
+        awk '/fake_port\.c:/ { gsub(",", "", $1); s += $1 } END { print s + 0 }')
+    echo "$n $ir $fake"
+}
+echo "### Host instructions per transaction (x86-64, callgrind, 15 servos, continuous sweeps)"
+echo
+echo "| bus advanced | Ir per transaction, library | of which table CRC | with the fake port's ops |"
+echo "|---|---:|---:|---:|"
+for mode in isr poll; do
+    read -r n1 i1 f1 < <(count "$mode" 3000)
+    read -r n2 i2 f2 < <(count "$mode" 6000)
+    crc=$(callgrind_annotate --inclusive=yes --threshold=100 "$out/callgrind.$mode.6000" 2>/dev/null |
+        awk '/crc32\.c:j288_crc32_run / && !v { gsub(",", "", $1); v = $1 } END { print v + 0 }')
+    awk -v n1="$n1" -v i1="$i1" -v f1="$f1" -v n2="$n2" -v i2="$i2" -v f2="$f2" -v c="${crc:-0}" -v m="$mode" \
+        'BEGIN { d = n2 - n1; printf "| %s | %.0f | %.0f | %.0f |\n",
+                 (m == "isr" ? "in the event calls (advance_in_isr)" : "by poll after each event"),
+                 ((i2 - f2) - (i1 - f1)) / d, c / n2, (i2 - i1) / d }'
+done
