@@ -48,3 +48,4 @@ $(LINUX_BENCH): $(OBJ)/test/linux/bench_linux_port.o $(LINUX_A) $(LIB_A)
 .PHONY: bench-linux
 bench-linux: $(LINUX_BENCH) $(BIN)/j288-sim
 	$(LINUX_BENCH) $(BIN)/j288-sim 5000
+ALL_TARGETS += $(LINUX_BENCH)
