@@ -49,3 +49,11 @@ foreach(src ${J288_UNIT_TESTS})
     set_target_properties(${name} PROPERTIES C_STANDARD 99 C_EXTENSIONS OFF)
     add_test(NAME ${name} COMMAND ${name} WORKING_DIRECTORY "${PROJECT_SOURCE_DIR}")
 endforeach()
+
+# The committed golden vectors must equal a fresh regeneration (as `make test` checks).
+find_program(J288_PYTHON3 python3)
+if(J288_PYTHON3)
+    add_test(NAME vectors_drift COMMAND env BUILD=${CMAKE_BINARY_DIR} PYTHON=${J288_PYTHON3}
+             bash tools/vectors/check-drift.sh
+             WORKING_DIRECTORY "${PROJECT_SOURCE_DIR}")
+endif()

@@ -8,13 +8,14 @@ fresh="$build/vectors-fresh"
 rm -rf "$fresh"
 mkdir -p "$fresh"
 "$python" tools/vectors/gen_vectors.py --out "$fresh"
-status=0
+status=0 n=0 bad=0
 for f in "$fresh"/*; do
+    n=$((n + 1))
     name=$(basename "$f")
     if ! cmp -s "$f" "test/vectors/$name"; then
         echo "FAIL: test/vectors/$name differs from a fresh regeneration (run: make vectors)"
         diff -u "test/vectors/$name" "$f" | head -n 20 || true
-        status=1
+        status=1 bad=$((bad + 1))
     fi
 done
 for f in test/vectors/*; do
@@ -22,4 +23,5 @@ for f in test/vectors/*; do
     [ -e "$fresh/$(basename "$f")" ] || { echo "FAIL: $f is not produced by the generator"; status=1; }
 done
 [ $status -eq 0 ] && echo "vectors: committed files equal a fresh regeneration"
+echo "$n Tests $bad Failures 0 Ignored"
 exit $status
