@@ -158,6 +158,8 @@ SIZE_BACKENDS := table nibble hw
 SIZE_table_DEFS := -DJ288_CONFIG_CRC_BACKEND=J288_CRC_BACKEND_TABLE -DJ288_STM32_HW_CRC=0
 SIZE_nibble_DEFS := -DJ288_CONFIG_CRC_BACKEND=J288_CRC_BACKEND_NIBBLE -DJ288_STM32_HW_CRC=0
 SIZE_hw_DEFS := -DJ288_CONFIG_CRC_BACKEND=J288_CRC_BACKEND_HW -DJ288_CONFIG_CRC_HW_FUNCTION=j288_stm32_crc32_default
+# The smallest Cortex-M0 build: CRC unit, raw integers only (no SI API, no soft float).
+SIZE_hw-nosi_DEFS := $(SIZE_hw_DEFS) -DJ288_CONFIG_SI=0
 SIZE_SRC := $(LIB_SRC) $(STM32_PORT_SRC) $(STM32_STUB_DIR)/stm32_hal_stub.c test/target/size_probe.c
 
 # $(1): core, $(2): backend
@@ -176,6 +178,7 @@ endef
 SIZE_DIRS :=
 SIZE_ELFS :=
 $(foreach c,$(SIZE_CORES),$(foreach b,$(SIZE_BACKENDS),$(eval $(call SIZE_RULES,$(c),$(b)))))
+$(eval $(call SIZE_RULES,m0,hw-nosi))
 
 .PHONY: size
 size: $(SIZE_ELFS)
