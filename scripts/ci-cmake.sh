@@ -11,7 +11,6 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 root=${CMAKE_BUILD_ROOT:-build/cmake}
 jobs=$(nproc 2>/dev/null || echo 2)
-gen=()
 mkdir -p "$root"
 root=$(cd "$root" && pwd)
 
@@ -23,11 +22,17 @@ need() { # need TOOL PACKAGE
 }
 need cmake cmake || exit 0
 
+# Unity: the one the user points at, else the copy a Make build already fetched, else CMake
+# fetches its own (scripts/fetch-unity.sh).
 unity_args=()
-if [ -n "${UNITY_DIR:-}" ]; then unity_args=(-DUNITY_DIR="$UNITY_DIR"); fi
+if [ -n "${UNITY_DIR:-}" ]; then
+    unity_args=(-DUNITY_DIR="$UNITY_DIR")
+elif [ -f "${BUILD:-build}/unity/unity.c" ]; then
+    unity_args=(-DUNITY_DIR="$(cd "${BUILD:-build}/unity" && pwd)")
+fi
 
 echo "== cmake: host build and ctest"
-cmake "${gen[@]}" -S . -B "$root/host" -DCMAKE_BUILD_TYPE=RelWithDebInfo "${unity_args[@]}" >/dev/null
+cmake -S . -B "$root/host" -DCMAKE_BUILD_TYPE=RelWithDebInfo "${unity_args[@]}" >/dev/null
 cmake --build "$root/host" -j "$jobs"
 (cd "$root/host" && ctest --output-on-failure -j "$jobs")
 
