@@ -107,7 +107,8 @@ static void usage(FILE *f)
           "  --ambient C         ambient temperature (default 25)\n"
           "  --load-inertia J    extra inertia on each output shaft, kg m^2 (default 0)\n"
           "  --load-torque NM    constant torque on each output shaft, N m (default 0)\n"
-          "  --turnaround-us N   reply delay (default 20)\n"
+          "  --turnaround-us N   extra reply delay (default 0: at once;\n"
+          "                      the pty adds tens of microseconds itself)\n"
           "  --echo              send every received byte straight back, as a single-wire\n"
           "                      adapter that hears its own transmit does\n"
           "  --log FILE          one line per received command frame ('-' = stderr)\n"
@@ -203,7 +204,7 @@ static void parse_args(options_t *o, int argc, char **argv)
     memset(o, 0, sizeof *o);
     o->ids = 1u << 1;
     o->bus.seed = 1u;
-    o->bus.turnaround_us = 20u;
+    o->bus.turnaround_us = 0u;
     j288_sim_params_default(&o->prm);
     for (i = 1; i < argc; i++) {
         const char *a = argv[i];
