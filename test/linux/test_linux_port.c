@@ -437,6 +437,24 @@ static void test_injected_faults_give_bus_errors(void)
         TEST_ASSERT_EQUAL_INT(J288_OK, j288_bus_transfer_blocking(&g_bus, &c, NULL));
 }
 
+static void test_late_replies_never_credited(void)
+{
+    j288_cmd_raw_t c = lock_cmd(1);
+    int i;
+    uint32_t discarded;
+    /* Every reply comes 15 ms late, after the 10 ms margin: each must count as stale (by the
+     * bus during its guard, or by the port before the next transmit), never as the next
+     * transaction's reply. */
+    sim_start("--late", "1", "--late-us", "15000", NULL);
+    open_sim_port();
+    for (i = 0; i < 6; i++)
+        TEST_ASSERT_EQUAL_INT(J288_ERR_TIMEOUT, j288_bus_transfer_blocking(&g_bus, &c, NULL));
+    (void)j288_linux_run(&g_lp, NULL, j288_linux_now_us() + 30000u, 0);
+    discarded = j288_bus_stats(&g_bus)->stale_bytes + j288_linux_stats(&g_lp)->flushed_bytes;
+    TEST_ASSERT_EQUAL_UINT32(6u * J288_REPLY_LEN, discarded);
+    TEST_ASSERT_EQUAL_UINT32(0, j288_bus_stats(&g_bus)->ok);
+}
+
 static void test_echoing_adapter(void)
 {
     j288_linux_options_t opt;
@@ -472,6 +490,7 @@ int main(void)
     RUN_TEST(test_eintr_storm);
     RUN_TEST(test_stop_flag_aborts_run);
     RUN_TEST(test_injected_faults_give_bus_errors);
+    RUN_TEST(test_late_replies_never_credited);
     RUN_TEST(test_echoing_adapter);
     return UNITY_END();
 }
