@@ -38,3 +38,25 @@ bench-codec: $(CODEC_BENCH)
 	for m in $(CODEC_BENCH_MODES); do \
 	    t=$$(ir $$m); echo "  $$m: $$(( (t - base) / $(CODEC_BENCH_N) ))"; \
 	done
+
+# The codec tests again with each compile-time CRC backend (J288_CONFIG_CRC_BACKEND): nibble,
+# bitwise, and HW through J288_CONFIG_CRC_HW_FUNCTION (a stand-in from test/support). Each
+# variant is a sub-build in $(BUILD)/crc-<variant>; its binaries run in `make test`.
+CODEC_CRC_VARIANTS := nibble bitwise hw
+CODEC_CRC_FLAGS_nibble := -DJ288_CONFIG_CRC_BACKEND=J288_CRC_BACKEND_NIBBLE
+CODEC_CRC_FLAGS_bitwise := -DJ288_CONFIG_CRC_BACKEND=J288_CRC_BACKEND_BITWISE
+CODEC_CRC_FLAGS_hw := -DJ288_CONFIG_CRC_BACKEND=J288_CRC_BACKEND_HW \
+                      -DJ288_CONFIG_CRC_HW_FUNCTION=codec_hw_crc_stub
+CODEC_CRC_TEST_NAMES := test_crc32 test_frame test_parser
+CODEC_CRC_TESTS := $(foreach v,$(CODEC_CRC_VARIANTS),$(CODEC_CRC_TEST_NAMES:%=$(BUILD)/crc-$(v)/test/%))
+
+.PHONY: codec-force
+codec-force:
+
+# One sub-make per variant builds all its test binaries (grouped pattern targets).
+$(CODEC_CRC_TEST_NAMES:%=$(BUILD)/crc-\%/test/%): $(UNITY)/unity.c codec-force
+	@$(MAKE) --no-print-directory BUILD=$(BUILD)/crc-$* UNITY_DIR=$(abspath $(UNITY)) \
+	    CC=$(CC) EXTRA_CFLAGS='$(EXTRA_CFLAGS) $(CODEC_CRC_FLAGS_$*)' \
+	    $(CODEC_CRC_TEST_NAMES:%=$(BUILD)/crc-$*/test/%)
+
+HOST_TESTS += $(CODEC_CRC_TESTS)

@@ -70,6 +70,17 @@ void codec_fix_reply_crc(uint8_t frame[26])
     put_le32(&frame[22], codec_ref_crc(0xFFFFFFFFu, &frame[2], 20u));
 }
 
+/* Test-only state: a call counter for the hardware-CRC stand-in (tests are single-threaded). */
+static unsigned long hw_crc_calls;
+
+unsigned long *codec_hw_crc_calls_ptr(void) { return &hw_crc_calls; }
+
+uint32_t codec_hw_crc_stub(const uint8_t *data, size_t nwords)
+{
+    hw_crc_calls++;
+    return codec_ref_crc(0xFFFFFFFFu, data, 4u * nwords);
+}
+
 static int hex_digit(char c)
 {
     if (c >= '0' && c <= '9') {

@@ -34,6 +34,13 @@ void codec_fix_reply_crc(uint8_t frame[26]);
  * count or more than cap bytes. */
 int codec_hex_decode(const char *hex, uint8_t *out, size_t cap);
 
+/* A stand-in for a hardware CRC unit with the signature J288_CONFIG_CRC_HW_FUNCTION needs,
+ * computed by codec_ref_crc(); it counts its calls in *codec_hw_crc_calls_ptr() so a test can
+ * tell it was used. Builds with -DJ288_CONFIG_CRC_BACKEND=J288_CRC_BACKEND_HW
+ * -DJ288_CONFIG_CRC_HW_FUNCTION=codec_hw_crc_stub use it (make test: crc-hw variant). */
+uint32_t codec_hw_crc_stub(const uint8_t *data, size_t nwords);
+unsigned long *codec_hw_crc_calls_ptr(void);
+
 /* Fill with a canary pattern / check it is still there (1) or not (0). */
 void codec_canary_fill(void *buf, size_t len);
 int codec_canary_intact(const void *buf, size_t len);

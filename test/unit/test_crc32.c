@@ -199,6 +199,22 @@ static void test_frame_codec_uses_engine(void)
     TEST_ASSERT_EQUAL_INT(J288_ERR_CRC, j288_reply_decode(r, &rep, NULL));
 }
 
+/* The compile-time default backend is the configured one (make test builds the variants). */
+static void test_compile_time_backend(void)
+{
+    uint8_t buf[8] = {1, 2, 3, 4, 5, 6, 7, 8};
+    unsigned long before = *codec_hw_crc_calls_ptr();
+    uint32_t want = codec_ref_crc(0xFFFFFFFFu, buf, sizeof buf);
+    TEST_ASSERT_EQUAL_HEX32(want, j288_crc32(buf, 2u));
+    TEST_ASSERT_EQUAL_HEX32(want, j288_crc32_run(NULL, buf, 2u));
+#if J288_CONFIG_CRC_BACKEND == J288_CRC_BACKEND_HW
+    TEST_ASSERT_EQUAL_UINT32(before + 2u, *codec_hw_crc_calls_ptr());
+#else
+    TEST_ASSERT_EQUAL_UINT32(before, *codec_hw_crc_calls_ptr());
+    TEST_ASSERT_EQUAL_HEX32(want, codec_hw_crc_stub(buf, 2u)); /* the stand-in itself */
+#endif
+}
+
 /* Little-endian helpers never depend on alignment or host order. */
 static void test_le_helpers(void)
 {
@@ -224,6 +240,7 @@ int main(void)
     RUN_TEST(test_streaming_in_pieces);
     RUN_TEST(test_runtime_engine_is_used);
     RUN_TEST(test_frame_codec_uses_engine);
+    RUN_TEST(test_compile_time_backend);
     RUN_TEST(test_le_helpers);
     return UNITY_END();
 }
