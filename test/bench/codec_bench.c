@@ -12,18 +12,18 @@
 
 #include "j288/j288.h"
 
-static const uint8_t reply3[J288_REPLY_LEN] = {
-    0xfc, 0xee, 0x13, 0x24, 0x29, 0x30, 0x00, 0x05, 0xd7, 0xff, 0x5f, 0x14, 0x00,
-    0x00, 0x00, 0x00, 0x00, 0x00, 0xe8, 0x03, 0x00, 0x00, 0x49, 0xc2, 0x3b, 0xee};
+static const uint8_t reply3[J288_REPLY_LEN] = {0xfc, 0xee, 0x13, 0x24, 0x29, 0x30, 0x00, 0x05, 0xd7,
+                                               0xff, 0x5f, 0x14, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00,
+                                               0xe8, 0x03, 0x00, 0x00, 0x49, 0xc2, 0x3b, 0xee};
 
 /* Keeps results alive so the optimiser cannot drop the work. */
 static volatile uint32_t sink;
 
 int main(int argc, char **argv)
 {
-    static const char *const modes[] = {"none",         "crc-table",   "crc-nibble",
-                                        "crc-bitwise",  "cmd-encode",  "reply-decode",
-                                        "parse-chunk",  "parse-bytes", "cmd-from-si"};
+    static const char *const modes[] = {"none",        "crc-table",   "crc-nibble",
+                                        "crc-bitwise", "cmd-encode",  "reply-decode",
+                                        "parse-chunk", "parse-bytes", "cmd-from-si"};
     const char *name = argc > 1 ? argv[1] : "none";
     int mode = -1, m;
     unsigned long n = argc > 2 ? strtoul(argv[2], NULL, 10) : 10000ul;

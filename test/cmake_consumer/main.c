@@ -7,8 +7,8 @@
 
 int main(void)
 {
-    static const uint8_t want[J288_CMD_LEN] = {0xfe, 0xee, 0x80, 0, 0, 0, 0, 0, 0, 0,
-                                               0, 0, 0, 0, 0, 0, 0x1d, 0x99, 0xfb, 0x6e};
+    static const uint8_t want[J288_CMD_LEN] = {0xfe, 0xee, 0x80, 0, 0, 0, 0,    0,    0,    0,
+                                               0,    0,    0,    0, 0, 0, 0x1d, 0x99, 0xfb, 0x6e};
     j288_cmd_raw_t cmd;
     uint8_t out[J288_CMD_LEN];
     memset(&cmd, 0, sizeof cmd);

@@ -1,7 +1,10 @@
 /* Helpers for the codec unit tests; see codec_support.h. */
 #include "codec_support.h"
 
-void codec_rng_seed(codec_rng_t *r, uint32_t seed) { r->s = (seed != 0u) ? seed : 1u; }
+void codec_rng_seed(codec_rng_t *r, uint32_t seed)
+{
+    r->s = (seed != 0u) ? seed : 1u;
+}
 
 uint32_t codec_rng_u32(codec_rng_t *r)
 {
@@ -13,7 +16,10 @@ uint32_t codec_rng_u32(codec_rng_t *r)
     return s;
 }
 
-uint32_t codec_rng_below(codec_rng_t *r, uint32_t n) { return codec_rng_u32(r) % n; }
+uint32_t codec_rng_below(codec_rng_t *r, uint32_t n)
+{
+    return codec_rng_u32(r) % n;
+}
 
 void codec_rng_fill(codec_rng_t *r, uint8_t *buf, size_t len)
 {
@@ -63,7 +69,10 @@ static void put_le32(uint8_t *p, uint32_t v)
     p[3] = (uint8_t)(v >> 24);
 }
 
-void codec_fix_cmd_crc(uint8_t frame[20]) { put_le32(&frame[16], codec_ref_crc(0xFFFFFFFFu, frame, 16u)); }
+void codec_fix_cmd_crc(uint8_t frame[20])
+{
+    put_le32(&frame[16], codec_ref_crc(0xFFFFFFFFu, frame, 16u));
+}
 
 void codec_fix_reply_crc(uint8_t frame[26])
 {
@@ -73,7 +82,10 @@ void codec_fix_reply_crc(uint8_t frame[26])
 /* Test-only state: a call counter for the hardware-CRC stand-in (tests are single-threaded). */
 static unsigned long hw_crc_calls;
 
-unsigned long *codec_hw_crc_calls_ptr(void) { return &hw_crc_calls; }
+unsigned long *codec_hw_crc_calls_ptr(void)
+{
+    return &hw_crc_calls;
+}
 
 uint32_t codec_hw_crc_stub(const uint8_t *data, size_t nwords)
 {
@@ -121,7 +133,7 @@ int codec_hex_decode(const char *hex, uint8_t *out, size_t cap)
     return (hi < 0) ? (int)n : -1;
 }
 
-#define CODEC_CANARY(i) ((uint8_t)(0xA5u ^ (uint8_t)((i) * 7u)))
+#define CODEC_CANARY(i) ((uint8_t)(0xA5u ^ (uint8_t)((i)*7u)))
 
 void codec_canary_fill(void *buf, size_t len)
 {

@@ -12,11 +12,26 @@ void tearDown(void) {}
 
 typedef uint32_t (*update_fn)(uint32_t, const uint8_t *, size_t);
 
-static uint32_t whole_table(const uint8_t *d, size_t n) { return j288_crc32_update_table(J288_CRC32_INIT, d, n); }
-static uint32_t whole_nibble(const uint8_t *d, size_t n) { return j288_crc32_update_nibble(J288_CRC32_INIT, d, n); }
-static uint32_t whole_bitwise(const uint8_t *d, size_t n) { return j288_crc32_update_bitwise(J288_CRC32_INIT, d, n); }
-static uint32_t whole_default(const uint8_t *d, size_t n) { return j288_crc32(d, n); }
-static uint32_t whole_run_null(const uint8_t *d, size_t n) { return j288_crc32_run(NULL, d, n); }
+static uint32_t whole_table(const uint8_t *d, size_t n)
+{
+    return j288_crc32_update_table(J288_CRC32_INIT, d, n);
+}
+static uint32_t whole_nibble(const uint8_t *d, size_t n)
+{
+    return j288_crc32_update_nibble(J288_CRC32_INIT, d, n);
+}
+static uint32_t whole_bitwise(const uint8_t *d, size_t n)
+{
+    return j288_crc32_update_bitwise(J288_CRC32_INIT, d, n);
+}
+static uint32_t whole_default(const uint8_t *d, size_t n)
+{
+    return j288_crc32(d, n);
+}
+static uint32_t whole_run_null(const uint8_t *d, size_t n)
+{
+    return j288_crc32_run(NULL, d, n);
+}
 static uint32_t whole_run_nullfn(const uint8_t *d, size_t n)
 {
     const j288_crc_t engine = {NULL, NULL};
@@ -29,8 +44,8 @@ typedef struct {
 } backend_t;
 
 static const backend_t backends[] = {
-    {"table", whole_table},       {"nibble", whole_nibble},     {"bitwise", whole_bitwise},
-    {"default", whole_default},   {"run(NULL)", whole_run_null}, {"run(fn NULL)", whole_run_nullfn},
+    {"table", whole_table},     {"nibble", whole_nibble},      {"bitwise", whole_bitwise},
+    {"default", whole_default}, {"run(NULL)", whole_run_null}, {"run(fn NULL)", whole_run_nullfn},
 };
 #define N_BACKENDS (sizeof backends / sizeof backends[0])
 

@@ -72,7 +72,8 @@ static j288_reply_raw_t golden_reply_fields(const golden_reply_t *g)
     return r;
 }
 
-static void assert_cmd_equal(const j288_cmd_raw_t *want, const j288_cmd_raw_t *got, const char *name)
+static void assert_cmd_equal(const j288_cmd_raw_t *want, const j288_cmd_raw_t *got,
+                             const char *name)
 {
     TEST_ASSERT_EQUAL_UINT8_MESSAGE(want->id, got->id, name);
     TEST_ASSERT_EQUAL_UINT8_MESSAGE(want->status, got->status, name);
@@ -473,14 +474,34 @@ static void test_fault_and_warning_names(void)
 
 static void test_strerror_every_code(void)
 {
-    static const int codes[] = {
-        J288_OK, J288_ERR_NULL, J288_ERR_BAD_ID, J288_ERR_BAD_STATUS, J288_ERR_NEG_GAIN,
-        J288_ERR_RANGE_TAU, J288_ERR_RANGE_SPEED, J288_ERR_RANGE_POS, J288_ERR_RANGE_KP,
-        J288_ERR_RANGE_KD, J288_ERR_NOT_FINITE, J288_ERR_RANGE, J288_ERR_BAD_ARG,
-        J288_ERR_BAD_CONFIG, J288_ERR_PORT_OPS, J288_ERR_BAD_HEADER, J288_ERR_CRC,
-        J288_ERR_TRUNCATED, J288_ERR_BUSY, J288_ERR_TIMEOUT, J288_ERR_WRONG_ID,
-        J288_ERR_COLLISION, J288_ERR_LINE, J288_ERR_PORT, J288_ERR_TX_TIMEOUT, J288_ERR_ABORTED,
-        J288_ERR_OVERFLOW, J288_ERR_OFFLINE};
+    static const int codes[] = {J288_OK,
+                                J288_ERR_NULL,
+                                J288_ERR_BAD_ID,
+                                J288_ERR_BAD_STATUS,
+                                J288_ERR_NEG_GAIN,
+                                J288_ERR_RANGE_TAU,
+                                J288_ERR_RANGE_SPEED,
+                                J288_ERR_RANGE_POS,
+                                J288_ERR_RANGE_KP,
+                                J288_ERR_RANGE_KD,
+                                J288_ERR_NOT_FINITE,
+                                J288_ERR_RANGE,
+                                J288_ERR_BAD_ARG,
+                                J288_ERR_BAD_CONFIG,
+                                J288_ERR_PORT_OPS,
+                                J288_ERR_BAD_HEADER,
+                                J288_ERR_CRC,
+                                J288_ERR_TRUNCATED,
+                                J288_ERR_BUSY,
+                                J288_ERR_TIMEOUT,
+                                J288_ERR_WRONG_ID,
+                                J288_ERR_COLLISION,
+                                J288_ERR_LINE,
+                                J288_ERR_PORT,
+                                J288_ERR_TX_TIMEOUT,
+                                J288_ERR_ABORTED,
+                                J288_ERR_OVERFLOW,
+                                J288_ERR_OFFLINE};
     const size_t n = sizeof codes / sizeof codes[0];
     size_t i, j;
     const char *unknown = j288_strerror(12345);

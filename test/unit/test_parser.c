@@ -17,7 +17,7 @@ void tearDown(void) {}
 /* Small enough for a 16 KiB-RAM Cortex-M0 (the tests also run on targets): long streams are
  * fed in batches of BATCH frames through the same parser. */
 #define MAX_FRAMES 64u
-#define BATCH 50u
+#define BATCH      50u
 #define STREAM_CAP 2600u
 
 static uint8_t stream[STREAM_CAP];
@@ -69,9 +69,9 @@ static size_t feed_chunks(j288_parser_t *p, const uint8_t *data, size_t len, siz
 static void assert_accounting(const j288_parser_t *p, size_t fed)
 {
     const j288_parser_stats_t *s = &p->stats;
-    TEST_ASSERT_EQUAL_UINT((unsigned)fed, (unsigned)(s->garbage_bytes + s->dropped_bytes +
-                                                     s->frames * p->frame_len +
-                                                     j288_parser_pending(p)));
+    TEST_ASSERT_EQUAL_UINT((unsigned)fed,
+                           (unsigned)(s->garbage_bytes + s->dropped_bytes +
+                                      s->frames * p->frame_len + j288_parser_pending(p)));
 }
 
 static void assert_stats(const j288_parser_t *p, uint32_t frames, uint32_t garbage,
@@ -113,7 +113,10 @@ static const uint8_t *reply_named(const char *name)
 }
 
 /* A reply without 0xFC anywhere after its head (so no false head inside). */
-static const uint8_t *plain_reply(void) { return reply_named("spec_reply_id3"); }
+static const uint8_t *plain_reply(void)
+{
+    return reply_named("spec_reply_id3");
+}
 
 static void test_api_errors(void)
 {
@@ -153,7 +156,8 @@ static void test_back_to_back_any_chunking(void)
             TEST_ASSERT_EQUAL_UINT(n, feed_chunks(&p, stream, len, chunks[c], &rng));
             for (i = 0; i < n; i++) {
                 TEST_ASSERT_EQUAL_HEX8_ARRAY_MESSAGE(golden_replies[first + i].frame, got[i],
-                                                     J288_REPLY_LEN, golden_replies[first + i].name);
+                                                     J288_REPLY_LEN,
+                                                     golden_replies[first + i].name);
             }
         }
         assert_stats(&p, GOLDEN_REPLY_COUNT, 0, 0, 0, 0);
@@ -193,8 +197,8 @@ static void test_commands_back_to_back(void)
         }
         TEST_ASSERT_EQUAL_UINT(n, feed_chunks(&p, stream, len, 0u, &rng));
         for (i = 0; i < n; i++) {
-            TEST_ASSERT_EQUAL_HEX8_ARRAY_MESSAGE(golden_cmds[first + i].frame, got[i],
-                                                 J288_CMD_LEN, golden_cmds[first + i].name);
+            TEST_ASSERT_EQUAL_HEX8_ARRAY_MESSAGE(golden_cmds[first + i].frame, got[i], J288_CMD_LEN,
+                                                 golden_cmds[first + i].name);
         }
         /* a reply parser finds no reply in a command stream */
         TEST_ASSERT_EQUAL_UINT(0u, feed_chunks(&rp, stream, len, 64u, &rng));

@@ -21,10 +21,10 @@ void tearDown(void) {}
 
 #if J288_CONFIG_SI_FLOAT
 #define IS_FLOAT 1
-#define REL_TOL 1e-6 /* a few float roundings */
+#define REL_TOL  1e-6 /* a few float roundings */
 #else
 #define IS_FLOAT 0
-#define REL_TOL 1e-12
+#define REL_TOL  1e-12
 #endif
 
 #define N_GEAR ((double)J288_GEAR_RATIO)
@@ -291,8 +291,8 @@ static void test_round_trip_pos(void)
             int rc;
             uint32_t u = codec_rng_u32(&rng);
             if (i < 8u) {
-                static const int32_t edges[8] = {INT32_MIN, INT32_MIN + 1, -1, 0, 1,
-                                                 INT32_MAX - 1, INT32_MAX, 16777217};
+                static const int32_t edges[8] = {INT32_MIN, INT32_MIN + 1, -1,        0,
+                                                 1,         INT32_MAX - 1, INT32_MAX, 16777217};
                 raw = edges[i];
             } else {
                 raw = (int32_t)(u >> (u & 31u)) * ((u & 32u) ? -1 : 1); /* all magnitudes */
@@ -379,8 +379,8 @@ static void test_gear_ratio_rules(void)
     /* one output turn is N rotor turns: 288.35 * 32768 LSB */
     {
         int32_t raw = 0;
-        TEST_ASSERT_EQUAL_INT(J288_OK, j288_pos_to_raw((j288_real_t)(2.0 * J288_PI),
-                                                       J288_SIDE_OUTPUT, &raw));
+        TEST_ASSERT_EQUAL_INT(
+            J288_OK, j288_pos_to_raw((j288_real_t)(2.0 * J288_PI), J288_SIDE_OUTPUT, &raw));
         TEST_ASSERT_INT32_WITHIN(IS_FLOAT ? 8 : 0, 9448653, raw); /* 288.35*32768 = 9448652.8 */
     }
 }
@@ -402,7 +402,8 @@ static void test_single_value_rejections(void)
                                   to_raw(q, (j288_real_t)((hi + 2000.0) / k), side, &raw));
             if (q == GOLDEN_Q_KP || q == GOLDEN_Q_KD) {
                 TEST_ASSERT_EQUAL_INT(J288_ERR_NEG_GAIN, to_raw(q, (j288_real_t)-1.0, side, &raw));
-                TEST_ASSERT_EQUAL_INT(J288_ERR_NEG_GAIN, to_raw(q, (j288_real_t)-1e-30, side, &raw));
+                TEST_ASSERT_EQUAL_INT(J288_ERR_NEG_GAIN,
+                                      to_raw(q, (j288_real_t)-1e-30, side, &raw));
                 TEST_ASSERT_EQUAL_INT(J288_ERR_NEG_GAIN,
                                       to_raw(q, (j288_real_t)-INFINITY, side, &raw));
             } else {
@@ -473,9 +474,9 @@ static void test_half_lsb_past_the_ends(void)
     TEST_ASSERT_EQUAL_INT(J288_OK, j288_pos_to_raw(2147483520.0f / (j288_real_t)J288_SCALE_POS,
                                                    J288_SIDE_ROTOR, &r32));
     TEST_ASSERT_INT32_WITHIN(1024, 2147483520, r32);
-    TEST_ASSERT_EQUAL_INT(J288_ERR_RANGE_POS,
-                          j288_pos_to_raw(4294967296.0f / (j288_real_t)J288_SCALE_POS,
-                                          J288_SIDE_ROTOR, &r32));
+    TEST_ASSERT_EQUAL_INT(
+        J288_ERR_RANGE_POS,
+        j288_pos_to_raw(4294967296.0f / (j288_real_t)J288_SCALE_POS, J288_SIDE_ROTOR, &r32));
 #endif
 }
 
@@ -483,18 +484,22 @@ static void test_half_lsb_past_the_ends(void)
 static void test_round_half_away(void)
 {
     int16_t r = 0;
-    TEST_ASSERT_EQUAL_INT(J288_OK, j288_torque_to_raw((j288_real_t)(1.0 / 4096.0), J288_SIDE_ROTOR, &r));
+    TEST_ASSERT_EQUAL_INT(J288_OK,
+                          j288_torque_to_raw((j288_real_t)(1.0 / 4096.0), J288_SIDE_ROTOR, &r));
     TEST_ASSERT_EQUAL_INT16(63, r); /* 62.5 */
-    TEST_ASSERT_EQUAL_INT(J288_OK, j288_torque_to_raw((j288_real_t)(-1.0 / 4096.0), J288_SIDE_ROTOR, &r));
+    TEST_ASSERT_EQUAL_INT(J288_OK,
+                          j288_torque_to_raw((j288_real_t)(-1.0 / 4096.0), J288_SIDE_ROTOR, &r));
     TEST_ASSERT_EQUAL_INT16(-63, r);
-    TEST_ASSERT_EQUAL_INT(J288_OK, j288_torque_to_raw((j288_real_t)(0.99 / 256000.0 / 2.0), J288_SIDE_ROTOR, &r));
+    TEST_ASSERT_EQUAL_INT(
+        J288_OK, j288_torque_to_raw((j288_real_t)(0.99 / 256000.0 / 2.0), J288_SIDE_ROTOR, &r));
     TEST_ASSERT_EQUAL_INT16(0, r); /* 0.495 */
-    TEST_ASSERT_EQUAL_INT(J288_OK, j288_kd_to_raw((j288_real_t)(1.0 / 16384.0), J288_SIDE_ROTOR, &r));
+    TEST_ASSERT_EQUAL_INT(J288_OK,
+                          j288_kd_to_raw((j288_real_t)(1.0 / 16384.0), J288_SIDE_ROTOR, &r));
     TEST_ASSERT_EQUAL_INT16(7813, r); /* 7812.5 */
 #if !J288_CONFIG_SI_FLOAT
     /* the largest double below 0.5 scaled by 1 must not round up (naive floor(x + 0.5) does) */
-    TEST_ASSERT_EQUAL_INT(J288_OK, j288_torque_to_raw(0.49999999999999994 / 256000.0 * 1.0,
-                                                      J288_SIDE_ROTOR, &r));
+    TEST_ASSERT_EQUAL_INT(
+        J288_OK, j288_torque_to_raw(0.49999999999999994 / 256000.0 * 1.0, J288_SIDE_ROTOR, &r));
     TEST_ASSERT_EQUAL_INT16(0, r);
 #endif
 }
@@ -610,8 +615,10 @@ static void test_clamped_variant(void)
         TEST_ASSERT_EQUAL_INT16(0, c.kp);
         TEST_ASSERT_EQUAL_INT16(INT16_MAX, c.kd);
     }
-    TEST_ASSERT_EQUAL_INT(J288_ERR_NULL, j288_cmd_from_si_clamped(NULL, J288_SIDE_ROTOR, &c, &mask));
-    TEST_ASSERT_EQUAL_INT(J288_ERR_NULL, j288_cmd_from_si_clamped(&s, J288_SIDE_ROTOR, NULL, &mask));
+    TEST_ASSERT_EQUAL_INT(J288_ERR_NULL,
+                          j288_cmd_from_si_clamped(NULL, J288_SIDE_ROTOR, &c, &mask));
+    TEST_ASSERT_EQUAL_INT(J288_ERR_NULL,
+                          j288_cmd_from_si_clamped(&s, J288_SIDE_ROTOR, NULL, &mask));
     TEST_ASSERT_EQUAL_INT(J288_ERR_BAD_ARG, j288_cmd_from_si_clamped(&s, bad_side, &c, &mask));
 }
 
@@ -682,8 +689,9 @@ static void test_reply_and_cmd_to_si(void)
             TEST_ASSERT_EQUAL(raw.watchdog, back.watchdog);
             TEST_ASSERT_EQUAL_INT16_MESSAGE(raw.tau, back.tau, g->name);
             TEST_ASSERT_EQUAL_INT16_MESSAGE(raw.speed, back.speed, g->name);
-            TEST_ASSERT_INT32_WITHIN_MESSAGE(IS_FLOAT ? (uint32_t)(1.0 + fabs((double)raw.pos) * 5e-7) : 0u,
-                                             raw.pos, back.pos, g->name);
+            TEST_ASSERT_INT32_WITHIN_MESSAGE(
+                IS_FLOAT ? (uint32_t)(1.0 + fabs((double)raw.pos) * 5e-7) : 0u, raw.pos, back.pos,
+                g->name);
             TEST_ASSERT_EQUAL_INT16_MESSAGE(raw.kp, back.kp, g->name);
             TEST_ASSERT_EQUAL_INT16_MESSAGE(raw.kd, back.kd, g->name);
         }
