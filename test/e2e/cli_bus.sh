@@ -65,15 +65,17 @@ $code" >"$E2E_TMP/chk" 2>&1; then
     fi
 }
 
-# wait_for_log FILE REGEX [SECONDS]: until a line of the simulator log matches.
+# wait_for_log FILE REGEX [SECONDS [FROM_LINE]]: until a line of the simulator log after
+# line FROM_LINE (default 0) matches.
 wait_for_log() {
-    local i n=$(( ${3:-5} * 20 ))
+    local i n=$(( ${3:-5} * 20 )) from=${4:-0}
     for i in $(seq 1 $n); do
-        grep -Eq "$2" "$1" 2>/dev/null && return 0
+        tail -n +$((from + 1)) "$1" 2>/dev/null | grep -Eq "$2" && return 0
         sleep 0.05
     done
     return 1
 }
+log_lines() { grep -c '' "$1" 2>/dev/null || echo 0; }
 
 # ---------------------------------------------------------------------------------------------
 start_sim main --ids 1,2,3 --fault 3:0x200 || exit 1
@@ -207,15 +209,15 @@ expect_bad plot_missing_png 2 'usage: j288 plot' "$J288" plot "$CSV"
 # with WANT_RC and that the last frame each id received is a lock.
 safe_stop() {
     local name=$1 sig=$2 want=$3 ids=$4; shift 4
-    local id pid rc ok=1 why=""
+    local id pid rc ok=1 why="" from
+    from=$(log_lines "$MAIN_LOG")
     timeout -k 2 30 "$@" >"$E2E_TMP/bg.out" 2>"$E2E_TMP/bg.err" &
     pid=$!
     BG_PIDS+=("$pid")
     for id in ${ids//,/ }; do
-        wait_for_log "$MAIN_LOG" "id=$id status=1 wd=1" 5 || { ok=0; why="no FOC frame for $id"; }
+        wait_for_log "$MAIN_LOG" "id=$id status=1 wd=1" 5 "$from" || { ok=0; why="no FOC frame for $id"; }
     done
-    # Let it run a little after the last check so that the FOC frames are the latest.
-    sleep 0.2
+    sleep 0.1
     kill -"$sig" "$pid"
     wait "$pid"; rc=$?
     if [ $ok -eq 1 ] && [ $rc -ne "$want" ]; then ok=0; why="exit $rc, want $want: $(cat "$E2E_TMP/bg.err")"; fi
@@ -234,10 +236,11 @@ safe_stop sigint_log INT 130 1,2,3 "$J288" --port "$MAIN" log --id 1,2,3 --rate 
 safe_stop sigterm_log TERM 143 1,3 "$J288" --port "$MAIN" log --id 1,3 --rate 1000 --duration 30 --hold
 
 # ---- port in use -----------------------------------------------------------------------------
+from=$(log_lines "$MAIN_LOG")
 timeout -k 2 30 "$J288" --port "$MAIN" hold --id 1 >/dev/null 2>&1 &
 HOLDER=$!
 BG_PIDS+=("$HOLDER")
-wait_for_log "$MAIN_LOG" 'id=1 status=1' 5
+wait_for_log "$MAIN_LOG" 'id=1 status=1' 5 "$from"
 # The holder is j288 under `timeout`: the PID named must be that child of $HOLDER.
 expect_bad port_in_use 1 "in use by PID [0-9]+" "$J288" --port "$MAIN" status --id 2
 named=$(grep -Eo 'PID [0-9]+' <<<"$E2E_ERR" | grep -Eo '[0-9]+')
