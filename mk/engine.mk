@@ -21,3 +21,19 @@ bench: bench-bus
 bench-bus: $(ENGINE_BENCH)
 	BIN=$(BIN) BUILD=$(BUILD) ENGINE_BENCH_TURNAROUND="$(ENGINE_BENCH_TURNAROUND)" \
 	    bash test/bench/bus_bench.sh
+
+# The port template must keep compiling (host; and Cortex-M0 when arm-none-eabi-gcc is there):
+# test/unit/test_port_template.c includes it and drives a bus through its interrupt glue.
+.PHONY: port-template
+port-template: $(LIB_A)
+	@mkdir -p $(OBJ)/port/template
+	$(CC) $(CPPFLAGS_LIB) $(CFLAGS_COMMON) -c port/template/j288_port_template.c \
+	    -o $(OBJ)/port/template/j288_port_template.o
+	@if command -v arm-none-eabi-gcc >/dev/null 2>&1; then \
+	    echo "arm-none-eabi-gcc -mcpu=cortex-m0 ... port/template/j288_port_template.c"; \
+	    arm-none-eabi-gcc -mcpu=cortex-m0 -mthumb -Os $(CSTD) $(WARN) $(CPPFLAGS_LIB) -c \
+	        port/template/j288_port_template.c -o $(OBJ)/port/template/j288_port_template.m0.o; \
+	elif [ "$$CI" = true ]; then echo "port-template: arm-none-eabi-gcc not found" >&2; exit 1; \
+	else echo "port-template: skipping the Cortex-M0 build; install gcc-arm-none-eabi"; fi
+$(OBJ)/test/unit/test_port_template.o: port/template/j288_port_template.c \
+    port/template/j288_port_template.h
