@@ -5,7 +5,8 @@
 #           for FPU-less parts (no soft-float library is pulled in by the SI API)
 #   m0-si   Cortex-M0, soft float, SI API in double: proves it builds, shows what it costs
 #   m4f     Cortex-M4F, hard float (fpv4-sp-d16), J288_CONFIG_SI_FLOAT=1; checked to call no
-#           double-precision soft-float helper (__aeabi_d*): all SI maths stays on the FPU
+#           soft-float helper (__aeabi_d*, __aeabi_f*, 64-bit int <-> float): all SI maths
+#           stays on the FPU and no floating-point library code is linked in
 ARM_CC ?= arm-none-eabi-gcc
 ARM_SIZE ?= arm-none-eabi-size
 ARM_NM ?= arm-none-eabi-nm
@@ -18,6 +19,8 @@ ARMLIB_m4f_FLAGS := -mcpu=cortex-m4 -mthumb -mfloat-abi=hard -mfpu=fpv4-sp-d16 \
     -DJ288_CONFIG_SI=1 -DJ288_CONFIG_SI_FLOAT=1
 ARMLIB_CFLAGS := -std=c99 $(WARN) -Os -ffunction-sections -fdata-sections $(ARM_EXTRA_CFLAGS)
 ARMLIB_NAMES := $(notdir $(basename $(LIB_SRC)))
+# libgcc's floating-point helpers: double ops, float ops, and 64-bit integer <-> float/double.
+ARMLIB_SOFTFLOAT_RE := __aeabi_([df][a-z]|[df]2|u?[il]2[df])
 
 define ARMLIB_CORE_RULES
 $(BUILD)/arm/$(1)/%.o: lib/src/%.c $(LIB_HDR)
@@ -46,9 +49,9 @@ arm-lib: arm-check-tools
 arm-lib-build: $(ARMLIB_ARCHIVES)
 	@$(foreach c,$(ARMLIB_CORES),echo; echo "== lib/ for $(c): $(strip $(ARMLIB_$(c)_FLAGS)) -Os"; \
 	    (cd $(BUILD)/arm/$(c) && $(ARM_SIZE) -t $(ARMLIB_NAMES:%=%.o)) | sed 's/(TOTALS)/TOTAL/';)
-	@if $(ARM_NM) -u $(BUILD)/arm/m4f/*.o | grep -q '__aeabi_d'; then \
-	    echo "arm: m4f objects call double-precision soft-float helpers:" >&2; \
-	    $(ARM_NM) -u -A $(BUILD)/arm/m4f/*.o | grep '__aeabi_d' >&2; exit 1; fi
-	@echo; echo "arm: m4f uses no double-precision soft float; archives: $(ARMLIB_ARCHIVES)"
+	@if $(ARM_NM) -u $(BUILD)/arm/m4f/*.o | grep -Eq '$(ARMLIB_SOFTFLOAT_RE)'; then \
+	    echo "arm: m4f objects call soft-float helpers:" >&2; \
+	    $(ARM_NM) -u -A $(BUILD)/arm/m4f/*.o | grep -E '$(ARMLIB_SOFTFLOAT_RE)' >&2; exit 1; fi
+	@echo; echo "arm: m4f calls no soft-float helper; archives: $(ARMLIB_ARCHIVES)"
 
 arm: arm-lib

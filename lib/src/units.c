@@ -39,20 +39,57 @@ static bool side_ok(j288_side_t side)
     return (side == J288_SIDE_ROTOR) || (side == J288_SIDE_OUTPUT);
 }
 
-/* Round half away from zero without libm: the fraction v - trunc(v) is exact. The caller
- * keeps |v| a little above the int32 range at most, so int64_t never overflows. */
-static int64_t round_half_away(j288_real_t v)
+/*
+ * Round a magnitude a >= 0 half away from zero into *mag, without libm: the fraction
+ * a - trunc(a) is exact. Only 32-bit conversions are used, which FPUs do in hardware (a 64-bit
+ * one would pull in library code on a Cortex-M4F). false: the result exceeds 2^31, outside
+ * every field. The caller keeps a below 2^31 + 2, where a - 2^31 is exact.
+ */
+static bool round_magnitude(j288_real_t a, uint32_t *mag)
 {
-    int64_t t = (int64_t)v;
-    j288_real_t frac = v - (j288_real_t)t;
-    if (frac >= (j288_real_t)0.5) {
-        t++;
-    } else if (frac <= (j288_real_t)-0.5) {
-        t--;
-    } else {
-        /* |frac| < 0.5: truncation already rounded to nearest */
+    const j288_real_t two31 = (j288_real_t)2147483648.0;
+    uint32_t t;
+    if (a >= two31) {
+        if ((a - two31) < (j288_real_t)0.5) {
+            *mag = 0x80000000u;
+            return true;
+        }
+        return false;
     }
-    return t;
+    t = (uint32_t)a;
+    if ((a - (j288_real_t)t) >= (j288_real_t)0.5) {
+        t++;
+    }
+    *mag = t;
+    return true;
+}
+
+/* v rounded half away from zero, when the result lies in [lo, hi] (lo < 0 < hi). */
+static bool round_into(j288_real_t v, int32_t lo, int32_t hi, int32_t *out)
+{
+    bool neg = v < (j288_real_t)0;
+    /* largest magnitude allowed on this side; -(lo + 1) + 1 avoids negating INT32_MIN */
+    uint32_t limit = neg ? (uint32_t)(-(lo + 1)) + 1u : (uint32_t)hi;
+    uint32_t mag = 0u;
+
+    /* A coarse window first: catches infinities and keeps the conversions defined. Exactly
+     * half past a limit rounds away from zero, out of range, and is caught by the integer
+     * test; comparing v against lo - 0.5 would be wrong in float, where that is not
+     * representable for int32. */
+    if (!((v >= (j288_real_t)lo - (j288_real_t)1) && (v <= (j288_real_t)hi + (j288_real_t)1))) {
+        return false;
+    }
+    if (!round_magnitude(neg ? -v : v, &mag) || (mag > limit)) {
+        return false;
+    }
+    if (!neg) {
+        *out = (int32_t)mag;
+    } else if (mag == 0x80000000u) {
+        *out = INT32_MIN;
+    } else {
+        *out = -(int32_t)mag;
+    }
+    return true;
 }
 
 /*
@@ -63,8 +100,7 @@ static int convert(j288_real_t si, quantity_t q, j288_side_t side, int32_t lo, i
                    int range_err, bool clamp, bool *was_clamped, int32_t *out)
 {
     j288_real_t v;
-    int64_t r = 0;
-    bool in_range;
+    int32_t r = 0;
     bool is_gain = (q == Q_KP) || (q == Q_KD);
 
     if (si != si) {
@@ -79,16 +115,7 @@ static int convert(j288_real_t si, quantity_t q, j288_side_t side, int32_t lo, i
         return J288_OK;
     }
     v = si * lsb_per_unit(q, side);
-    /* A coarse window first (also catches infinities and keeps the int64 cast defined), then
-     * the exact test on the rounded integer: a half just past lo or hi rounds away from zero,
-     * out of range. Comparing the real value against lo - 0.5 instead is wrong in float,
-     * where lo - 0.5 is not representable for int32. */
-    in_range = (v >= (j288_real_t)lo - (j288_real_t)1) && (v <= (j288_real_t)hi + (j288_real_t)1);
-    if (in_range) {
-        r = round_half_away(v);
-        in_range = (r >= (int64_t)lo) && (r <= (int64_t)hi);
-    }
-    if (!in_range) {
+    if (!round_into(v, lo, hi, &r)) {
         if (!clamp) {
             return range_err;
         }
@@ -96,7 +123,7 @@ static int convert(j288_real_t si, quantity_t q, j288_side_t side, int32_t lo, i
         *out = (v < (j288_real_t)0) ? lo : hi;
         return J288_OK;
     }
-    *out = (int32_t)r;
+    *out = r;
     return J288_OK;
 }
 
