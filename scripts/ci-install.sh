@@ -1,0 +1,33 @@
+#!/usr/bin/env bash
+# Install every Debian package CI needs (idempotent: only what is missing is installed).
+# One list; each area adds its packages here with a comment saying which target needs them.
+set -euo pipefail
+
+packages=(
+    # hardening (mk/hardening.mk)
+    clang-14 libclang-rt-14-dev     # make fuzz / fuzz-ci (libFuzzer, ASan, UBSan)
+    valgrind                        # make test-valgrind
+    cppcheck clang-tidy             # make lint (cppcheck's MISRA addon ships with cppcheck)
+    gcovr                           # make coverage
+    gcc-s390x-linux-gnu libc6-dev-s390x-cross        # make test-be (big-endian)
+    gcc-arm-linux-gnueabihf libc6-dev-armhf-cross    # make test-32 (gcc-multilib conflicts
+                                                     # with the s390x cross gcc in Debian 12)
+    qemu-user                       # make test-be / test-32 (qemu-s390x, qemu-arm)
+    binutils gcc-arm-none-eabi libnewlib-arm-none-eabi  # make check-symbols (nm, M0 archive)
+    python3                         # make fuzz-corpus, golden vectors
+)
+
+missing=()
+for p in "${packages[@]}"; do
+    dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q 'install ok installed' || missing+=("$p")
+done
+if [ ${#missing[@]} -eq 0 ]; then
+    echo "ci-install: all ${#packages[@]} packages present"
+    exit 0
+fi
+echo "ci-install: installing ${missing[*]}"
+sudo=
+[ "$(id -u)" -eq 0 ] || sudo=sudo
+export DEBIAN_FRONTEND=noninteractive
+$sudo apt-get update -qq
+$sudo apt-get install -y -qq --no-install-recommends "${missing[@]}"
