@@ -23,6 +23,20 @@ $(BIN)/j288: $(CLI_OBJ) $(CLI_LINUX_A) $(LIB_A)
 .PHONY: cli
 cli: $(BIN)/j288
 
-ALL_TARGETS += $(BIN)/j288
+# Unity test of the tool's helpers (test/cli/): linked with the helper objects, not main().
+CLI_TEST := $(BUILD)/test/test_cli_helpers
+CLI_TEST_DEPS := $(addprefix $(OBJ)/examples/cli/,args.o hexparse.o json.o frameview.o report.o)
+
+$(OBJ)/test/cli/%.o: test/cli/%.c $(CLI_HDR) $(LIB_HDR) $(UNITY)/unity.c
+	@mkdir -p $(@D)
+	$(CC) $(TEST_CPPFLAGS) -Iexamples/cli -Iport/linux -D_XOPEN_SOURCE=700 $(CFLAGS_COMMON) \
+	    -c $< -o $@
+
+$(CLI_TEST): $(OBJ)/test/cli/test_cli_helpers.o $(CLI_TEST_DEPS) $(UNITY_OBJ) $(LIB_A)
+	@mkdir -p $(@D)
+	$(CC) $(CFLAGS_COMMON) $^ -o $@ $(LDFLAGS_COMMON) -lm
+
+ALL_TARGETS += $(BIN)/j288 $(CLI_TEST)
+HOST_TESTS += $(CLI_TEST)
 TEST_DEPS += $(BIN)/j288 $(BIN)/j288-sim
 TEST_SCRIPTS += test/e2e/cli_offline.sh test/e2e/cli_bus.sh

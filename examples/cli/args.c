@@ -77,8 +77,7 @@ int cli_args_next(cli_args_t *a, const cli_opt_t *opts, const char **value)
     return o->key;
 }
 
-int cli_parse_int(const char *opt, const char *text, long long lo, long long hi,
-                  long long *out)
+int cli_parse_int(const char *opt, const char *text, long long lo, long long hi, long long *out)
 {
     const char *digits = text;
     char *end = NULL;

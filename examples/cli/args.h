@@ -20,10 +20,10 @@ typedef struct {
     int key; /* >= 0, returned by cli_args_next() */
 } cli_opt_t;
 
-#define CLI_ARG_END (-1)
+#define CLI_ARG_END        (-1)
 #define CLI_ARG_POSITIONAL (-2)
-#define CLI_ARG_ERROR (-3)
-#define CLI_ARG_HELP (-4)
+#define CLI_ARG_ERROR      (-3)
+#define CLI_ARG_HELP       (-4)
 
 typedef struct {
     int argc;
@@ -44,8 +44,7 @@ void cli_args_init(cli_args_t *a, int argc, char **argv);
 int cli_args_next(cli_args_t *a, const cli_opt_t *opts, const char **value);
 
 /* Whole number in [lo, hi]; decimal or 0x-prefixed hexadecimal, optional sign. */
-int cli_parse_int(const char *opt, const char *text, long long lo, long long hi,
-                  long long *out);
+int cli_parse_int(const char *opt, const char *text, long long lo, long long hi, long long *out);
 
 /* Finite real number (strtod syntax, no trailing characters). */
 int cli_parse_real(const char *opt, const char *text, double *out);

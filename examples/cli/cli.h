@@ -10,6 +10,7 @@
 #define J288_CLI_H
 
 #include <stdint.h>
+#include <stdio.h>
 
 #include "j288/j288.h"
 
@@ -18,11 +19,11 @@
 #endif
 
 /* Exit codes, documented in `j288 --help`. */
-#define CLI_EXIT_OK 0
-#define CLI_EXIT_FAIL 1    /* invalid frame, device or bus failure, no reply */
-#define CLI_EXIT_USAGE 2   /* bad command line: unknown option, bad or out-of-range value */
+#define CLI_EXIT_OK      0
+#define CLI_EXIT_FAIL    1 /* invalid frame, device or bus failure, no reply */
+#define CLI_EXIT_USAGE   2 /* bad command line: unknown option, bad or out-of-range value */
 #define CLI_EXIT_NO_TOOL 3 /* an optional helper program (gnuplot) is not installed */
-#define CLI_EXIT_SIGINT 130
+#define CLI_EXIT_SIGINT  130
 #define CLI_EXIT_SIGTERM 143
 
 /* Global options given before the command (`j288 --port DEV --baud N COMMAND`). Commands
@@ -34,6 +35,9 @@ typedef struct {
 
 /* Name used as the message prefix ("encode" -> "j288 encode: ..."). NULL: plain "j288". */
 void cli_set_command(const char *name);
+
+/* Where cli_error() writes: NULL (the default) is stderr. For tests. */
+void cli_set_error_stream(FILE *f);
 
 /* One line on stderr, prefixed and newline-terminated. */
 void cli_error(const char *fmt, ...)

@@ -109,8 +109,8 @@ int cli_bus_open(cli_bus_t *b, const cli_bus_opts_t *o, int default_retries)
     b->dev = dev;
     memset(&lo, 0, sizeof lo);
     lo.echo = o->echo;
-    lo.margin_us = o->margin_us != 0u ? o->margin_us
-                                      : (is_pseudo_terminal(dev) ? PTY_MARGIN_US : 0u);
+    lo.margin_us =
+        o->margin_us != 0u ? o->margin_us : (is_pseudo_terminal(dev) ? PTY_MARGIN_US : 0u);
     rc = j288_linux_open(&b->lp, dev, o->baud, &lo);
     if (rc != J288_OK) {
         cli_error("%s", j288_linux_error(&b->lp));
@@ -199,12 +199,12 @@ void cli_report_txn_failure(cli_bus_t *b, uint8_t id, int rc)
     if (rc == J288_ERR_OFFLINE || j288_linux_offline(&b->lp)) {
         cli_error("%s", j288_linux_error(&b->lp));
     } else if (rc == J288_ERR_TIMEOUT) {
-        cli_error("no reply from servo %u on %s (check id, power, wiring and --baud)",
-                  (unsigned)id, b->dev);
+        cli_error("no reply from servo %u on %s (check id, power, wiring and --baud)", (unsigned)id,
+                  b->dev);
     } else if (rc == J288_ERR_PORT) {
-        cli_error("%s: %s", b->dev, j288_linux_error(&b->lp)[0] != '\0'
-                                        ? j288_linux_error(&b->lp)
-                                        : j288_strerror(rc));
+        cli_error("%s: %s", b->dev,
+                  j288_linux_error(&b->lp)[0] != '\0' ? j288_linux_error(&b->lp)
+                                                      : j288_strerror(rc));
     } else {
         cli_error("servo %u on %s: %s", (unsigned)id, b->dev, j288_strerror(rc));
     }

@@ -29,19 +29,22 @@ enum {
     CLI_OPT_RETRIES,
     CLI_OPT_JSON
 };
-#define CLI_BUS_COMMON_OPTS                                                                    \
-    {"--port", true, CLI_OPT_PORT}, {"--baud", true, CLI_OPT_BAUD},                            \
-        {"--margin-us", true, CLI_OPT_MARGIN}, {"--echo", false, CLI_OPT_ECHO},                \
-        {"--retries", true, CLI_OPT_RETRIES}, {"--json", false, CLI_OPT_JSON }
+#define CLI_BUS_COMMON_OPTS                                                                        \
+    {"--port", true, CLI_OPT_PORT}, {"--baud", true, CLI_OPT_BAUD},                                \
+        {"--margin-us", true, CLI_OPT_MARGIN}, {"--echo", false, CLI_OPT_ECHO},                    \
+        {"--retries", true, CLI_OPT_RETRIES},                                                      \
+    {                                                                                              \
+        "--json", false, CLI_OPT_JSON                                                              \
+    }
 
-#define CLI_BUS_COMMON_HELP                                                                    \
-    "common options:\n"                                                                        \
-    "  --port DEV       serial device (or give it before the command; default $J288_PORT)\n" \
-    "  --baud N         line rate, default 6000000\n"                                          \
-    "  --margin-us N    reply deadline margin for host latency; default 20000 for a USB\n"     \
-    "                   adapter, 5000 for a pseudo-terminal (the simulator)\n"               \
-    "  --echo           the adapter hears its own transmit (skip and check the echo)\n"      \
-    "  --retries N      re-send a failed command up to N times (0-3)\n"                     \
+#define CLI_BUS_COMMON_HELP                                                                        \
+    "common options:\n"                                                                            \
+    "  --port DEV       serial device (or give it before the command; default $J288_PORT)\n"       \
+    "  --baud N         line rate, default 6000000\n"                                              \
+    "  --margin-us N    reply deadline margin for host latency; default 20000 for a USB\n"         \
+    "                   adapter, 5000 for a pseudo-terminal (the simulator)\n"                     \
+    "  --echo           the adapter hears its own transmit (skip and check the echo)\n"            \
+    "  --retries N      re-send a failed command up to N times (0-3)\n"                            \
     "  --json           machine-readable output\n"
 
 typedef struct {

@@ -12,9 +12,9 @@
 /* Default gains, output side: gentle (a first try on real hardware should not snap), well
  * inside the wire range (kp 0..2128 N*m/rad, kd 0..21.28 N*m*s/rad on the output side);
  * kd gives a damping ratio near 0.7 on the simulator's rotor (2e-6 kg m^2). */
-#define DEFAULT_KP_OUTPUT 20.0
-#define DEFAULT_KD_OUTPUT 2.5
-#define DEFAULT_RATE_HZ 200.0
+#define DEFAULT_KP_OUTPUT         20.0
+#define DEFAULT_KD_OUTPUT         2.5
+#define DEFAULT_RATE_HZ           200.0
 #define DEFAULT_MOVE_SPEED_OUTPUT 1.0 /* rad/s */
 
 /* Parse loop shared by every bus command: common options are handled here, the command's
@@ -125,15 +125,14 @@ int cli_cmd_scan(int argc, char **argv, const cli_global_t *g)
         cli_json_newline(&j);
     } else {
         char list[512];
-        printf("%-3s %-5s %9s %9s %8s  %s\n", "id", "mode", "case", "winding", "voltage",
-               "faults");
+        printf("%-3s %-5s %9s %9s %8s  %s\n", "id", "mode", "case", "winding", "voltage", "faults");
         for (id = 0; id <= J288_MAX_ID; id++) {
             const j288_reply_raw_t *r = &txn[id].reply;
             if (result[id] != J288_OK) {
                 continue;
             }
-            printf("%-3u %-5s %7d C %7u C %6.1f V  %s%s\n", (unsigned)id,
-                   cli_mode_name(r->status), (int)r->case_temp_c, (unsigned)r->winding_temp_c,
+            printf("%-3u %-5s %7d C %7u C %6.1f V  %s%s\n", (unsigned)id, cli_mode_name(r->status),
+                   (int)r->case_temp_c, (unsigned)r->winding_temp_c,
                    (double)r->voltage_raw * J288_SCALE_VOLTAGE,
                    cli_fault_list(r->faults, list, sizeof list),
                    r->watchdog_tripped ? " (watchdog had tripped)" : "");
@@ -160,8 +159,19 @@ static const char status_help[] =
     "Exit status: 0 the servo answered; 1 no reply or device error.\n"
     "\n" CLI_BUS_COMMON_HELP;
 
-enum { OPT_ID = 0, OPT_KP, OPT_KD, OPT_POS, OPT_SPEED, OPT_TAU, OPT_SIDE, OPT_RATE,
-       OPT_DURATION, OPT_WATCHDOG, OPT_KEEP };
+enum {
+    OPT_ID = 0,
+    OPT_KP,
+    OPT_KD,
+    OPT_POS,
+    OPT_SPEED,
+    OPT_TAU,
+    OPT_SIDE,
+    OPT_RATE,
+    OPT_DURATION,
+    OPT_WATCHDOG,
+    OPT_KEEP
+};
 
 typedef struct {
     long long id;
@@ -178,8 +188,7 @@ static int parse_id_opt(void *ctx, int key, const char *v)
 
 int cli_cmd_status(int argc, char **argv, const cli_global_t *g)
 {
-    static const cli_opt_t opts[] = {{"--id", true, OPT_ID}, CLI_BUS_COMMON_OPTS,
-                                     {NULL, false, 0}};
+    static const cli_opt_t opts[] = {{"--id", true, OPT_ID}, CLI_BUS_COMMON_OPTS, {NULL, false, 0}};
     cli_bus_opts_t o;
     cli_bus_t b;
     id_ctx_t c = {-1};
@@ -216,8 +225,8 @@ int cli_cmd_status(int argc, char **argv, const cli_global_t *g)
         cli_json_newline(&j);
     } else {
         char title[160];
-        snprintf(title, sizeof title, "servo %u on %s: reply after %lu us", (unsigned)c.id,
-                 b.dev, (unsigned long)txn.latency_us);
+        snprintf(title, sizeof title, "servo %u on %s: reply after %lu us", (unsigned)c.id, b.dev,
+                 (unsigned long)txn.latency_us);
         cli_show_reply(stdout, &txn.reply, title);
     }
     cli_bus_close(&b);
@@ -236,8 +245,7 @@ static const char stop_help[] =
 
 int cli_cmd_stop(int argc, char **argv, const cli_global_t *g)
 {
-    static const cli_opt_t opts[] = {{"--id", true, OPT_ID}, CLI_BUS_COMMON_OPTS,
-                                     {NULL, false, 0}};
+    static const cli_opt_t opts[] = {{"--id", true, OPT_ID}, CLI_BUS_COMMON_OPTS, {NULL, false, 0}};
     cli_bus_opts_t o;
     cli_bus_t b;
     id_ctx_t c = {-1};
@@ -271,7 +279,8 @@ int cli_cmd_stop(int argc, char **argv, const cli_global_t *g)
     return CLI_EXIT_OK;
 }
 
-/* ---- hold, move, torque: a refresh loop -------------------------------------------------------- */
+/* ---- hold, move, torque: a refresh loop --------------------------------------------------------
+ */
 
 typedef enum { DRIVE_HOLD, DRIVE_MOVE, DRIVE_TORQUE } drive_kind_t;
 
@@ -347,9 +356,9 @@ static int parse_drive_opt(void *ctx, int key, const char *v)
 
 /* Gains and fields, validated and converted once. */
 typedef struct {
-    j288_cmd_raw_t base; /* id, FOC, watchdog, gains, tau */
-    int32_t start_pos;   /* rotor raw, from the first reply */
-    int32_t target_pos;  /* rotor raw */
+    j288_cmd_raw_t base;   /* id, FOC, watchdog, gains, tau */
+    int32_t start_pos;     /* rotor raw, from the first reply */
+    int32_t target_pos;    /* rotor raw */
     double ramp_lsb_per_s; /* move: setpoint speed in position LSB per second */
     int16_t ramp_speed_raw;
     double ramp_time_s;
@@ -400,10 +409,10 @@ static int plan_fields(const drive_args_t *d, drive_plan_t *p)
         }
     }
     if (d->kind == DRIVE_MOVE) {
-        double v = d->have_speed ? fabs(d->speed)
-                                 : (side == J288_SIDE_OUTPUT ? DEFAULT_MOVE_SPEED_OUTPUT
-                                                            : DEFAULT_MOVE_SPEED_OUTPUT *
-                                                                  J288_GEAR_RATIO);
+        double v = d->have_speed
+                       ? fabs(d->speed)
+                       : (side == J288_SIDE_OUTPUT ? DEFAULT_MOVE_SPEED_OUTPUT
+                                                   : DEFAULT_MOVE_SPEED_OUTPUT * J288_GEAR_RATIO);
         rc = j288_pos_to_raw((j288_real_t)d->pos, side, &p->target_pos);
         if (rc != J288_OK) {
             return si_error("--pos", d->pos, rc);
@@ -605,20 +614,20 @@ static int run_drive(drive_args_t *d, const cli_bus_opts_t *o)
     return cli_stop_signal != 0 ? cli_signal_exit_code() : CLI_EXIT_OK;
 }
 
-#define DRIVE_COMMON_HELP                                                                      \
-    "  --rate HZ        command refresh rate, default 200\n"                                   \
-    "  --duration S     stop after S seconds; default: run until Ctrl-C or SIGTERM\n"         \
-    "  --watchdog W     on (default): the servo locks itself if commands stop for 1 s\n"      \
-    "  --keep           at the end of --duration leave the last command in force instead\n"  \
-    "                   of locking (with the watchdog on the servo locks itself 1 s later)\n" \
-    "  --side S         SI values on the output side (default) or the rotor side\n"         \
-    "Ctrl-C or SIGTERM: the servo is sent lock before exiting (exit 130 / 143).\n"            \
-    "Exit status: 0 done; 1 no reply, servo stopped answering or device error; 2 bad\n"      \
+#define DRIVE_COMMON_HELP                                                                          \
+    "  --rate HZ        command refresh rate, default 200\n"                                       \
+    "  --duration S     stop after S seconds; default: run until Ctrl-C or SIGTERM\n"              \
+    "  --watchdog W     on (default): the servo locks itself if commands stop for 1 s\n"           \
+    "  --keep           at the end of --duration leave the last command in force instead\n"        \
+    "                   of locking (with the watchdog on the servo locks itself 1 s later)\n"      \
+    "  --side S         SI values on the output side (default) or the rotor side\n"                \
+    "Ctrl-C or SIGTERM: the servo is sent lock before exiting (exit 130 / 143).\n"                 \
+    "Exit status: 0 done; 1 no reply, servo stopped answering or device error; 2 bad\n"            \
     "arguments.\n"
 
-#define DRIVE_OPTS                                                                             \
-    {"--id", true, OPT_ID}, {"--side", true, OPT_SIDE}, {"--rate", true, OPT_RATE},          \
-        {"--duration", true, OPT_DURATION}, {"--watchdog", true, OPT_WATCHDOG},              \
+#define DRIVE_OPTS                                                                                 \
+    {"--id", true, OPT_ID}, {"--side", true, OPT_SIDE}, {"--rate", true, OPT_RATE},                \
+        {"--duration", true, OPT_DURATION}, {"--watchdog", true, OPT_WATCHDOG},                    \
         {"--keep", false, OPT_KEEP}, CLI_BUS_COMMON_OPTS
 
 static void drive_args_init(drive_args_t *d, drive_kind_t kind)
@@ -641,8 +650,8 @@ static const char hold_help[] =
 
 int cli_cmd_hold(int argc, char **argv, const cli_global_t *g)
 {
-    static const cli_opt_t opts[] = {{"--kp", true, OPT_KP}, {"--kd", true, OPT_KD},
-                                     DRIVE_OPTS, {NULL, false, 0}};
+    static const cli_opt_t opts[] = {
+        {"--kp", true, OPT_KP}, {"--kd", true, OPT_KD}, DRIVE_OPTS, {NULL, false, 0}};
     drive_args_t d;
     cli_bus_opts_t o;
     int ec;
@@ -664,9 +673,12 @@ static const char move_help[] =
 
 int cli_cmd_move(int argc, char **argv, const cli_global_t *g)
 {
-    static const cli_opt_t opts[] = {{"--pos", true, OPT_POS}, {"--speed", true, OPT_SPEED},
-                                     {"--kp", true, OPT_KP},   {"--kd", true, OPT_KD},
-                                     DRIVE_OPTS,               {NULL, false, 0}};
+    static const cli_opt_t opts[] = {{"--pos", true, OPT_POS},
+                                     {"--speed", true, OPT_SPEED},
+                                     {"--kp", true, OPT_KP},
+                                     {"--kd", true, OPT_KD},
+                                     DRIVE_OPTS,
+                                     {NULL, false, 0}};
     drive_args_t d;
     cli_bus_opts_t o;
     int ec;

@@ -76,8 +76,7 @@ static int classify(const uint8_t *b, size_t len, bool *is_reply)
     bool reply_head = len >= 2u && b[0] == J288_REPLY_HEAD0 && b[1] == J288_REPLY_HEAD1;
 
     if (cmd_head && len != J288_CMD_LEN) {
-        cli_error("wrong length: %zu bytes with a command header (fe ee); a command is 20",
-                  len);
+        cli_error("wrong length: %zu bytes with a command header (fe ee); a command is 20", len);
         return -1;
     }
     if (reply_head && len != J288_REPLY_LEN) {
@@ -86,8 +85,7 @@ static int classify(const uint8_t *b, size_t len, bool *is_reply)
     }
     if (!cmd_head && !reply_head) {
         if (len == J288_CMD_LEN || len == J288_REPLY_LEN) {
-            cli_error("wrong header %02x %02x: a command starts fe ee, a reply fc ee", b[0],
-                      b[1]);
+            cli_error("wrong header %02x %02x: a command starts fe ee, a reply fc ee", b[0], b[1]);
         } else {
             cli_error("wrong length: %zu bytes; a command is 20 bytes (fe ee ...), a reply 26 "
                       "(fc ee ...)",
@@ -106,8 +104,7 @@ static int check_crc(const uint8_t *b, bool is_reply)
         is_reply ? j288_reply_crc_expected(b, NULL) : j288_cmd_crc_expected(b, NULL);
     if (carried != expected) {
         cli_error("CRC mismatch: the %s carries 0x%08lx, its bytes give 0x%08lx",
-                  is_reply ? "reply" : "command", (unsigned long)carried,
-                  (unsigned long)expected);
+                  is_reply ? "reply" : "command", (unsigned long)carried, (unsigned long)expected);
         return -1;
     }
     return 0;
@@ -142,8 +139,7 @@ int cli_cmd_decode(int argc, char **argv, const cli_global_t *g)
         } else {
             any = true;
             if (append_text(text, &used, v) != 0) {
-                cli_error("input longer than %u characters: not a single frame",
-                          MAX_TEXT - 1u);
+                cli_error("input longer than %u characters: not a single frame", MAX_TEXT - 1u);
                 return CLI_EXIT_FAIL;
             }
         }

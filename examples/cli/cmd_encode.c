@@ -51,15 +51,21 @@ enum {
 
 #define NFIELDS 5
 
-static const cli_opt_t encode_opts[] = {
-    {"--id", true, OPT_ID},           {"--mode", true, OPT_MODE},
-    {"--watchdog", true, OPT_WATCHDOG}, {"--side", true, OPT_SIDE},
-    {"--tau-raw", true, OPT_TAU_RAW}, {"--speed-raw", true, OPT_SPEED_RAW},
-    {"--pos-raw", true, OPT_POS_RAW}, {"--kp-raw", true, OPT_KP_RAW},
-    {"--kd-raw", true, OPT_KD_RAW},   {"--tau", true, OPT_TAU},
-    {"--speed", true, OPT_SPEED},     {"--pos", true, OPT_POS},
-    {"--kp", true, OPT_KP},           {"--kd", true, OPT_KD},
-    {NULL, false, 0}};
+static const cli_opt_t encode_opts[] = {{"--id", true, OPT_ID},
+                                        {"--mode", true, OPT_MODE},
+                                        {"--watchdog", true, OPT_WATCHDOG},
+                                        {"--side", true, OPT_SIDE},
+                                        {"--tau-raw", true, OPT_TAU_RAW},
+                                        {"--speed-raw", true, OPT_SPEED_RAW},
+                                        {"--pos-raw", true, OPT_POS_RAW},
+                                        {"--kp-raw", true, OPT_KP_RAW},
+                                        {"--kd-raw", true, OPT_KD_RAW},
+                                        {"--tau", true, OPT_TAU},
+                                        {"--speed", true, OPT_SPEED},
+                                        {"--pos", true, OPT_POS},
+                                        {"--kp", true, OPT_KP},
+                                        {"--kd", true, OPT_KD},
+                                        {NULL, false, 0}};
 
 typedef struct {
     const char *raw_opt;

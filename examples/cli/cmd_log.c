@@ -41,8 +41,19 @@ static const char log_help[] =
     "Exit status: 0 done; 1 a servo never answered, device error; 2 bad arguments.\n"
     "\n" CLI_BUS_COMMON_HELP;
 
-enum { OPT_IDS = 0, OPT_RATE, OPT_DURATION, OPT_CSV, OPT_HOLD, OPT_SWING, OPT_PERIOD, OPT_KP,
-       OPT_KD, OPT_SIDE, OPT_WATCHDOG };
+enum {
+    OPT_IDS = 0,
+    OPT_RATE,
+    OPT_DURATION,
+    OPT_CSV,
+    OPT_HOLD,
+    OPT_SWING,
+    OPT_PERIOD,
+    OPT_KP,
+    OPT_KD,
+    OPT_SIDE,
+    OPT_WATCHDOG
+};
 
 typedef enum { MOTION_NONE, MOTION_HOLD, MOTION_SWING } motion_t;
 
@@ -131,14 +142,19 @@ static int parse_log_opt(log_args_t *a, int key, const char *v)
 
 static int parse_args(int argc, char **argv, log_args_t *a, cli_bus_opts_t *o, int *ec)
 {
-    static const cli_opt_t opts[] = {
-        {"--id", true, OPT_IDS},       {"--rate", true, OPT_RATE},
-        {"--duration", true, OPT_DURATION}, {"--csv", true, OPT_CSV},
-        {"--hold", false, OPT_HOLD},   {"--swing", true, OPT_SWING},
-        {"--period", true, OPT_PERIOD}, {"--kp", true, OPT_KP},
-        {"--kd", true, OPT_KD},        {"--side", true, OPT_SIDE},
-        {"--watchdog", true, OPT_WATCHDOG}, CLI_BUS_COMMON_OPTS,
-        {NULL, false, 0}};
+    static const cli_opt_t opts[] = {{"--id", true, OPT_IDS},
+                                     {"--rate", true, OPT_RATE},
+                                     {"--duration", true, OPT_DURATION},
+                                     {"--csv", true, OPT_CSV},
+                                     {"--hold", false, OPT_HOLD},
+                                     {"--swing", true, OPT_SWING},
+                                     {"--period", true, OPT_PERIOD},
+                                     {"--kp", true, OPT_KP},
+                                     {"--kd", true, OPT_KD},
+                                     {"--side", true, OPT_SIDE},
+                                     {"--watchdog", true, OPT_WATCHDOG},
+                                     CLI_BUS_COMMON_OPTS,
+                                     {NULL, false, 0}};
     cli_args_t args;
     const char *v;
     int key, rc;
@@ -199,8 +215,7 @@ static int base_command(const log_args_t *a, j288_cmd_raw_t *cmd)
 }
 
 /* Swing setpoint (rotor raw) and speed feed-forward at time t. */
-static void swing_setpoint(const log_args_t *a, int32_t p0, double t, int32_t *pos,
-                           int16_t *speed)
+static void swing_setpoint(const log_args_t *a, int32_t p0, double t, int32_t *pos, int16_t *speed)
 {
     double n = a->side == 0 ? 1.0 : J288_GEAR_RATIO;
     double w = 2.0 * J288_PI / a->period_s;

@@ -173,8 +173,8 @@ static int write_script(FILE *gp, const char *csv, const char *png, uint32_t ids
             bool first = true;
             for (id = 0; id <= J288_MAX_ID; id++) {
                 if ((ids & (1u << id)) != 0u) {
-                    fprintf(gp, ", $s%u using 1:5 with lines dt 2 lc rgb 'gray40' title '%s'",
-                            id, first ? "commanded" : "");
+                    fprintf(gp, ", $s%u using 1:5 with lines dt 2 lc rgb 'gray40' title '%s'", id,
+                            first ? "commanded" : "");
                     first = false;
                 }
             }

@@ -77,8 +77,7 @@ const char *cli_warning_list(unsigned warnings, char *buf, size_t len)
 
 typedef j288_real_t (*from_raw_fn)(int32_t raw, j288_side_t side);
 
-static void show_quantity(FILE *f, const char *name, long raw, from_raw_fn conv,
-                          const char *unit)
+static void show_quantity(FILE *f, const char *name, long raw, from_raw_fn conv, const char *unit)
 {
     char rotor[40];
     snprintf(rotor, sizeof rotor, "%.7g %s", (double)conv((int32_t)raw, J288_SIDE_ROTOR), unit);
@@ -94,8 +93,8 @@ static void show_quantity_header(FILE *f)
 void cli_show_cmd(FILE *f, const j288_cmd_raw_t *c, const char *title)
 {
     fprintf(f, "%s\n", title);
-    fprintf(f, "  %-13s %u%s\n", "id", (unsigned)c->id, c->id == J288_BROADCAST_ID ?
-            " (broadcast)" : "");
+    fprintf(f, "  %-13s %u%s\n", "id", (unsigned)c->id,
+            c->id == J288_BROADCAST_ID ? " (broadcast)" : "");
     fprintf(f, "  %-13s %u (%s)\n", "mode", (unsigned)c->status, cli_mode_name(c->status));
     fprintf(f, "  %-13s %u (%s)\n", "watchdog", c->watchdog ? 1u : 0u,
             c->watchdog ? "enabled" : "disabled");

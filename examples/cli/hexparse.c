@@ -39,8 +39,7 @@ int cli_hex_parse(const char *text, uint8_t *out, size_t cap, size_t *len, char 
          * followed by a separator is the byte 05. */
         if (c == '0' && (text[i + 1] == 'x' || text[i + 1] == 'X') && digits % 2u == 0u) {
             i++;
-            if (hex_value(text[i + 1]) >= 0 &&
-                (text[i + 2] == '\0' || is_separator(text[i + 2]))) {
+            if (hex_value(text[i + 1]) >= 0 && (text[i + 2] == '\0' || is_separator(text[i + 2]))) {
                 if (digits / 2u < cap) {
                     out[digits / 2u] = (uint8_t)hex_value(text[i + 1]);
                 }

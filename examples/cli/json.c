@@ -65,10 +65,22 @@ static void close_container(cli_json_t *j, char bracket)
     }
 }
 
-void cli_json_begin_object(cli_json_t *j, const char *key) { open_container(j, key, '{'); }
-void cli_json_end_object(cli_json_t *j) { close_container(j, '}'); }
-void cli_json_begin_array(cli_json_t *j, const char *key) { open_container(j, key, '['); }
-void cli_json_end_array(cli_json_t *j) { close_container(j, ']'); }
+void cli_json_begin_object(cli_json_t *j, const char *key)
+{
+    open_container(j, key, '{');
+}
+void cli_json_end_object(cli_json_t *j)
+{
+    close_container(j, '}');
+}
+void cli_json_begin_array(cli_json_t *j, const char *key)
+{
+    open_container(j, key, '[');
+}
+void cli_json_end_array(cli_json_t *j)
+{
+    close_container(j, ']');
+}
 
 void cli_json_int(cli_json_t *j, const char *key, long long v)
 {

@@ -3,32 +3,12 @@
  * --port, a bus master for J288/S288 servos (scan, status, hold, move, torque, stop, log),
  * plus plot for the CSV that log writes.
  */
-#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "args.h"
 #include "cli.h"
-
-static const char *current_command;
-
-void cli_set_command(const char *name) { current_command = name; }
-
-void cli_error(const char *fmt, ...)
-{
-    va_list ap;
-    fflush(stdout);
-    if (current_command != NULL) {
-        fprintf(stderr, "j288 %s: ", current_command);
-    } else {
-        fputs("j288: ", stderr);
-    }
-    va_start(ap, fmt);
-    vfprintf(stderr, fmt, ap);
-    va_end(ap);
-    fputc('\n', stderr);
-}
 
 typedef int (*command_fn)(int argc, char **argv, const cli_global_t *g);
 
