@@ -11,6 +11,16 @@
  * watchdog trip, or the trip cleared. Clearing a trip is j288_sched_clear_watchdog(): the
  * next command to that servo goes out with the watchdog bit 0, as the manual requires.
  *
+ * Statistics: every completed transaction of a slot counts once, under its final result
+ * (crc_errors includes truncated replies; other_errors: line, port, tx timeout, offline,
+ * aborted). consecutive_failures counts failures since the last good reply, except
+ * J288_ERR_ABORTED (an emergency stop says nothing about the servo). Latencies are those of
+ * good replies. A slot starts offline: its first good reply reports J288_EV_ONLINE; it goes
+ * offline (J288_EV_OFFLINE, once) after offline_after consecutive failures. Fault and
+ * warning events compare with the previous good reply (with 0 before the first one).
+ * Watchdog events follow the reply's watchdog_tripped flag (tripped on a rising edge,
+ * cleared on a falling edge).
+ *
  * The scheduler owns the bus's completion callback while a sweep runs; do not submit to the
  * same bus yourself in between. Thread only unless the bus advances in its ISR, in which case
  * the same rules as bus.h apply (thread calls are wrapped in the port's lock/unlock).
@@ -114,7 +124,12 @@ int j288_sched_set_cmd_si(j288_sched_t *s, const j288_cmd_si_t *cmd, j288_side_t
 #endif
 
 /* Begin a sweep over the enabled slots. Errors: J288_ERR_NULL, J288_ERR_BUSY (a sweep is
- * running or the bus is busy). A sweep with no enabled slot ends at once. */
+ * running, or the bus refused the first submit: a transaction in flight or queued, or an
+ * estop pending). A sweep with no enabled slot ends at once (on_sweep is called, and a
+ * continuous scheduler does not restart an empty sweep). Starting during the 2 us guard
+ * after the previous transaction is fine (the first command waits for the guard). If the
+ * bus refuses a submit in the middle of a sweep (an estop made directly on the bus), the
+ * sweep ends there without counting; that slot's last_result says why. */
 int j288_sched_start_sweep(j288_sched_t *s, uint32_t now_us);
 
 /* Advance bus and scheduler (calls j288_bus_poll()). Thread only, or the owning ISR. */
@@ -124,12 +139,17 @@ void j288_sched_poll(j288_sched_t *s, uint32_t now_us);
 bool j288_sched_busy(const j288_sched_t *s);
 
 /* Ask that servo id's watchdog trip be cleared: its next command goes out with the
- * watchdog bit 0 (once), after which the slot's own watchdog setting applies again.
+ * watchdog bit 0 (once), after which the slot's own watchdog setting applies again. "Once"
+ * means until a transaction carrying it succeeds: if the servo did not answer, the next
+ * sweep sends the bit 0 again. The slot must be enabled for anything to be sent.
  * Errors: J288_ERR_NULL, J288_ERR_BAD_ID. */
 int j288_sched_clear_watchdog(j288_sched_t *s, uint8_t id);
 
 /* Emergency stop: end the sweep, drop queued work and broadcast lock (j288_bus_estop()).
- * Every slot's command becomes lock so that a later sweep does not resume motion. */
+ * Every slot's command becomes lock (all fields 0, each slot's watchdog bit kept) so that a
+ * later sweep does not resume motion; no further slot is sent in this sweep, and the
+ * transaction in flight ends J288_ERR_ABORTED. Sweeps resume only with
+ * j288_sched_start_sweep(). Errors: J288_ERR_NULL. */
 int j288_sched_estop(j288_sched_t *s, uint32_t now_us);
 
 /* Slot id's state, or NULL for a bad id. Valid until the next poll. */
