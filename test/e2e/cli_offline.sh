@@ -106,6 +106,10 @@ assert o[\"warnings\"] == 7 and o[\"out_pos_raw\"] == 8191 and o[\"case_temp_c\"
 assert o[\"voltage_v\"] == 127.5 and o[\"warning_names\"][0].startswith(\"low-voltage\"), o
 '"
 
+# JSON validity as `python3 -m json.tool` sees it, for a command and a reply.
+expect_true json_tool_command bash -c "'$J288' decode --json $FOC3 | python3 -m json.tool >/dev/null"
+expect_true json_tool_reply bash -c "'$J288' decode --json $REPLY3_SPACED | python3 -m json.tool >/dev/null"
+
 # --- golden vectors -------------------------------------------------------------------------
 if ls test/vectors/* >/dev/null 2>&1; then
     expect_true golden_vectors python3 test/e2e/cli_vectors.py "$J288" test/vectors
