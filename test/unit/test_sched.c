@@ -468,6 +468,37 @@ static void test_estop_while_sweeping(void)
     TEST_ASSERT_EQUAL_INT(0, fp.lock_errors);
 }
 
+static void estop_on_fault(void *user, const j288_event_t *ev)
+{
+    on_event(user, ev);
+    if (ev->kind == J288_EV_FAULTS_CHANGED) {
+        TEST_ASSERT_EQUAL_INT(J288_OK, j288_sched_estop(&sch, 0u));
+    }
+}
+
+static void test_estop_from_an_event_callback(void)
+{
+    static const uint8_t ids[3] = {0u, 1u, 2u};
+    j288_cmd_raw_t stop;
+    memset(&stop, 0, sizeof stop);
+    stop.id = 15u;
+    stop.watchdog = true;
+    setup_all(true, true, 0u);
+    sch.cfg.on_event = estop_on_fault;
+    add_servos(ids, 3u);
+    fp.servo[1].reply.faults = J288_FAULT_OVER_CURRENT;
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_sched_start_sweep(&sch, 0u));
+    fake_port_run_until(&fp, 5000u * US);
+    /* servo 0, servo 1 (fault: stop), then the stop frame right after servo 1's reply */
+    TEST_ASSERT_EQUAL_UINT32(3u, fp.nframes);
+    assert_frame_cmd(2u, &stop);
+    TEST_ASSERT_EQUAL_UINT32(TXN_US + 86u, fake_port_frame(&fp, 2u)->start_us);
+    TEST_ASSERT_FALSE(j288_sched_busy(&sch));
+    TEST_ASSERT_EQUAL_UINT32(1u, j288_bus_stats(&bus)->estops);
+    TEST_ASSERT_EQUAL_UINT32(0u, j288_bus_stats(&bus)->aborted);
+    TEST_ASSERT_EQUAL_INT(0, fp.lock_errors);
+}
+
 static void test_control_loop_ticks_in_poll_mode(void)
 {
     static const uint8_t ids[3] = {0u, 1u, 2u};
@@ -499,6 +530,7 @@ int main(void)
     RUN_TEST(test_wrong_id_and_crc_in_slot_stats);
     RUN_TEST(test_collision_in_slot_stats);
     RUN_TEST(test_estop_while_sweeping);
+    RUN_TEST(test_estop_from_an_event_callback);
     RUN_TEST(test_control_loop_ticks_in_poll_mode);
     return UNITY_END();
 }
