@@ -9,16 +9,18 @@
  *
  * - TX: the command is on the wire; the port reports the end with j288_bus_on_tx_done().
  * - ECHO (config.echo): a transceiver that hears itself returns our 20 bytes first; they are
- *   compared byte for byte, and a difference is a collision.
+ *   compared byte for byte, and a difference is a collision (the attempt ends as soon as
+ *   the transmit is complete; an echo still incomplete at the deadline is one too).
  * - WAIT_REPLY: bytes go through the reply parser; a good reply from the addressed id ends
  *   the transaction. A good reply from another id, or a corrupt frame, is recorded and the
  *   wait goes on until the deadline; the result then names the most specific failure
- *   (wrong id > crc > timeout). The deadline is the wire time of command and reply at the
+ *   (wrong id > line > crc > timeout). The deadline is the wire time of command and reply at the
  *   configured baud plus turnaround_us plus margin_us, counted from the start of transmit.
  * - GUARD: a quiet gap before the next transmit (guard_us after success; after a failure the
- *   full reply budget, so that a late reply dies out). Anything received during the guard,
- *   or before a transmit completes, is discarded and counted as stale: a late reply is
- *   never credited to a later transaction.
+ *   full reply budget, so that a late reply dies out). Anything received while idle, during
+ *   the guard, or (without echo) before our transmit completes, is discarded and counted as
+ *   stale; a frame from another id is never taken: a late reply is never credited to a
+ *   later transaction. A broadcast ends when its transmit (and echo) is complete.
  * - Retries (config.retries): a failed attempt is re-sent after the guard; each attempt's
  *   reason is kept in the j288_txn_t. J288_ERR_OFFLINE and an emergency stop end it at once.
  * - Line errors (j288_bus_on_error) during an attempt mark it: when no good reply comes, the
