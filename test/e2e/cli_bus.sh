@@ -314,7 +314,7 @@ import csv
 rows = list(csv.DictReader(open('$E2E_TMP/f.csv')))
 bad = [r for r in rows if r['ok'] == '0']
 assert bad and all(r['pos_rad'] == '' for r in bad), len(bad)"
-e2e_run "$J288" --port "$DEV" move --id 2 --pos 0.1 --duration 0.5 --json
+e2e_run "$J288" --port "$DEV" move --id 2 --pos 0.1 --duration 0.5 --retries 0 --json
 json_check faulty_move_completes 'assert o["ended"] == "done" and o["failures"] > 0 and o["locked"], o'
 stop_sim "$SIM_PID"
 
