@@ -3,9 +3,9 @@
 
 #include <string.h>
 
-#define RING_MASK (J288_CONFIG_RX_RING_SIZE - 1u)
+#define RING_MASK  (J288_CONFIG_RX_RING_SIZE - 1u)
 #define MAX_CFG_US 60000000u /* longest turnaround, margin or guard: 1 minute */
-#define MAX_STEPS 16u        /* transitions per advance call; more is a bug, not a hang */
+#define MAX_STEPS  16u       /* transitions per advance call; more is a bug, not a hang */
 
 /* Failure ranking at the deadline: the most specific observation names the result. */
 static unsigned fail_rank(int err)
@@ -24,7 +24,10 @@ static unsigned fail_rank(int err)
 }
 
 /* Wrap-safe "now is at or after t", for intervals below 2^31 us. */
-static bool time_reached(uint32_t now, uint32_t t) { return (uint32_t)(now - t) < 0x80000000u; }
+static bool time_reached(uint32_t now, uint32_t t)
+{
+    return (uint32_t)(now - t) < 0x80000000u;
+}
 
 static bool is_active(uint8_t state)
 {
@@ -133,8 +136,8 @@ int j288_bus_init(j288_bus_t *bus, const j288_port_t *port, void *port_ctx,
     bus->crc.fn = port->crc32;
     bus->crc.ctx = port_ctx;
     bus->cfg = c;
-    bus->reply_budget_us = j288_wire_time_us(c.baud, J288_CMD_LEN + J288_REPLY_LEN) +
-                           c.turnaround_us + c.margin_us;
+    bus->reply_budget_us =
+        j288_wire_time_us(c.baud, J288_CMD_LEN + J288_REPLY_LEN) + c.turnaround_us + c.margin_us;
     bus->state = (uint8_t)J288_BUS_IDLE;
     bus->attempt_fail = J288_OK;
     return j288_parser_init(&bus->parser, J288_PARSE_REPLY, &bus->crc);
@@ -741,7 +744,10 @@ j288_bus_state_t j288_bus_state(const j288_bus_t *bus)
     return (bus == NULL) ? J288_BUS_IDLE : (j288_bus_state_t)bus->state;
 }
 
-bool j288_bus_is_idle(const j288_bus_t *bus) { return j288_bus_state(bus) == J288_BUS_IDLE; }
+bool j288_bus_is_idle(const j288_bus_t *bus)
+{
+    return j288_bus_state(bus) == J288_BUS_IDLE;
+}
 
 const j288_bus_stats_t *j288_bus_stats(const j288_bus_t *bus)
 {

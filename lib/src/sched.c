@@ -288,7 +288,10 @@ void j288_sched_poll(j288_sched_t *s, uint32_t now_us)
     }
 }
 
-bool j288_sched_busy(const j288_sched_t *s) { return (s != NULL) && s->sweeping; }
+bool j288_sched_busy(const j288_sched_t *s)
+{
+    return (s != NULL) && s->sweeping;
+}
 
 int j288_sched_clear_watchdog(j288_sched_t *s, uint8_t id)
 {
@@ -329,4 +332,7 @@ const j288_slot_t *j288_sched_slot(const j288_sched_t *s, uint8_t id)
     return &s->slot[id];
 }
 
-uint32_t j288_sched_sweeps(const j288_sched_t *s) { return (s == NULL) ? 0u : s->sweeps; }
+uint32_t j288_sched_sweeps(const j288_sched_t *s)
+{
+    return (s == NULL) ? 0u : s->sweeps;
+}

@@ -18,8 +18,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define WARMUP 5u
-#define MEASURE 200u
+#define WARMUP            5u
+#define MEASURE           200u
 #define WIRE_NS_PER_SERVO 76667.0 /* 46 bytes x 10 bits at 6 Mbps */
 
 static fake_port_t fp;
@@ -45,9 +45,15 @@ static void on_sweep(void *user, uint32_t sweep, uint32_t now_us)
 
 /* Entry points kept out of line so that callgrind can count from them. */
 void bench_poll(void *sched, uint32_t now_us);
-void bench_poll(void *sched, uint32_t now_us) { j288_sched_poll((j288_sched_t *)sched, now_us); }
+void bench_poll(void *sched, uint32_t now_us)
+{
+    j288_sched_poll((j288_sched_t *)sched, now_us);
+}
 int bench_start(uint32_t now_us);
-int bench_start(uint32_t now_us) { return j288_sched_start_sweep(&sch, now_us); }
+int bench_start(uint32_t now_us)
+{
+    return j288_sched_start_sweep(&sch, now_us);
+}
 
 static int setup(unsigned nservos, uint32_t turnaround_ns, uint32_t rx_latency_ns,
                  uint32_t guard_us, bool isr, meter_t *m)
@@ -177,9 +183,8 @@ int main(int argc, char **argv)
         } else if (strcmp(argv[i], "--poll") == 0) {
             poll = true;
         } else {
-            fprintf(stderr,
-                    "usage: bus_timing [--turnaround \"0 10 20 50\"] [--rx-latency NS] "
-                    "[--guard US] | --count N [--poll]\n");
+            fprintf(stderr, "usage: bus_timing [--turnaround \"0 10 20 50\"] [--rx-latency NS] "
+                            "[--guard US] | --count N [--poll]\n");
             return 2;
         }
     }

@@ -16,7 +16,10 @@ uint32_t fake_port_now_us(const fake_port_t *fp)
     return fp->origin_us + (uint32_t)(fp->now_ns / NS_PER_US);
 }
 
-uint64_t fake_port_byte_ns(const fake_port_t *fp) { return 10000000000ull / fp->baud; }
+uint64_t fake_port_byte_ns(const fake_port_t *fp)
+{
+    return 10000000000ull / fp->baud;
+}
 
 /* End of byte i (0-based) of a stream that starts at t0, without accumulated rounding. */
 static uint64_t byte_end_ns(const fake_port_t *fp, uint64_t t0, size_t i)
@@ -74,7 +77,10 @@ void fake_port_rx_paced(fake_port_t *fp, uint64_t t_ns, const uint8_t *data, siz
     }
 }
 
-void fake_port_idle_at(fake_port_t *fp, uint64_t t_ns) { (void)ev_new(fp, t_ns, EV_IDLE); }
+void fake_port_idle_at(fake_port_t *fp, uint64_t t_ns)
+{
+    (void)ev_new(fp, t_ns, EV_IDLE);
+}
 
 void fake_port_error_at(fake_port_t *fp, uint64_t t_ns, uint32_t line_flags)
 {
@@ -84,7 +90,10 @@ void fake_port_error_at(fake_port_t *fp, uint64_t t_ns, uint32_t line_flags)
     }
 }
 
-void fake_port_tx_done_at(fake_port_t *fp, uint64_t t_ns) { (void)ev_new(fp, t_ns, EV_TXDONE); }
+void fake_port_tx_done_at(fake_port_t *fp, uint64_t t_ns)
+{
+    (void)ev_new(fp, t_ns, EV_TXDONE);
+}
 
 /* Earliest event index (ties: scheduling order), or -1. */
 static int ev_earliest(const fake_port_t *fp)
@@ -114,8 +123,7 @@ uint64_t fake_port_next_event_ns(const fake_port_t *fp)
 static void servos_hear(fake_port_t *fp, const uint8_t *data, size_t len, uint64_t tx_end);
 
 /* Everything that enters the bus from the fake goes through here (benchmarks count it). */
-void fake_port_deliver(fake_port_t *fp, int kind, const uint8_t *data, size_t len,
-                       uint32_t flags)
+void fake_port_deliver(fake_port_t *fp, int kind, const uint8_t *data, size_t len, uint32_t flags)
 {
     switch (kind) {
     case EV_RX:
@@ -199,7 +207,10 @@ void fake_port_run_until(fake_port_t *fp, uint64_t t_ns)
     poll_hook(fp);
 }
 
-void fake_port_run_for(fake_port_t *fp, uint64_t dt_ns) { fake_port_run_until(fp, fp->now_ns + dt_ns); }
+void fake_port_run_for(fake_port_t *fp, uint64_t dt_ns)
+{
+    fake_port_run_until(fp, fp->now_ns + dt_ns);
+}
 
 bool fake_port_run_until_idle(fake_port_t *fp, uint64_t limit_ns)
 {
@@ -252,8 +263,8 @@ static uint64_t schedule_reply(fake_port_t *fp, const fake_servo_t *sv, const ui
     } else {
         while (pos < n) {
             size_t k = ((n - pos) < sv->chunk) ? (n - pos) : sv->chunk;
-            fake_port_rx_at(fp, byte_end_ns(fp, t0, pos + k - 1u) + fp->rx_latency_ns,
-                            &stream[pos], k);
+            fake_port_rx_at(fp, byte_end_ns(fp, t0, pos + k - 1u) + fp->rx_latency_ns, &stream[pos],
+                            k);
             pos += k;
         }
     }
@@ -374,9 +385,15 @@ static int op_start_tx(void *ctx, const uint8_t *data, size_t len)
     return 0;
 }
 
-static uint32_t op_now_us(void *ctx) { return fake_port_now_us((const fake_port_t *)ctx); }
+static uint32_t op_now_us(void *ctx)
+{
+    return fake_port_now_us((const fake_port_t *)ctx);
+}
 
-static void op_start_rx(void *ctx) { ((fake_port_t *)ctx)->start_rx_calls++; }
+static void op_start_rx(void *ctx)
+{
+    ((fake_port_t *)ctx)->start_rx_calls++;
+}
 
 static void op_set_dir(void *ctx, j288_dir_t dir)
 {
@@ -458,7 +475,10 @@ void fake_port_init(fake_port_t *fp)
     }
 }
 
-void fake_port_attach(fake_port_t *fp, j288_bus_t *bus) { fp->bus = bus; }
+void fake_port_attach(fake_port_t *fp, j288_bus_t *bus)
+{
+    fp->bus = bus;
+}
 
 void fake_port_add_servo(fake_port_t *fp, uint8_t id, const j288_reply_raw_t *reply)
 {
@@ -481,7 +501,10 @@ const fake_frame_t *fake_port_frame(const fake_port_t *fp, uint32_t i)
     return (i < fp->nframes && i < FAKE_PORT_MAX_FRAMES) ? &fp->frame[i] : NULL;
 }
 
-void fake_port_poll_bus(void *bus, uint32_t now_us) { j288_bus_poll((j288_bus_t *)bus, now_us); }
+void fake_port_poll_bus(void *bus, uint32_t now_us)
+{
+    j288_bus_poll((j288_bus_t *)bus, now_us);
+}
 
 void fake_port_poll_sched(void *sched, uint32_t now_us)
 {

@@ -41,7 +41,7 @@
 
 #define FAKE_PORT_MAX_FRAMES 128u /* frames recorded in full; later ones are only counted */
 #define FAKE_PORT_MAX_EVENTS 512u /* scheduled events pending at once */
-#define FAKE_PORT_CHUNK_MAX 32u   /* bytes in one scheduled rx event */
+#define FAKE_PORT_CHUNK_MAX  32u  /* bytes in one scheduled rx event */
 
 typedef enum {
     FAKE_TXDONE_TIMED = 0, /* tx done after the frame's wire time (an MCU) */
@@ -78,22 +78,22 @@ typedef void (*fake_poll_fn)(void *user, uint32_t now_us);
 typedef struct fake_port fake_port_t;
 
 struct fake_port {
-    j288_port_t ops;   /* hand &fp->ops and fp to j288_bus_init() */
-    j288_bus_t *bus;   /* events go here (fake_port_attach) */
+    j288_port_t ops; /* hand &fp->ops and fp to j288_bus_init() */
+    j288_bus_t *bus; /* events go here (fake_port_attach) */
 
     /* configuration: set after fake_port_init, before running */
-    uint32_t baud;              /* byte timing, 8N1; default 6000000 */
-    uint32_t origin_us;         /* now_us() at virtual time 0 (test wrap-around) */
-    fake_txdone_mode_t txdone;  /* default TIMED */
+    uint32_t baud;             /* byte timing, 8N1; default 6000000 */
+    uint32_t origin_us;        /* now_us() at virtual time 0 (test wrap-around) */
+    fake_txdone_mode_t txdone; /* default TIMED */
     bool echo;
-    int echo_flip_at;           /* echoed byte index to corrupt, -1: none */
-    uint32_t echo_delay_ns;     /* receive path delay of the echo (e.g. a FIFO) */
-    bool idle;                  /* report rx idle one byte time after each reply; default on */
-    uint32_t turnaround_ns;     /* default servo turnaround: 10000 (10 us) */
-    uint32_t rx_latency_ns;     /* servo reply bytes reach the bus this much later (an
-                                   idle-line DMA interrupt, ISR latency); idle too */
-    int start_tx_fail;          /* > 0: that many next start_tx calls return J288_ERR_PORT */
-    bool gone;                  /* wait() returns J288_ERR_OFFLINE */
+    int echo_flip_at;       /* echoed byte index to corrupt, -1: none */
+    uint32_t echo_delay_ns; /* receive path delay of the echo (e.g. a FIFO) */
+    bool idle;              /* report rx idle one byte time after each reply; default on */
+    uint32_t turnaround_ns; /* default servo turnaround: 10000 (10 us) */
+    uint32_t rx_latency_ns; /* servo reply bytes reach the bus this much later (an
+                               idle-line DMA interrupt, ISR latency); idle too */
+    int start_tx_fail;      /* > 0: that many next start_tx calls return J288_ERR_PORT */
+    bool gone;              /* wait() returns J288_ERR_OFFLINE */
     fake_poll_fn poll_fn;
     void *poll_user;
     fake_servo_t servo[J288_MAX_SERVOS];
@@ -101,8 +101,8 @@ struct fake_port {
     /* observation */
     uint64_t now_ns;
     fake_frame_t frame[FAKE_PORT_MAX_FRAMES];
-    uint32_t nframes;           /* frames sent (may exceed FAKE_PORT_MAX_FRAMES) */
-    fake_frame_t last;          /* the latest frame sent */
+    uint32_t nframes;  /* frames sent (may exceed FAKE_PORT_MAX_FRAMES) */
+    fake_frame_t last; /* the latest frame sent */
     uint32_t set_dir_calls;
     j288_dir_t dir;
     uint32_t start_rx_calls;
@@ -112,11 +112,11 @@ struct fake_port {
     uint64_t timer_ns;
     int lock_depth;
     uint32_t lock_calls;
-    int lock_errors;            /* unlock without lock, or nested lock */
-    uint32_t crc_calls;         /* when ops.crc32 is fake_port_crc32 */
+    int lock_errors;    /* unlock without lock, or nested lock */
+    uint32_t crc_calls; /* when ops.crc32 is fake_port_crc32 */
     uint32_t wait_calls;
-    bool tx_busy;               /* between start_tx and its tx done */
-    int tx_overlap_errors;      /* start_tx while a transmit was still running */
+    bool tx_busy;          /* between start_tx and its tx done */
+    int tx_overlap_errors; /* start_tx while a transmit was still running */
 
     /* private: the event queue */
     struct fake_event {
@@ -129,7 +129,7 @@ struct fake_port {
     } ev[FAKE_PORT_MAX_EVENTS];
     uint32_t nev;
     uint32_t seq;
-    int overflow_errors;        /* events dropped because the queue was full */
+    int overflow_errors; /* events dropped because the queue was full */
 };
 
 /* Defaults as described above; every op present (crc32 is NULL: the default backend). */
@@ -179,8 +179,7 @@ void fake_port_poll_sched(void *sched, uint32_t now_us);
 
 /* The one place where the fake calls into the bus (kind: internal event kind; 0 = timer).
  * Exposed so that benchmarks can count the instructions spent inside the library. */
-void fake_port_deliver(fake_port_t *fp, int kind, const uint8_t *data, size_t len,
-                       uint32_t flags);
+void fake_port_deliver(fake_port_t *fp, int kind, const uint8_t *data, size_t len, uint32_t flags);
 
 /* A crc32 op (software, counting calls) to test the port's CRC hook. */
 uint32_t fake_port_crc32(void *ctx, const uint8_t *data, size_t nwords);

@@ -18,13 +18,13 @@ static const uint8_t WORKED_CMD3[J288_CMD_LEN] = {0xfe, 0xee, 0x93, 0x00, 0x00, 
 static const uint8_t WORKED_REPLY3[J288_REPLY_LEN] = {
     0xfc, 0xee, 0x13, 0x24, 0x29, 0x30, 0x00, 0x05, 0xd7, 0xff, 0x5f, 0x14, 0x00,
     0x00, 0x00, 0x00, 0x00, 0x00, 0xe8, 0x03, 0x00, 0x00, 0x49, 0xc2, 0x3b, 0xee};
-static const uint8_t WORKED_LOCK0[J288_CMD_LEN] = {0xfe, 0xee, 0x80, 0, 0, 0, 0, 0, 0, 0,
-                                                   0,    0,    0,    0, 0, 0, 0x1d, 0x99, 0xfb, 0x6e};
+static const uint8_t WORKED_LOCK0[J288_CMD_LEN] = {
+    0xfe, 0xee, 0x80, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0x1d, 0x99, 0xfb, 0x6e};
 
-#define US 1000u
-#define TX_END_NS 33333u    /* 20 bytes at 6 Mbps */
-#define REPLY_NS 43333u     /* 26 bytes at 6 Mbps */
-#define BUDGET_US 147u      /* 77 wire + 50 turnaround + 20 margin */
+#define US        1000u
+#define TX_END_NS 33333u /* 20 bytes at 6 Mbps */
+#define REPLY_NS  43333u /* 26 bytes at 6 Mbps */
+#define BUDGET_US 147u   /* 77 wire + 50 turnaround + 20 margin */
 
 static fake_port_t fp;
 static j288_bus_t bus;
@@ -89,7 +89,10 @@ static void setup_cfg(const j288_bus_config_t *cfg)
     fp.poll_user = &bus;
 }
 
-static void setup(void) { setup_cfg(NULL); }
+static void setup(void)
+{
+    setup_cfg(NULL);
+}
 
 static void submit_ok(const j288_cmd_raw_t *cmd)
 {
@@ -493,7 +496,7 @@ static void test_two_servos_with_one_id(void)
     j288_reply_raw_t r4 = reply_for(4u, 400);
     setup();
     fake_port_add_servo(&fp, 3u, &r3);
-    fp.servo[3].twin = true;          /* its twin answers 38 us after it */
+    fp.servo[3].twin = true; /* its twin answers 38 us after it */
     fp.servo[3].twin_gap_ns = 38u * US;
     fake_port_add_servo(&fp, 4u, &r4);
     fp.servo[4].turnaround_ns = 50u * US;

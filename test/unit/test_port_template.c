@@ -43,8 +43,8 @@ static void test_template_forwards_wrapped_dma(void)
         port.rx_dma[(start + i) % J288_PORT_TEMPLATE_RX_DMA_SIZE] = frame[i];
     }
     j288_port_template_rx_event_isr(&port, 0u, false); /* transfer complete: 10 bytes */
-    j288_port_template_rx_event_isr(&port, (start + J288_REPLY_LEN) % J288_PORT_TEMPLATE_RX_DMA_SIZE,
-                                    true);
+    j288_port_template_rx_event_isr(
+        &port, (start + J288_REPLY_LEN) % J288_PORT_TEMPLATE_RX_DMA_SIZE, true);
     j288_bus_poll(&port.bus, 0u);
     TEST_ASSERT_EQUAL_INT(1, calls);
     TEST_ASSERT_EQUAL_INT(J288_OK, last.result);

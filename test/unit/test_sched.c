@@ -9,7 +9,7 @@
 void setUp(void) {}
 void tearDown(void) {}
 
-#define US 1000u
+#define US     1000u
 #define TXN_US 88u /* 33.3 tx + 10 turnaround + 43.3 reply, floored, + 2 guard */
 
 static fake_port_t fp;
@@ -107,8 +107,14 @@ static void assert_frame_cmd(uint32_t i, const j288_cmd_raw_t *cmd)
     TEST_ASSERT_EQUAL_HEX8_ARRAY(want, f->data, J288_CMD_LEN);
 }
 
-static uint8_t frame_id(uint32_t i) { return (uint8_t)(fake_port_frame(&fp, i)->data[2] & 0x0Fu); }
-static bool frame_wd(uint32_t i) { return (fake_port_frame(&fp, i)->data[2] & 0x80u) != 0u; }
+static uint8_t frame_id(uint32_t i)
+{
+    return (uint8_t)(fake_port_frame(&fp, i)->data[2] & 0x0Fu);
+}
+static bool frame_wd(uint32_t i)
+{
+    return (fake_port_frame(&fp, i)->data[2] & 0x80u) != 0u;
+}
 
 static int count_events(j288_event_kind_t kind, uint8_t id)
 {
