@@ -66,7 +66,7 @@ static void note_fail(j288_bus_t *bus, int err)
 uint32_t j288_wire_time_us(uint32_t baud, uint32_t nbytes)
 {
     uint64_t bit_us = (uint64_t)nbytes * 10u * 1000000u;
-    uint64_t b = (baud == 0u) ? J288_DEFAULT_BAUD : baud;
+    uint64_t b = (uint64_t)((baud == 0u) ? J288_DEFAULT_BAUD : baud);
     return (uint32_t)((bit_us + b - 1u) / b);
 }
 
@@ -122,7 +122,7 @@ int j288_bus_init(j288_bus_t *bus, const j288_port_t *port, void *port_ctx,
     if (cfg != NULL) {
         c = *cfg;
     } else {
-        memset(&c, 0, sizeof c);
+        (void)memset(&c, 0, sizeof c);
     }
     err = check_config(&c);
     if (err != J288_OK) {
@@ -130,7 +130,7 @@ int j288_bus_init(j288_bus_t *bus, const j288_port_t *port, void *port_ctx,
     }
     apply_defaults(&c);
 
-    memset(bus, 0, sizeof *bus);
+    (void)memset(bus, 0, sizeof *bus);
     bus->port = port;
     bus->port_ctx = port_ctx;
     bus->crc.fn = port->crc32;
@@ -150,14 +150,15 @@ static void ring_put(j288_bus_t *bus, const uint8_t *data, size_t len)
     uint32_t head = bus->ring_head;
     uint32_t room = J288_CONFIG_RX_RING_SIZE - (uint32_t)(head - bus->ring_tail);
     size_t n = (len < room) ? len : room;
-    size_t off = head & RING_MASK;
+    uint32_t masked = head & RING_MASK;
+    size_t off = masked;
     size_t first = J288_CONFIG_RX_RING_SIZE - off; /* bytes before the end of the array */
 
     if (n <= first) {
-        memcpy(&bus->ring[off], data, n);
+        (void)memcpy(&bus->ring[off], data, n);
     } else {
-        memcpy(&bus->ring[off], data, first);
-        memcpy(bus->ring, &data[first], n - first);
+        (void)memcpy(&bus->ring[off], data, first);
+        (void)memcpy(bus->ring, &data[first], n - first);
     }
     if (n < len) {
         bus->stats.rx_overflows += (uint32_t)(len - n);
@@ -281,7 +282,7 @@ static void begin_txn(j288_bus_t *bus, uint8_t id, j288_bus_done_fn done, void *
 
     bus->cur ^= 1u; /* the previous txn stays intact for a callback still looking at it */
     t = &bus->txn[bus->cur];
-    memset(t, 0, sizeof *t);
+    (void)memset(t, 0, sizeof *t);
     t->id = id;
     t->result = J288_ERR_BUSY;
     bus->tx_id = id;
@@ -294,7 +295,7 @@ static void send_estop(j288_bus_t *bus, uint32_t now)
 {
     j288_cmd_raw_t stop;
 
-    memset(&stop, 0, sizeof stop);
+    (void)memset(&stop, 0, sizeof stop);
     stop.id = J288_BROADCAST_ID;
     stop.status = J288_MODE_LOCK;
     stop.watchdog = true;

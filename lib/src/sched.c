@@ -22,7 +22,7 @@ static void sched_unlock(const j288_sched_t *s)
 
 static void lock_cmd(j288_cmd_raw_t *c, uint8_t id, bool watchdog)
 {
-    memset(c, 0, sizeof *c);
+    (void)memset(c, 0, sizeof *c);
     c->id = id;
     c->status = J288_MODE_LOCK;
     c->watchdog = watchdog;
@@ -35,7 +35,7 @@ int j288_sched_init(j288_sched_t *s, j288_bus_t *bus, const j288_sched_config_t 
     if ((s == NULL) || (bus == NULL)) {
         return J288_ERR_NULL;
     }
-    memset(s, 0, sizeof *s);
+    (void)memset(s, 0, sizeof *s);
     s->bus = bus;
     if (cfg != NULL) {
         s->cfg = *cfg;
