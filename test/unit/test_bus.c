@@ -1119,6 +1119,40 @@ static void test_transfer_blocking(void)
     TEST_ASSERT_EQUAL_INT(J288_ERR_PORT_OPS, j288_bus_transfer_blocking(&bus, &cmd, &txn));
 }
 
+static int blocking_from_cb_rc;
+
+static void on_done_try_blocking(void *user, const j288_txn_t *txn)
+{
+    j288_cmd_raw_t c = lock_cmd(1u);
+    on_done(user, txn);
+    blocking_from_cb_rc = j288_bus_transfer_blocking(&bus, &c, NULL);
+}
+
+static void test_transfer_blocking_edge_cases(void)
+{
+    j288_cmd_raw_t cmd = lock_cmd(3u);
+    j288_txn_t txn;
+    setup();
+    fp.poll_fn = NULL;
+    /* the device vanishes while the command is in flight (not queued behind a guard) */
+    TEST_ASSERT_TRUE(j288_bus_is_idle(&bus));
+    fp.gone = true;
+    TEST_ASSERT_EQUAL_INT(J288_ERR_OFFLINE, j288_bus_transfer_blocking(&bus, &cmd, &txn));
+    TEST_ASSERT_EQUAL_INT(J288_ERR_OFFLINE, txn.result);
+    TEST_ASSERT_EQUAL_UINT8(1u, txn.attempts);
+    TEST_ASSERT_EQUAL_UINT32(1u, fp.nframes);
+    fp.gone = false;
+    /* not from a completion callback */
+    fp.poll_fn = fake_port_poll_bus;
+    TEST_ASSERT_TRUE(fake_port_run_until_idle(&fp, fp.now_ns + 5000u * US));
+    blocking_from_cb_rc = 0;
+    TEST_ASSERT_EQUAL_INT(
+        J288_OK, j288_bus_submit(&bus, &cmd, fake_port_now_us(&fp), on_done_try_blocking, &cb));
+    TEST_ASSERT_TRUE(fake_port_run_until_idle(&fp, fp.now_ns + 5000u * US));
+    TEST_ASSERT_EQUAL_INT(J288_ERR_BUSY, blocking_from_cb_rc);
+    TEST_ASSERT_EQUAL_UINT32(2u, fp.nframes);
+}
+
 /* ---- poll mode without a timer op: the application's polls find the deadline */
 
 static void test_poll_only_port(void)
@@ -1187,6 +1221,7 @@ int main(void)
     RUN_TEST(test_time_wraps_at_2_pow_32);
     RUN_TEST(test_several_buses_are_independent);
     RUN_TEST(test_transfer_blocking);
+    RUN_TEST(test_transfer_blocking_edge_cases);
     RUN_TEST(test_poll_only_port);
     return UNITY_END();
 }

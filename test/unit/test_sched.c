@@ -505,6 +505,27 @@ static void test_estop_from_an_event_callback(void)
     TEST_ASSERT_EQUAL_INT(0, fp.lock_errors);
 }
 
+static void test_default_config_without_handlers(void)
+{
+    static const uint8_t ids[2] = {3u, 4u};
+    j288_cmd_si_t si;
+    setup_all(false, false, 0u);
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_sched_init(&sch, &bus, NULL)); /* no handlers */
+    memset(&si, 0, sizeof si);
+    TEST_ASSERT_EQUAL_INT(J288_ERR_NULL, j288_sched_set_cmd_si(NULL, &si, J288_SIDE_ROTOR));
+    TEST_ASSERT_EQUAL_INT(J288_ERR_NULL, j288_sched_set_cmd_si(&sch, NULL, J288_SIDE_ROTOR));
+    add_servos(ids, 2u);
+    fp.servo[4].present = false;
+    sweep_once();
+    sweep_once();
+    sweep_once();
+    TEST_ASSERT_EQUAL_INT(0, nev);
+    TEST_ASSERT_TRUE(j288_sched_slot(&sch, 3u)->online);
+    TEST_ASSERT_EQUAL_UINT32(3u, j288_sched_slot(&sch, 4u)->stats.consecutive_failures);
+    TEST_ASSERT_EQUAL_UINT32(3u, j288_sched_sweeps(&sch));
+    TEST_ASSERT_EQUAL_UINT32(0u, sweep_calls);
+}
+
 static void test_control_loop_ticks_in_poll_mode(void)
 {
     static const uint8_t ids[3] = {0u, 1u, 2u};
@@ -537,6 +558,7 @@ int main(void)
     RUN_TEST(test_collision_in_slot_stats);
     RUN_TEST(test_estop_while_sweeping);
     RUN_TEST(test_estop_from_an_event_callback);
+    RUN_TEST(test_default_config_without_handlers);
     RUN_TEST(test_control_loop_ticks_in_poll_mode);
     return UNITY_END();
 }
