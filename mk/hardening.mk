@@ -35,10 +35,16 @@ FUZZ_NAMES := $(sort $(patsubst test/fuzz/fuzz_%.c,%,$(wildcard test/fuzz/fuzz_*
 FUZZ_BINS := $(FUZZ_NAMES:%=$(BUILD)/fuzz/fuzz_%)
 FUZZ_DICT := test/fuzz/j288.dict
 
+# Per-target extras: sources (libFuzzer build), objects (replay build), preprocessor flags.
+# The CLI target links the tool's parsers as functions (hexparse.c, args.c), not by exec.
+FUZZ_EXTRA_cli := examples/cli/hexparse.c examples/cli/args.c
+FUZZ_EXTRA_OBJ_cli := $(OBJ)/examples/cli/hexparse.o $(OBJ)/examples/cli/args.o
+FUZZ_CPPFLAGS_cli = -Iexamples/cli $(CLI_CPPFLAGS)
+
 $(BUILD)/fuzz/fuzz_%: test/fuzz/fuzz_%.c test/fuzz/fuzz_common.h $(LIB_SRC) $(LIB_HDR) \
-                      $(wildcard test/fuzz/*.h)
+                      $(wildcard test/fuzz/*.h examples/cli/*.c examples/cli/*.h)
 	@mkdir -p $(@D)
-	$(FUZZ_CC) $(FUZZ_CFLAGS) $< $(FUZZ_EXTRA_$*) $(LIB_SRC) -o $@ -lm
+	$(FUZZ_CC) $(FUZZ_CFLAGS) $(FUZZ_CPPFLAGS_$*) $< $(FUZZ_EXTRA_$*) $(LIB_SRC) -o $@ -lm
 
 .PHONY: fuzz fuzz-ci fuzz-build fuzz-corpus
 fuzz-build:
@@ -79,12 +85,14 @@ $(OBJ)/test/fuzz/replay_%.o: test/fuzz/replay_main.c test/fuzz/fuzz_common.h
 
 $(OBJ)/test/fuzz/fuzz_%.o: test/fuzz/fuzz_%.c $(LIB_HDR) $(wildcard test/fuzz/*.h test/support/*.h)
 	@mkdir -p $(@D)
-	$(CC) $(CPPFLAGS_LIB) -Itest/fuzz -Itest/support $(CFLAGS_COMMON) -c $< -o $@
+	$(CC) $(CPPFLAGS_LIB) -Itest/fuzz -Itest/support $(FUZZ_CPPFLAGS_$*) $(CFLAGS_COMMON) -c $< -o $@
 
-$(BUILD)/test/fuzz_replay_%: $(OBJ)/test/fuzz/fuzz_%.o $(OBJ)/test/fuzz/replay_%.o \
-                             $(FUZZ_EXTRA_OBJ_$*) $(LIB_A)
+$(BUILD)/test/fuzz_replay_%: $(OBJ)/test/fuzz/fuzz_%.o $(OBJ)/test/fuzz/replay_%.o $(LIB_A)
 	@mkdir -p $(@D)
 	$(CC) $(CFLAGS_COMMON) $^ -o $@ $(LDFLAGS_COMMON) -lm
+
+# Extra objects of a target's replay (a rule without recipe adds prerequisites, and so $^).
+$(BUILD)/test/fuzz_replay_cli: $(FUZZ_EXTRA_OBJ_cli)
 
 HOST_TESTS += $(FUZZ_REPLAY_TESTS)
 ALL_TARGETS += $(FUZZ_REPLAY_TESTS)

@@ -53,7 +53,7 @@ def main():
     cmd_pick = cmd_frames[:: max(1, len(cmd_frames) // 8)][:8]
     rpl_pick = rpl_frames[:: max(1, len(rpl_frames) // 8)][:8]
 
-    for t in ("parser", "codec", "units"):
+    for t in ("parser", "codec", "units", "cli"):
         clear(t)
 
     # parser: flags, nchunks, chunk sizes, stream.
@@ -109,6 +109,20 @@ def main():
     write("units", "seed_si_half", [0] + list(dbl(32767.5 / 256000.0, -32768.5 / 256000.0, 0, 0, 0)))
     write("units", "seed_raw_rotor", [2] + list(struct.pack("<BBhhihh", 3, 1, -700, 41, 5215, 1280, 12800)) + [0xe8, 3, 48])
     write("units", "seed_raw_output", [3] + list(struct.pack("<BBhhihh", 7, 1, 32767, -32768, -2**31, 32767, 0)) + [0xff, 0xff, 255])
+
+    # cli: byte 0 = case (0 hex, 1 arguments, 2 integer, 3 real, 4 id list), bytes 1-2 =
+    # parameters, then the text.
+    write("cli", "seed_hex_spec", [0, 30, 60] + list(" ".join("%02x" % b for b in cmd_frames[0][1]).encode()))
+    write("cli", "seed_hex_forms", [0, 5, 10] + list(b"0xfe,0xEE:80 1d"))
+    write("cli", "seed_hex_odd", [0, 3, 2] + list(b"fee"))
+    write("cli", "seed_args", [1, 0, 0] + list(b"--id\x003\x00--flag\x00--tau=-0.5\x00pos\x00--\x00--id"))
+    write("cli", "seed_args_help", [1, 0, 0] + list(b"-h\x00--port"))
+    for i, t in enumerate([b"3", b"-0x10", b"0x", b"+14", b"9223372036854775808", b" 3", b"010"]):
+        write("cli", "seed_int_%d" % i, [2, i, 7 - i] + list(t))
+    for i, t in enumerate([b"0.5", b"-1e3", b"nan", b"inf", b"1e999", b"0x1p3"]):
+        write("cli", "seed_real_%d" % i, [3, 0, 0] + list(t))
+    for i, t in enumerate([b"1,2,3", b"0,14", b"1,,2", b"3,3", b"15"]):
+        write("cli", "seed_ids_%d" % i, [4, 14, 0] + list(t))
     return 0
 
 
