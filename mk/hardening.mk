@@ -111,8 +111,10 @@ test-asan: $(UNITY)/unity.c
 HARD_VALGRIND := valgrind -q --error-exitcode=1 --leak-check=full --show-leak-kinds=all \
                  --errors-for-leak-kinds=definite,indirect,possible --track-origins=yes
 
-test-valgrind: $(HOST_TESTS) $(TEST_DEPS)
+# (Fragments included after this one add to HOST_TESTS: the list is taken at run time.)
+test-valgrind:
 	@$(call HARD_REQUIRE,valgrind,valgrind); \
+	 $(MAKE) --no-print-directory $(HOST_TESTS) $(TEST_DEPS) && \
 	 TEST_WRAPPER="$(HARD_VALGRIND)" BUILD=$(BUILD) BIN=$(BIN) bash scripts/run-tests.sh $(HOST_TESTS)
 
 # ---------------------------------------------------------------------------------------------
