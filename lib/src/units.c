@@ -69,7 +69,7 @@ static bool round_into(j288_real_t v, int32_t lo, int32_t hi, int32_t *out)
 {
     bool neg = v < (j288_real_t)0;
     /* largest magnitude allowed on this side; -(lo + 1) + 1 avoids negating INT32_MIN */
-    uint32_t limit = neg ? (uint32_t)(-(lo + 1)) + 1u : (uint32_t)hi;
+    uint32_t limit = neg ? ((uint32_t)(-(lo + 1)) + 1u) : (uint32_t)hi;
     uint32_t mag = 0u;
 
     /* A coarse window first: catches infinities and keeps the conversions defined. Exactly
