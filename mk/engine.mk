@@ -37,3 +37,37 @@ port-template: $(LIB_A)
 	else echo "port-template: skipping the Cortex-M0 build; install gcc-arm-none-eabi"; fi
 $(OBJ)/test/unit/test_port_template.o: port/template/j288_port_template.c \
     port/template/j288_port_template.h
+
+# Engine cost on Cortex-M under QEMU -icount (instructions per transaction, port ops empty):
+#   make bench-bus-target   needs arm-none-eabi-gcc and qemu-system-arm (Debian packages
+#                           gcc-arm-none-eabi libnewlib-arm-none-eabi qemu-system-arm)
+ENGINE_TGT_DIR := $(BUILD)/bench-bus-target
+ENGINE_TGT_m4 := -mcpu=cortex-m4 -mthumb -mfloat-abi=hard -mfpu=fpv4-sp-d16 -DJ288_CONFIG_SI_FLOAT=1
+ENGINE_TGT_m0 := -mcpu=cortex-m0 -mthumb -mfloat-abi=soft
+ENGINE_TGT_QEMU_m4 := -M mps2-an386 -cpu cortex-m4
+ENGINE_TGT_QEMU_m0 := -M mps2-an385 -cpu cortex-m3
+ENGINE_TGT_ELFS := $(foreach c,m0 m4,$(foreach o,O2 Os,$(ENGINE_TGT_DIR)/bus_target_$(c)_$(o).elf))
+
+$(ENGINE_TGT_DIR)/bus_target_%.elf: test/bench/bus_target.c test/target/startup.c $(LIB_SRC) $(LIB_HDR)
+	@mkdir -p $(@D)
+	arm-none-eabi-gcc $(ENGINE_TGT_$(word 1,$(subst _, ,$*))) -$(word 2,$(subst _, ,$*)) -g \
+	    $(CSTD) $(WARN) -ffunction-sections -fdata-sections $(CPPFLAGS_LIB) \
+	    test/bench/bus_target.c test/target/startup.c $(LIB_SRC) \
+	    -nostartfiles --specs=nano.specs --specs=rdimon.specs -Wl,--gc-sections -Ltest/target \
+	    -T mem_mps2.ld -o $@ -lm
+
+.PHONY: bench-bus-target
+bench: bench-bus-target
+bench-bus-target:
+	@if ! command -v arm-none-eabi-gcc >/dev/null 2>&1 || ! command -v qemu-system-arm >/dev/null 2>&1; then \
+	    if [ "$$CI" = true ]; then echo "bench-bus-target: arm-none-eabi-gcc or qemu-system-arm missing" >&2; exit 1; fi; \
+	    echo "bench-bus-target: skipped; install gcc-arm-none-eabi libnewlib-arm-none-eabi qemu-system-arm"; \
+	    exit 0; fi; \
+	 $(MAKE) --no-print-directory BUILD=$(BUILD) $(ENGINE_TGT_ELFS) >/dev/null && \
+	 for c in m0 m4; do for o in O2 Os; do \
+	    echo "Cortex-$$c -$$o (QEMU -icount shift=0), instructions per transaction:"; \
+	    if [ $$c = m4 ]; then q="$(ENGINE_TGT_QEMU_m4)"; else q="$(ENGINE_TGT_QEMU_m0)"; fi; \
+	    timeout 120 qemu-system-arm $$q -icount shift=0 -nographic -monitor none -serial none \
+	        -semihosting-config enable=on,target=native \
+	        -kernel $(ENGINE_TGT_DIR)/bus_target_$${c}_$$o.elf || exit 1; \
+	 done; done
