@@ -173,7 +173,9 @@ static void enter_guard(j288_bus_t *bus, uint32_t now, uint32_t gap)
     bus->state = (uint8_t)J288_BUS_GUARD;
     bus->guard_end = now + gap;
     arm_at(bus, bus->guard_end);
-    bus->again = true;
+    if (bus->estop_pending) {
+        bus->again = true; /* the stop goes out at once, not after the guard */
+    }
 }
 
 static void finish(j288_bus_t *bus, int result, uint32_t now)
@@ -237,6 +239,14 @@ static void end_attempt(j288_bus_t *bus, int result, uint32_t now)
     enter_guard(bus, now, bus->reply_budget_us);
 }
 
+/* Something recorded that the machine has not looked at yet. */
+static bool events_pending(const j288_bus_t *bus)
+{
+    return (bus->ev_tx_done != bus->seen_tx_done) || (bus->ring_head != bus->ring_tail) ||
+           (bus->ev_idle != bus->seen_idle) || (bus->ev_line != bus->seen_line) ||
+           (bus->ev_gone != bus->seen_gone);
+}
+
 static void start_attempt(j288_bus_t *bus, uint32_t now)
 {
     j288_txn_t *t = &bus->txn[bus->cur];
@@ -261,7 +271,6 @@ static void start_attempt(j288_bus_t *bus, uint32_t now)
     bus->deadline = now + bus->reply_budget_us;
     /* State first: the port may report tx done from inside start_tx. */
     bus->state = (uint8_t)J288_BUS_TX;
-    bus->again = true;
     arm_at(bus, bus->deadline);
     if (bus->port->set_dir != NULL) {
         bus->port->set_dir(bus->port_ctx, J288_DIR_TX);
@@ -273,6 +282,9 @@ static void start_attempt(j288_bus_t *bus, uint32_t now)
     if (rc < 0) {
         bus->stats.port_errors++;
         end_attempt(bus, J288_ERR_PORT, now);
+    } else {
+        /* Events reported from inside start_tx are taken in this same advance. */
+        bus->again = bus->again || events_pending(bus);
     }
 }
 
@@ -457,15 +469,11 @@ static void after_transmit(j288_bus_t *bus, uint32_t now)
     if (bus->collided) {
         end_attempt(bus, J288_ERR_COLLISION, now);
     } else if (bus->cfg.echo && (bus->echo_pos < J288_CMD_LEN)) {
-        if (bus->state != J288_BUS_ECHO) {
-            bus->state = (uint8_t)J288_BUS_ECHO;
-            bus->again = true;
-        }
+        bus->state = (uint8_t)J288_BUS_ECHO;
     } else if (bus->tx_id == J288_BROADCAST_ID) {
         end_attempt(bus, (bus->attempt_fail == J288_ERR_LINE) ? J288_ERR_LINE : J288_OK, now);
     } else {
-        bus->state = (uint8_t)J288_BUS_WAIT_REPLY;
-        bus->again = true;
+        bus->state = (uint8_t)J288_BUS_WAIT_REPLY; /* bytes so far were taken already */
     }
 }
 
