@@ -144,16 +144,23 @@ void tearDown(void)
     (void)unlink(g_log);
 }
 
-/* Open the simulator's pty with a short margin (a pty answers in microseconds). */
-static void open_sim_port(void)
+/* Open the simulator's pty with a reply margin of margin_us. */
+static void open_sim_port_margin(uint32_t margin_us)
 {
     j288_linux_options_t opt;
     memset(&opt, 0, sizeof opt);
-    opt.margin_us = 10000;
+    opt.margin_us = margin_us;
     TEST_ASSERT_EQUAL_INT_MESSAGE(J288_OK, j288_linux_open(&g_lp, g_pty, 0, &opt),
                                   j288_linux_error(&g_lp));
     TEST_ASSERT_EQUAL_INT(J288_OK, j288_linux_bus_init(&g_lp, &g_bus, NULL));
 }
+
+/* A short margin (a pty answers in microseconds), for tests that wait out timeouts. */
+static void open_sim_port(void) { open_sim_port_margin(10000u); }
+
+/* Tests that count successes use a margin far beyond any scheduling hiccup of a loaded CI
+ * machine (or valgrind): a failure there then means a real fault, not a slow simulator. */
+#define LOADED_MACHINE_MARGIN_US 250000u
 
 static j288_cmd_raw_t lock_cmd(uint8_t id)
 {
@@ -238,7 +245,7 @@ static void test_scheduler_sweeps(void)
     int i;
     uint32_t next;
     sim_start("--ids", "1,2,3", NULL);
-    open_sim_port();
+    open_sim_port_margin(LOADED_MACHINE_MARGIN_US);
     TEST_ASSERT_EQUAL_INT(J288_OK, j288_sched_init(&s, &g_bus, NULL));
     for (id = 1; id <= 3; id++)
         TEST_ASSERT_EQUAL_INT(J288_OK, j288_sched_enable(&s, id, true));
@@ -258,7 +265,7 @@ static void test_scheduler_sweeps(void)
         TEST_ASSERT_TRUE(sl->online);
         TEST_ASSERT_TRUE(sl->has_reply);
         TEST_ASSERT_EQUAL_UINT(id, sl->reply.id);
-        /* Allow a handful of failures on a loaded machine; most must succeed. */
+        /* With the long margin only a real fault fails a sweep; keep slack for a frozen host. */
         TEST_ASSERT_TRUE(sl->stats.successes >= 191u);
     }
 }
@@ -364,7 +371,7 @@ static void test_eintr_storm(void)
     j288_cmd_raw_t c = lock_cmd(1);
     int i, ok = 0;
     sim_start(NULL);
-    open_sim_port();
+    open_sim_port_margin(LOADED_MACHINE_MARGIN_US);
     memset(&sa, 0, sizeof sa);
     sa.sa_handler = on_alarm;
     sigemptyset(&sa.sa_mask);
