@@ -186,9 +186,12 @@ coverage: $(UNITY)/unity.c
 	 $(HARD_SUBMAKE) BUILD=$(BUILD)/cov OPT="-O0 -g" EXTRA_CFLAGS=--coverage \
 	     EXTRA_LDFLAGS=--coverage hard-cov-run
 
-hard-cov-run: $(UNIT_TESTS)
+# Which tests count (override to widen, e.g. COVERAGE_TESTS='$(UNIT_TESTS) $(FUZZ_REPLAY_TESTS)').
+COVERAGE_TESTS ?= $(UNIT_TESTS)
+
+hard-cov-run: $(COVERAGE_TESTS)
 	find $(BUILD) -name '*.gcda' -delete
-	BUILD=$(BUILD) bash scripts/run-tests.sh $(UNIT_TESTS)
+	BUILD=$(BUILD) bash scripts/run-tests.sh $(COVERAGE_TESTS)
 	@mkdir -p $(BUILD)/coverage
 	$(HARD_GCOVR) --print-summary \
 	    --html-details $(BUILD)/coverage/index.html $(OBJ)/lib
