@@ -223,7 +223,7 @@ soak-short: $(SOAK_BIN) $(BIN)/j288-sim
 	   echo "soak-short: under valgrind memcheck"; \
 	   $(HARD_VALGRIND) $(SOAK_BIN) $(BIN)/j288-sim --txns $(SOAK_SHORT_TXNS) --margin-us 50000; \
 	 else \
-	   $(call HARD_REQUIRE,valgrind,valgrind); \
+	   $(HARD_NEED) valgrind valgrind; [ $$? -eq 1 ] || exit 1; \
 	   $(SOAK_BIN) $(BIN)/j288-sim --txns $(SOAK_SHORT_TXNS); \
 	 fi
 
