@@ -4,6 +4,11 @@
 set -euo pipefail
 
 packages=(
+    # build and host tests (Makefile, make test, make test CC=clang-14, make demo)
+    make gcc clang-14 python3 coreutils
+    gnuplot-nox                     # make demo / cli_bus.sh plot test (PNG); CI treats it as required
+    cmake                           # scripts/ci-cmake.sh
+    qemu-system-arm                 # make test-target, bench-target, bench-bus-target (Cortex-M)
     # hardening (mk/hardening.mk)
     clang-14 libclang-rt-14-dev     # make fuzz / fuzz-ci (libFuzzer, ASan, UBSan)
     valgrind                        # make test-valgrind
