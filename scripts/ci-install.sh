@@ -5,7 +5,7 @@ set -euo pipefail
 
 packages=(
     # build and host tests (Makefile, make test, make test CC=clang-14, make demo)
-    make gcc clang-14 python3 coreutils
+    make gcc clang-14 coreutils
     gnuplot-nox                     # make demo / cli_bus.sh plot test (PNG); CI treats it as required
     cmake                           # scripts/ci-cmake.sh
     qemu-system-arm                 # make test-target, bench-target, bench-bus-target (Cortex-M)
