@@ -190,10 +190,12 @@ static void finish(j288_bus_t *bus, int result, uint32_t now)
     }
     t->result = result;
     t->latency_us = (t->attempts != 0u) ? (uint32_t)(now - t->start_us) : 0u;
-    if (result == J288_OK) {
-        bus->stats.ok++;
-    } else if (result == J288_ERR_ABORTED) {
-        bus->stats.aborted++;
+    if (!was_estop) { /* the stop is counted in estops only: it is not a user transaction */
+        if (result == J288_OK) {
+            bus->stats.ok++;
+        } else if (result == J288_ERR_ABORTED) {
+            bus->stats.aborted++;
+        }
     }
     bus->queued = false;
     bus->retry_pending = false;
@@ -300,7 +302,6 @@ static void begin_txn(j288_bus_t *bus, uint8_t id, j288_bus_done_fn done, void *
     bus->tx_id = id;
     bus->done = done;
     bus->done_user = user;
-    bus->stats.transactions++;
 }
 
 static void send_estop(j288_bus_t *bus, uint32_t now)
@@ -315,8 +316,7 @@ static void send_estop(j288_bus_t *bus, uint32_t now)
     bus->estop_pending = false;
     bus->estop_active = true;
     begin_txn(bus, J288_BROADCAST_ID, NULL, NULL);
-    bus->stats.transactions--; /* the stop is counted in estops, not as a user transaction */
-    bus->stats.estops++;
+    bus->stats.estops++; /* not in transactions: the stop is not a user transaction */
     start_attempt(bus, now);
 }
 
@@ -586,6 +586,7 @@ int j288_bus_submit(j288_bus_t *bus, const j288_cmd_raw_t *cmd, uint32_t now_us,
         return err;
     }
     begin_txn(bus, cmd->id, done, user);
+    bus->stats.transactions++;
     bus->queued = true;
     if (bus->in_advance) {
         bus->again = true; /* from a callback: the running advance starts it */

@@ -849,6 +849,39 @@ static void test_estop_idle_and_with_queued_work(void)
     assert_frame_cmd(2u, &stop);
 }
 
+/* The stop frame is not a user transaction: it counts in estops only, never in ok or
+ * aborted, whose sums must stay those of the transactions called back. */
+static void test_estop_counts_in_estops_only(void)
+{
+    j288_cmd_raw_t cmd = lock_cmd(3u);
+    j288_reply_raw_t r = reply_for(3u, 31);
+    setup();
+    fake_port_add_servo(&fp, 3u, &r);
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_bus_estop(&bus, 0u));
+    TEST_ASSERT_TRUE(fake_port_run_until_idle(&fp, 5000u * US));
+    TEST_ASSERT_EQUAL_UINT32(1u, fp.nframes);
+    TEST_ASSERT_EQUAL_UINT32(1u, j288_bus_stats(&bus)->estops);
+    TEST_ASSERT_EQUAL_UINT32(1u, j288_bus_stats(&bus)->attempts);
+    TEST_ASSERT_EQUAL_UINT32(0u, j288_bus_stats(&bus)->transactions);
+    TEST_ASSERT_EQUAL_UINT32(0u, j288_bus_stats(&bus)->ok);
+    TEST_ASSERT_EQUAL_UINT32(0u, j288_bus_stats(&bus)->aborted);
+
+    /* a transaction aborted by a stop: aborted 1, ok still only the user's successes */
+    submit_ok(&cmd);
+    TEST_ASSERT_TRUE(fake_port_run_until_idle(&fp, fp.now_ns + 5000u * US));
+    TEST_ASSERT_EQUAL_INT(J288_OK, cb.txn.result);
+    submit_ok(&cmd);
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_bus_estop(&bus, fake_port_now_us(&fp)));
+    TEST_ASSERT_TRUE(fake_port_run_until_idle(&fp, fp.now_ns + 5000u * US));
+    TEST_ASSERT_EQUAL_INT(2, cb.calls);
+    TEST_ASSERT_EQUAL_INT(J288_ERR_ABORTED, cb.txn.result);
+    TEST_ASSERT_EQUAL_UINT32(4u, fp.nframes);
+    TEST_ASSERT_EQUAL_UINT32(2u, j288_bus_stats(&bus)->estops);
+    TEST_ASSERT_EQUAL_UINT32(2u, j288_bus_stats(&bus)->transactions);
+    TEST_ASSERT_EQUAL_UINT32(1u, j288_bus_stats(&bus)->ok);
+    TEST_ASSERT_EQUAL_UINT32(1u, j288_bus_stats(&bus)->aborted);
+}
+
 /* ---- advance in ISR */
 
 static int chain_left;
@@ -1212,6 +1245,7 @@ int main(void)
     RUN_TEST(test_port_crc_hook_is_used);
     RUN_TEST(test_estop_while_busy);
     RUN_TEST(test_estop_idle_and_with_queued_work);
+    RUN_TEST(test_estop_counts_in_estops_only);
     RUN_TEST(test_advance_in_isr_chains_without_poll);
     RUN_TEST(test_advance_in_isr_with_inline_tx_done);
     RUN_TEST(test_failure_ranking);

@@ -107,7 +107,7 @@ typedef struct {
 typedef struct {
     uint32_t transactions; /* submits accepted */
     uint32_t attempts;     /* frames handed to start_tx (stop frames included) */
-    uint32_t ok;           /* transactions that ended J288_OK */
+    uint32_t ok;           /* user transactions that ended J288_OK */
     uint32_t timeouts;     /* attempts ended by the deadline (reply or tx done) */
     uint32_t crc_errors;   /* corrupt or truncated frames in a reply window */
     uint32_t wrong_id;     /* good frames from another id in a reply window */
@@ -117,7 +117,8 @@ typedef struct {
     uint32_t aborted;      /* transactions ended J288_ERR_ABORTED by an estop */
     uint32_t stale_bytes;   /* discarded outside a reply window (late replies, noise) */
     uint32_t rx_overflows;  /* bytes lost because the ring was full */
-    uint32_t estops;
+    uint32_t estops;        /* stop frames put on the wire by j288_bus_estop() (not counted in
+                               transactions, ok or aborted: the stop is not a user transaction) */
 } j288_bus_stats_t;
 
 typedef struct j288_bus {
