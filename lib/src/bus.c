@@ -195,6 +195,8 @@ static void finish(j288_bus_t *bus, int result, uint32_t now)
             bus->stats.ok++;
         } else if (result == J288_ERR_ABORTED) {
             bus->stats.aborted++;
+        } else {
+            bus->stats.failed++;
         }
     }
     bus->queued = false;

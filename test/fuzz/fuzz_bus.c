@@ -23,7 +23,9 @@
  *   never while a transmit is still running;
  * - liveness: after a poll the bus is idle, or the port has a timer armed in the future
  *   (when it has arm_timeout); and once events stop, the bus returns to idle with time alone;
- * - statistics: transactions = callbacks + in flight, ok and aborted match the callbacks,
+ * - statistics: transactions = callbacks + in flight (at most one) = ok + failed + aborted +
+ *   in flight, checked after every operation and in every callback; ok, failed and aborted
+ *   match the callbacks' results exactly (a stop frame counts in estops only),
  *   and (when no estop ran, whose attempts have no callback) attempts, timeouts, collisions
  *   and port errors equal the attempts the callbacks report with those results.
  */
@@ -127,6 +129,17 @@ static void port_arm(void *ctx, uint32_t t)
 
 static void on_done(void *user, const j288_txn_t *t);
 
+/* bus.h: transactions == ok + failed + aborted + (1 if one is in flight or queued). The
+ * submits accepted and not yet called back are w.fifo_n, minus the one being called back
+ * (counted already) when checked from its callback. */
+static void check_stats_add_up(unsigned calling_back)
+{
+    const j288_bus_stats_t *st = j288_bus_stats(&bus);
+    unsigned pending = w.fifo_n - calling_back;
+    FUZZ_CHECK(pending <= 1u);
+    FUZZ_CHECK(st->transactions == st->ok + st->failed + st->aborted + pending);
+}
+
 static void try_submit(uint8_t id, bool valid_fields)
 {
     j288_cmd_raw_t c;
@@ -174,6 +187,7 @@ static void on_done(void *user, const j288_txn_t *t)
     FUZZ_CHECK(t->id == w.fifo_id[0]);
     FUZZ_CHECK(is_bus_result(t->result));
     FUZZ_CHECK(t->attempts <= (unsigned)w.retries + 1u);
+    check_stats_add_up(1u);
     if (w.fifo_pre_estop[0]) {
         FUZZ_CHECK(t->result == J288_ERR_ABORTED);
     }
@@ -432,6 +446,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 
     while (in.n > 0u && ops < MAX_OPS) {
         do_op(&in);
+        check_stats_add_up(0u);
         ops++;
     }
 
@@ -457,6 +472,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     /* Stop frames count in estops only: ok is exactly the callbacks' successes. */
     FUZZ_CHECK(st->ok == w.cb_ok);
     FUZZ_CHECK(st->aborted == w.cb_aborted);
+    FUZZ_CHECK(st->failed == w.callbacks - w.cb_ok - w.cb_aborted);
+    check_stats_add_up(0u);
     FUZZ_CHECK(st->estops <= w.estops);
     FUZZ_CHECK(st->attempts >= w.cb_attempts);
     if (w.estops == 0u) {

@@ -114,6 +114,14 @@ static void assert_frame_cmd(uint32_t i, const j288_cmd_raw_t *cmd)
     assert_frame(i, want);
 }
 
+/* Every accepted submit is ok, failed or aborted once it is called back; pending is the one
+ * in flight or queued (0 or 1). */
+static void assert_stats_add_up(uint32_t pending)
+{
+    const j288_bus_stats_t *st = j288_bus_stats(&bus);
+    TEST_ASSERT_EQUAL_UINT32(st->transactions, st->ok + st->failed + st->aborted + pending);
+}
+
 /* ---- init and configuration */
 
 static void test_init_rejections(void)
@@ -226,6 +234,7 @@ static void test_normal_transaction(void)
     TEST_ASSERT_EQUAL_UINT32(1u, j288_bus_parser_stats(&bus)->frames);
     TEST_ASSERT_EQUAL_UINT32(0u, j288_bus_parser_stats(&bus)->truncated);
     TEST_ASSERT_EQUAL_UINT32(1u, fp.nframes);
+    assert_stats_add_up(0u);
 }
 
 static void test_worked_lock_frame_through_bus(void)
@@ -644,6 +653,47 @@ static void test_retries_exhausted(void)
     TEST_ASSERT_EQUAL_UINT32(3u, j288_bus_stats(&bus)->timeouts);
 }
 
+/* failed counts transactions (after all their retries), not attempts; aborted and ok not. */
+static void test_failed_counts_transactions(void)
+{
+    j288_bus_config_t cfg;
+    j288_cmd_raw_t cmd = lock_cmd(3u);
+    j288_reply_raw_t r = reply_for(3u, 31);
+    memset(&cfg, 0, sizeof cfg);
+    cfg.retries = 2u;
+    setup_cfg(&cfg);
+    submit_ok(&cmd); /* nobody answers: 3 attempts, 1 failed transaction */
+    assert_stats_add_up(1u);
+    TEST_ASSERT_TRUE(fake_port_run_until_idle(&fp, 5000u * US));
+    TEST_ASSERT_EQUAL_INT(J288_ERR_TIMEOUT, cb.txn.result);
+    TEST_ASSERT_EQUAL_UINT32(3u, j288_bus_stats(&bus)->timeouts);
+    TEST_ASSERT_EQUAL_UINT32(1u, j288_bus_stats(&bus)->failed);
+    assert_stats_add_up(0u);
+
+    fake_port_add_servo(&fp, 3u, &r); /* a success */
+    submit_ok(&cmd);
+    TEST_ASSERT_TRUE(fake_port_run_until_idle(&fp, fp.now_ns + 5000u * US));
+    TEST_ASSERT_EQUAL_INT(J288_OK, cb.txn.result);
+    TEST_ASSERT_EQUAL_UINT32(1u, j288_bus_stats(&bus)->failed);
+    assert_stats_add_up(0u);
+
+    submit_ok(&cmd); /* aborted by a stop: aborted, not failed */
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_bus_estop(&bus, fake_port_now_us(&fp)));
+    TEST_ASSERT_TRUE(fake_port_run_until_idle(&fp, fp.now_ns + 5000u * US));
+    TEST_ASSERT_EQUAL_INT(J288_ERR_ABORTED, cb.txn.result);
+    TEST_ASSERT_EQUAL_UINT32(1u, j288_bus_stats(&bus)->failed);
+    TEST_ASSERT_EQUAL_UINT32(1u, j288_bus_stats(&bus)->aborted);
+    assert_stats_add_up(0u);
+
+    fp.start_tx_fail = 3; /* port errors on every attempt: failed */
+    submit_ok(&cmd);
+    TEST_ASSERT_TRUE(fake_port_run_until_idle(&fp, fp.now_ns + 5000u * US));
+    TEST_ASSERT_EQUAL_INT(J288_ERR_PORT, cb.txn.result);
+    TEST_ASSERT_EQUAL_UINT32(2u, j288_bus_stats(&bus)->failed);
+    TEST_ASSERT_EQUAL_UINT32(4u, j288_bus_stats(&bus)->transactions);
+    assert_stats_add_up(0u);
+}
+
 /* ---- line errors */
 
 static void test_line_error_marks_attempt(void)
@@ -822,6 +872,7 @@ static void test_estop_while_busy(void)
     TEST_ASSERT_EQUAL_UINT32(1u, j288_bus_stats(&bus)->estops);
     TEST_ASSERT_EQUAL_UINT32(1u, j288_bus_stats(&bus)->aborted);
     TEST_ASSERT_EQUAL_UINT32(2u, j288_bus_stats(&bus)->transactions);
+    assert_stats_add_up(1u);
 }
 
 static void test_estop_idle_and_with_queued_work(void)
@@ -1150,6 +1201,10 @@ static void test_transfer_blocking(void)
     fp.ops.wait = NULL;
     cmd.id = 3u;
     TEST_ASSERT_EQUAL_INT(J288_ERR_PORT_OPS, j288_bus_transfer_blocking(&bus, &cmd, &txn));
+    /* 3 ok, a timeout and the vanished device failed; the refused calls count nowhere */
+    TEST_ASSERT_EQUAL_UINT32(5u, j288_bus_stats(&bus)->transactions);
+    TEST_ASSERT_EQUAL_UINT32(2u, j288_bus_stats(&bus)->failed);
+    assert_stats_add_up(0u);
 }
 
 static int blocking_from_cb_rc;
@@ -1236,6 +1291,7 @@ int main(void)
     RUN_TEST(test_broadcast_waits_for_no_reply);
     RUN_TEST(test_retries_keep_each_reason);
     RUN_TEST(test_retries_exhausted);
+    RUN_TEST(test_failed_counts_transactions);
     RUN_TEST(test_line_error_marks_attempt);
     RUN_TEST(test_line_gone_is_offline_without_retry);
     RUN_TEST(test_submit_errors_send_nothing);

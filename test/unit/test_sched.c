@@ -460,6 +460,11 @@ static void test_estop_while_sweeping(void)
     TEST_ASSERT_EQUAL_UINT32(0u, j288_sched_slot(&sch, 1u)->stats.consecutive_failures);
     TEST_ASSERT_EQUAL_UINT32(0u, j288_sched_slot(&sch, 2u)->stats.transactions);
     TEST_ASSERT_EQUAL_UINT32(0u, j288_sched_sweeps(&sch));
+    /* on the bus: servo 0 ok, servo 1 aborted, the stop in estops only */
+    TEST_ASSERT_EQUAL_UINT32(2u, j288_bus_stats(&bus)->transactions);
+    TEST_ASSERT_EQUAL_UINT32(1u, j288_bus_stats(&bus)->ok);
+    TEST_ASSERT_EQUAL_UINT32(0u, j288_bus_stats(&bus)->failed);
+    TEST_ASSERT_EQUAL_UINT32(1u, j288_bus_stats(&bus)->aborted);
     for (i = 0u; i < 4u; i++) {
         TEST_ASSERT_EQUAL_UINT8(J288_MODE_LOCK, fp.servo[i].last_cmd.status);
         TEST_ASSERT_EQUAL_UINT8(15u, fp.servo[i].last_cmd.id);

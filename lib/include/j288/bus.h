@@ -103,11 +103,17 @@ typedef struct {
 } j288_bus_config_t;
 
 /* Bus-wide counters (per-servo ones live in the scheduler). Attempt outcomes and what was
- * seen on the wire are counted where they happen, whatever the transaction's final result. */
+ * seen on the wire are counted where they happen, whatever the transaction's final result.
+ * Each accepted submit ends in exactly one of ok, failed and aborted, counted just before its
+ * callback runs, so that at any time, seen from the thread or from a callback:
+ *   transactions == ok + failed + aborted + (1 if a submit is in flight or queued, else 0).
+ * The emergency stop frame is none of these (see estops). */
 typedef struct {
     uint32_t transactions; /* submits accepted */
     uint32_t attempts;     /* frames handed to start_tx (stop frames included) */
     uint32_t ok;           /* user transactions that ended J288_OK */
+    uint32_t failed;       /* user transactions that ended with any other result (after all
+                              their retries), except J288_ERR_ABORTED */
     uint32_t timeouts;     /* attempts ended by the deadline (reply or tx done) */
     uint32_t crc_errors;   /* corrupt or truncated frames in a reply window */
     uint32_t wrong_id;     /* good frames from another id in a reply window */
