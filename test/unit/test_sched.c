@@ -190,7 +190,7 @@ static void test_set_cmd_si(void)
     si.status = J288_MODE_FOC;
     si.watchdog = true;
     si.pos = 1.5;
-    si.kp = 0.01;
+    si.kp = (j288_real_t)0.01;
     TEST_ASSERT_EQUAL_INT(J288_OK, j288_sched_set_cmd_si(&sch, &si, J288_SIDE_ROTOR));
     TEST_ASSERT_EQUAL_INT(J288_OK, j288_cmd_from_si(&si, J288_SIDE_ROTOR, &raw));
     TEST_ASSERT_EQUAL_MEMORY(&raw, &j288_sched_slot(&sch, 2u)->cmd, sizeof raw);
