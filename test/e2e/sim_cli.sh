@@ -1,10 +1,12 @@
 #!/usr/bin/env bash
 # j288-sim as a program: --help, argument errors, the pty path line, --link, --log, exit on
-# SIGINT/SIGTERM and --exit-after with the statistics line, nothing left behind.
+# SIGINT/SIGTERM and --exit-after with the statistics line, nothing left behind, and the
+# fault switch (SIGUSR1 off, SIGUSR2 on) seen through the j288 tool's status command.
 # Run from the repo root with BIN set (make test does).
 set -u
 BIN=${BIN:-build/bin}
 SIM="$BIN/j288-sim"
+J288="$BIN/j288"
 tmp=$(mktemp -d)
 pids=()
 cleanup() {
@@ -81,6 +83,50 @@ t_log_frames() {
         grep -q ' bad-crc id=0$' "$tmp/log" &&
         grep -q 'commands 1 .*bad-crc 1 ' "$tmp/err" && grep -q ' replies 1 ' "$tmp/err"
 }
+# wait_err PATTERN: up to 3 s for a line of the simulator's stderr to match.
+wait_err() {
+    for _ in $(seq 1 60); do
+        grep -Eq "$1" "$tmp/err" && return 0
+        sleep 0.05
+    done
+    return 1
+}
+# status_ok / status_fails: one status exchange with servo 1, no retries.
+status_ok() { timeout 10 "$J288" --port "$SIM_PTY" status --id 1 --retries 0 >/dev/null 2>"$tmp/st"; }
+status_fails() {
+    timeout 10 "$J288" --port "$SIM_PTY" status --id 1 --retries 0 >/dev/null 2>"$tmp/st"
+    [ $? -eq 1 ] && grep -q 'no reply from servo 1' "$tmp/st"
+}
+# Every reply dropped: status times out; after SIGUSR1 it succeeds (acknowledged with the
+# statistics so far); after SIGUSR2 it times out again.
+t_fault_switch() {
+    [ -x "$J288" ] || { echo "$J288 not built"; return 1; }
+    start_sim --ids 1 --drop 1 --exit-after 30 || return 1
+    status_fails || { echo "status succeeded with --drop 1"; return 1; }
+    kill -s USR1 "$SIM_PID"
+    wait_err '^j288-sim: faults off: stats: .* replies 0 dropped 1 ' || { echo "no ack"; return 1; }
+    status_ok || { echo "status failed after SIGUSR1: $(cat "$tmp/st")"; return 1; }
+    status_ok || return 1
+    kill -s USR2 "$SIM_PID"
+    wait_err '^j288-sim: faults on: stats: .* replies 2 dropped 1 ' || return 1
+    status_fails || { echo "status succeeded after SIGUSR2"; return 1; }
+    kill -s TERM "$SIM_PID"; wait_exit "$SIM_PID" || return 1
+    grep -q '^j288-sim: stats: .* commands 4 .* replies 2 dropped 2 ' "$tmp/err"
+}
+# A reply delayed before SIGUSR1 still goes out when due (counted as sent); it does not
+# disturb the clean exchanges after the switch.
+t_fault_switch_late_in_flight() {
+    [ -x "$J288" ] || { echo "$J288 not built"; return 1; }
+    start_sim --ids 1 --late 1 --late-us 400000 --exit-after 30 || return 1
+    status_fails || { echo "status succeeded with the reply 400 ms late"; return 1; }
+    kill -s USR1 "$SIM_PID"
+    wait_err '^j288-sim: faults off: stats: .* late 1 ' || { echo "no ack"; return 1; }
+    status_ok || { echo "status failed after SIGUSR1: $(cat "$tmp/st")"; return 1; }
+    sleep 0.5 # the late reply is out now
+    status_ok || { echo "status failed after the late reply: $(cat "$tmp/st")"; return 1; }
+    kill -s TERM "$SIM_PID"; wait_exit "$SIM_PID" || return 1
+    grep -q '^j288-sim: stats: .* commands 3 .* replies 3 dropped 0 corrupted 0 late 1 ' "$tmp/err"
+}
 t_link_refuses_file() {
     echo keep >"$tmp/file"
     "$SIM" --link "$tmp/file" --exit-after 1 >/dev/null 2>"$tmp/e"; local rc=$?
@@ -94,6 +140,8 @@ check path_link_exit_after t_path_link_exit_after
 check signals t_signals
 check log_frames t_log_frames
 check link_refuses_file t_link_refuses_file
+check fault_switch t_fault_switch
+check fault_switch_late_in_flight t_fault_switch_late_in_flight
 
 echo "$tests Tests $failures Failures 0 Ignored"
 [ $failures -eq 0 ]

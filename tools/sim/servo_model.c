@@ -284,6 +284,11 @@ int j288_sim_bus_inject_faults(j288_sim_bus_t *b, uint8_t id, uint32_t bits)
     return 0;
 }
 
+void j288_sim_bus_set_faults(j288_sim_bus_t *b, bool on)
+{
+    b->faults_off = !on;
+}
+
 j288_sim_servo_t *j288_sim_bus_servo(j288_sim_bus_t *b, uint8_t id)
 {
     if (id > J288_MAX_ID || (b->present & (1u << id)) == 0u)
@@ -319,8 +324,9 @@ static void emit(j288_sim_bus_t *b, uint64_t at_us, const uint8_t *data, size_t 
         b->send(b->user, at_us, data, len);
 }
 
-/* One servo's answer, with the injected faults. Draws the same random numbers whatever is
- * decided, so one fault's probability does not shift the others' sequence. */
+/* One servo's answer, with the injected faults unless they are switched off. Draws the same
+ * random numbers whatever is decided, so one fault's probability (or the switch) does not
+ * shift the others' sequence. */
 static void answer(j288_sim_bus_t *b, j288_sim_servo_t *s, uint64_t now_us)
 {
     j288_reply_raw_t r;
@@ -338,6 +344,11 @@ static void answer(j288_sim_bus_t *b, j288_sim_servo_t *s, uint64_t now_us)
     j288_sim_servo_reply(s, &r);
     if (j288_reply_encode(&r, frame, NULL) != J288_OK)
         return; /* cannot happen: every field comes from the model within range */
+    if (b->faults_off) {
+        emit(b, at, frame, sizeof frame);
+        b->stats.replies++;
+        return;
+    }
     if (u_drop < b->cfg.drop) {
         b->stats.dropped++;
         return;
@@ -386,8 +397,10 @@ static void dispatch(j288_sim_bus_t *b, const j288_cmd_raw_t *cmd, uint64_t now_
     answer(b, &b->servo[id], now_us);
     if (has_dup(b, id)) {
         j288_sim_servo_command(&b->dup[id], cmd, now_us);
-        answer(b, &b->dup[id], now_us);
-        b->stats.duplicates++;
+        if (!b->faults_off) {
+            answer(b, &b->dup[id], now_us);
+            b->stats.duplicates++;
+        }
     }
 }
 

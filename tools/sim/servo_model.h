@@ -28,6 +28,14 @@
  *   until the temperature falls 10 C below the limit. Supply below 10 V: under-voltage fault,
  *   above 30 V: over-voltage fault (both remove torque); below 11 V: low-supply warning.
  * - Injected fault bits are reported only; they do not change the physics.
+ * - The wire faults (drop, corrupt, late, noise, duplicate-id replies) can be switched off
+ *   and on again while running (j288_sim_bus_set_faults). Off means a clean line: every
+ *   addressed servo answers once, intact, after the turnaround; the duplicate servos still
+ *   obey commands (so they pick up where they were when switched on again) but stay silent.
+ *   Injected fault bits (--fault) are servo state, not line faults: the switch keeps them.
+ *   A reply draws the same random numbers with the faults on or off (a silent duplicate
+ *   draws none), so a run stays reproducible for the same commands, timing and switching.
+ *   Replies already handed to the send callback (e.g. a late one) are not recalled.
  */
 #ifndef J288_SIM_SERVO_MODEL_H
 #define J288_SIM_SERVO_MODEL_H
@@ -154,6 +162,7 @@ typedef struct {
     uint8_t window[J288_CMD_LEN]; /* the last 20 bytes fed, oldest first */
     uint64_t last_byte_us;
     uint64_t now_us;
+    bool faults_off; /* j288_sim_bus_set_faults(b, false): a clean line */
     j288_sim_stats_t stats;
     j288_sim_send_fn send;
     j288_sim_log_fn log;
@@ -169,6 +178,10 @@ int j288_sim_bus_init(j288_sim_bus_t *b, uint16_t ids, const j288_sim_bus_config
 
 /* Inject fault bits (reported in every reply until changed). -1 for an id not on the bus. */
 int j288_sim_bus_inject_faults(j288_sim_bus_t *b, uint8_t id, uint32_t bits);
+
+/* Wire faults on (as configured; the state after init) or off (a clean line) from the next
+ * command on. Injected fault bits are kept either way; see the decisions above. */
+void j288_sim_bus_set_faults(j288_sim_bus_t *b, bool on);
 
 /* Bytes from the host, received at now_us. */
 void j288_sim_bus_feed(j288_sim_bus_t *b, const uint8_t *data, size_t len, uint64_t now_us);

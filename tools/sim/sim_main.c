@@ -3,8 +3,10 @@
  *
  * Prints the pty's path on stdout (one line), serves the servos until SIGINT/SIGTERM (or
  * --exit-after), then closes the pty master (clients see the device vanish), removes the
- * --link symlink and prints one statistics line on stderr. The servo physics and protocol
- * live in servo_model.c; this file is the I/O: the pty, timing of replies, options, the log.
+ * --link symlink and prints one statistics line on stderr. SIGUSR1 switches the injected
+ * wire faults off, SIGUSR2 on again (the handlers only record the wish; the loop applies
+ * it). The servo physics and protocol live in servo_model.c; this file is the I/O: the
+ * pty, timing of replies, options, signals, the log.
  */
 #define _GNU_SOURCE 1 /* posix_openpt, ppoll, sigaction under -std=c99 */
 
@@ -43,15 +45,23 @@ typedef struct {
     uint64_t queue_full;
     uint64_t lost_no_client;
     bool echo;
+    bool quiet;
     FILE *log;
 } sim_io_t;
 
-static volatile sig_atomic_t g_stop; /* set by SIGINT/SIGTERM/SIGHUP */
+static volatile sig_atomic_t g_stop;          /* set by SIGINT/SIGTERM/SIGHUP */
+static volatile sig_atomic_t g_faults_on = 1; /* SIGUSR1: 0, SIGUSR2: 1; the last one wins */
 
 static void on_signal(int sig)
 {
     (void)sig;
     g_stop = 1;
+}
+
+/* Async-signal-safe: one store; serve() applies it before it reads the next bytes. */
+static void on_fault_signal(int sig)
+{
+    g_faults_on = (sig == SIGUSR2) ? 1 : 0;
 }
 
 static void die(const char *fmt, ...) __attribute__((format(printf, 1, 2), noreturn));
@@ -123,6 +133,13 @@ static void usage(FILE *f)
           "  --noise P           probability of 1-8 noise bytes ahead of a reply\n"
           "  --dup ID            a second servo also answers to ID (repeatable)\n"
           "  --fault ID:BITS     servo ID reports fault bits BITS (e.g. 0x200; repeatable)\n"
+          "switching faults while running:\n"
+          "  SIGUSR1             wire faults off: no drop, corrupt, late, noise or duplicate-id\n"
+          "                      replies from the next command on (a reply already delayed by\n"
+          "                      --late still arrives when due); --fault bits are servo state\n"
+          "                      and stay. Unless --quiet, prints 'j288-sim: faults off: stats:\n"
+          "                      ...' (the statistics line so far) once it applies.\n"
+          "  SIGUSR2             wire faults on again as configured ('faults on: stats: ...').\n"
           "log lines: SECONDS HEX20 then 'id=N status=N wd=0|1 tau= speed= pos= kp= kd='\n"
           "for a good frame, or 'bad-crc id=N' for a frame whose CRC failed.\n",
           f);
@@ -319,6 +336,36 @@ static void flush_due(sim_io_t *io, uint64_t now_us)
     }
 }
 
+/* The statistics line, after label ("stats" at exit, "faults off: stats" on a switch). */
+static void print_stats(const sim_io_t *io, const j288_sim_bus_t *bus, const char *label)
+{
+    const j288_sim_stats_t *st = &bus->stats;
+    fprintf(stderr,
+            "j288-sim: %s: bytes %llu commands %llu broadcast %llu bad-crc %llu "
+            "other-ids %llu replies %llu dropped %llu corrupted %llu late %llu noise %llu "
+            "duplicates %llu watchdog-trips %llu garbage-bytes %lu lost %llu\n",
+            label, (unsigned long long)st->bytes, (unsigned long long)st->commands,
+            (unsigned long long)st->broadcasts, (unsigned long long)st->bad_crc,
+            (unsigned long long)st->for_others, (unsigned long long)st->replies,
+            (unsigned long long)st->dropped, (unsigned long long)st->corrupted,
+            (unsigned long long)st->late, (unsigned long long)st->noise,
+            (unsigned long long)st->duplicates, (unsigned long long)st->watchdog_trips,
+            (unsigned long)bus->parser.stats.garbage_bytes,
+            (unsigned long long)(io->lost_no_client + io->queue_full));
+    fflush(stderr);
+}
+
+/* Apply a SIGUSR1/SIGUSR2 wish. Replies already queued (a late one) are left to arrive. */
+static void apply_fault_switch(const sim_io_t *io, j288_sim_bus_t *bus)
+{
+    bool on = (g_faults_on != 0);
+    if (on == !bus->faults_off)
+        return;
+    j288_sim_bus_set_faults(bus, on);
+    if (!io->quiet)
+        print_stats(io, bus, on ? "faults on: stats" : "faults off: stats");
+}
+
 /* ---- log ------------------------------------------------------------------------------------ */
 
 static void log_frame(void *user, uint64_t now_us, const uint8_t frame[J288_CMD_LEN],
@@ -405,18 +452,25 @@ static void install_signals(sigset_t *run_mask)
     (void)sigaction(SIGINT, &sa, NULL);
     (void)sigaction(SIGTERM, &sa, NULL);
     (void)sigaction(SIGHUP, &sa, NULL);
+    sa.sa_handler = on_fault_signal;
+    (void)sigaction(SIGUSR1, &sa, NULL);
+    (void)sigaction(SIGUSR2, &sa, NULL);
     sa.sa_handler = SIG_IGN;
     (void)sigaction(SIGPIPE, &sa, NULL);
     /* Signals stay blocked except inside ppoll: no wake-up is lost between a check of
-     * g_stop and the sleep. */
+     * g_stop (or g_faults_on) and the sleep. */
     sigemptyset(&block);
     sigaddset(&block, SIGINT);
     sigaddset(&block, SIGTERM);
     sigaddset(&block, SIGHUP);
+    sigaddset(&block, SIGUSR1);
+    sigaddset(&block, SIGUSR2);
     (void)sigprocmask(SIG_BLOCK, &block, run_mask);
     sigdelset(run_mask, SIGINT);
     sigdelset(run_mask, SIGTERM);
     sigdelset(run_mask, SIGHUP);
+    sigdelset(run_mask, SIGUSR1);
+    sigdelset(run_mask, SIGUSR2);
 }
 
 static struct timespec ts_from_us(uint64_t us)
@@ -462,6 +516,7 @@ static void serve(sim_io_t *io, j288_sim_bus_t *bus, uint64_t exit_at_us, const 
         int rc;
         if (exit_at_us != 0u && now >= exit_at_us)
             break;
+        apply_fault_switch(io, bus);
         flush_due(io, now);
         if (now - last_tick >= TICK_US) {
             j288_sim_bus_advance(bus, now);
@@ -500,11 +555,11 @@ int main(int argc, char **argv)
     sigset_t run_mask;
     uint64_t exit_at = 0;
     uint8_t id;
-    const j288_sim_stats_t *st;
 
     parse_args(&o, argc, argv);
     memset(&io, 0, sizeof io);
     io.echo = o.echo;
+    io.quiet = o.quiet;
     bus = calloc(1, sizeof *bus);
     if (bus == NULL)
         die("out of memory");
@@ -545,19 +600,7 @@ int main(int argc, char **argv)
     if (o.link != NULL)
         remove_link(o.link, path);
     j288_sim_bus_advance(bus, sim_now_us(&io));
-    st = &bus->stats;
-    fprintf(stderr,
-            "j288-sim: stats: bytes %llu commands %llu broadcast %llu bad-crc %llu "
-            "other-ids %llu replies %llu dropped %llu corrupted %llu late %llu noise %llu "
-            "duplicates %llu watchdog-trips %llu garbage-bytes %lu lost %llu\n",
-            (unsigned long long)st->bytes, (unsigned long long)st->commands,
-            (unsigned long long)st->broadcasts, (unsigned long long)st->bad_crc,
-            (unsigned long long)st->for_others, (unsigned long long)st->replies,
-            (unsigned long long)st->dropped, (unsigned long long)st->corrupted,
-            (unsigned long long)st->late, (unsigned long long)st->noise,
-            (unsigned long long)st->duplicates, (unsigned long long)st->watchdog_trips,
-            (unsigned long)bus->parser.stats.garbage_bytes,
-            (unsigned long long)(io.lost_no_client + io.queue_full));
+    print_stats(&io, bus, "stats");
     if (io.log != NULL && io.log != stderr)
         fclose(io.log);
     free(bus);
