@@ -188,6 +188,11 @@ static void finish(j288_bus_t *bus, int result, uint32_t now)
     if (!was_estop && bus->estop_pending) {
         result = J288_ERR_ABORTED;
     }
+    if (was_estop && (result != J288_OK)) {
+        bus->stats.estop_failures++;
+        bus->estop_pending = bus->estop_rearm; /* a request merged into it: a stop of its own */
+    }
+    bus->estop_rearm = false;
     t->result = result;
     t->latency_us = (t->attempts != 0u) ? (uint32_t)(now - t->start_us) : 0u;
     if (!was_estop) { /* the stop is counted in estops only: it is not a user transaction */
@@ -224,12 +229,25 @@ static void count_result(j288_bus_t *bus, int result)
     }
 }
 
+/* Success and a vanished line end any transaction. A stop frame is sent again whatever
+ * config.retries says (the lock must reach the servos), up to J288_ESTOP_ATTEMPTS; a user
+ * transaction retries unless a stop waits. */
+static bool attempt_is_final(const j288_bus_t *bus, int result, uint8_t attempts)
+{
+    if ((result == J288_OK) || (result == J288_ERR_OFFLINE)) {
+        return true;
+    }
+    if (bus->estop_active) {
+        return attempts >= J288_ESTOP_ATTEMPTS;
+    }
+    return bus->estop_pending || (attempts > bus->cfg.retries);
+}
+
 /* An attempt ended: keep its reason, then retry after a guard or finish. */
 static void end_attempt(j288_bus_t *bus, int result, uint32_t now)
 {
     j288_txn_t *t = &bus->txn[bus->cur];
-    bool final = (result == J288_OK) || (result == J288_ERR_OFFLINE) || bus->estop_pending ||
-                 (t->attempts > bus->cfg.retries);
+    bool final = attempt_is_final(bus, result, t->attempts);
 
     if (t->attempts != 0u) {
         t->attempt_result[t->attempts - 1u] = result;
@@ -517,6 +535,11 @@ static void step_active(j288_bus_t *bus, uint32_t now)
 static void step_quiet(j288_bus_t *bus, uint32_t now)
 {
     consume_to(bus, bus->ring_head, now); /* late replies and noise: stale */
+    if (bus->retry_pending && (bus->ev_gone != bus->seen_gone)) {
+        bus->seen_gone = bus->ev_gone;
+        finish(bus, J288_ERR_OFFLINE, now); /* the line went away between two attempts */
+        return;
+    }
     if (bus->estop_pending) {
         if (bus->queued || bus->retry_pending) {
             finish(bus, J288_ERR_ABORTED, now); /* calls back; the stop goes next time round */
@@ -673,7 +696,9 @@ int j288_bus_estop(j288_bus_t *bus, uint32_t now_us)
         return J288_ERR_NULL;
     }
     port_lock(bus);
-    if (!bus->estop_active) {
+    if (bus->estop_active) {
+        bus->estop_rearm = true; /* merged into the stop in progress, unless that one fails */
+    } else {
         bus->estop_pending = true;
     }
     if (bus->in_advance) {

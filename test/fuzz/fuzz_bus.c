@@ -26,8 +26,11 @@
  * - statistics: transactions = callbacks + in flight (at most one) = ok + failed + aborted +
  *   in flight, checked after every operation and in every callback; ok, failed and aborted
  *   match the callbacks' results exactly (a stop frame counts in estops only),
- *   and (when no estop ran, whose attempts have no callback) attempts, timeouts, collisions
- *   and port errors equal the attempts the callbacks report with those results.
+ *   attempts and port errors equal those the callbacks report plus the stop frames (and
+ *   those of them that failed), timeouts and collisions those the callbacks report plus at
+ *   most the stop frames';
+ * - a stop frame that fails is sent again (whatever the retries) before anything else, at
+ *   most J288_ESTOP_ATTEMPTS times, and a stop given up had exactly that many transmits.
  */
 #include "fuzz_common.h"
 
@@ -61,6 +64,10 @@ typedef struct {
     uint32_t accepted, callbacks, cb_ok, cb_aborted, cb_attempts, cb_timeouts, cb_collisions;
     uint32_t cb_port_errors;
     uint32_t estops;
+    uint32_t stop_frames;      /* start_tx calls with the stop frame (failed ones included) */
+    uint32_t stop_port_errors; /* of them, failed here */
+    uint32_t series_seen;      /* stats.estops at the latest stop frame */
+    uint32_t series_attempts;  /* stop frames of that stop so far */
     uint32_t chain_budget;
     bool chain;
     int serial_next;
@@ -91,13 +98,29 @@ static int port_start_tx(void *ctx, const uint8_t *data, size_t len)
         FUZZ_CHECK(is_stop);
         w.estop_expected = false;
     } else if (is_stop && w.estops > 0u) {
-        /* a retry of the stop */
+        /* a re-send of the stop, or a stop merged into one that was then given up */
     } else {
         FUZZ_CHECK(w.fifo_n > 0u);
         FUZZ_CHECK((data[2] & 0x0Fu) == w.fifo_id[0]);
     }
+    if (is_stop) {
+        const j288_bus_stats_t *st = j288_bus_stats(&bus);
+        if (st->estops != w.series_seen) { /* counted when a stop starts */
+            w.series_seen = st->estops;
+            w.series_attempts = 0u;
+        }
+        w.series_attempts++;
+        w.stop_frames++;
+        FUZZ_CHECK(w.series_attempts <= J288_ESTOP_ATTEMPTS); /* bounded on a dead port */
+    }
     if (w.fail_next > 0) {
         w.fail_next--;
+        if (is_stop) {
+            /* Whatever the retries: a failed stop frame is sent again, before anything else,
+             * until it has had its J288_ESTOP_ATTEMPTS. */
+            w.stop_port_errors++;
+            w.estop_expected = w.series_attempts < J288_ESTOP_ATTEMPTS;
+        }
         return J288_ERR_PORT;
     }
     w.tx_start = w.now;
@@ -475,12 +498,20 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     FUZZ_CHECK(st->failed == w.callbacks - w.cb_ok - w.cb_aborted);
     check_stats_add_up(0u);
     FUZZ_CHECK(st->estops <= w.estops);
-    FUZZ_CHECK(st->attempts >= w.cb_attempts);
+    /* Every frame handed to start_tx is an attempt of a called-back transaction or a stop
+     * frame; the stops' own failures are the only attempt results without a callback. */
+    FUZZ_CHECK(st->attempts == w.cb_attempts + w.stop_frames);
+    FUZZ_CHECK(st->port_errors == w.cb_port_errors + w.stop_port_errors);
+    FUZZ_CHECK(st->timeouts >= w.cb_timeouts && st->collisions >= w.cb_collisions);
+    FUZZ_CHECK((st->timeouts - w.cb_timeouts) + (st->collisions - w.cb_collisions) +
+                   w.stop_port_errors <= w.stop_frames);
     if (w.estops == 0u) {
-        FUZZ_CHECK(st->attempts == w.cb_attempts);
-        FUZZ_CHECK(st->timeouts == w.cb_timeouts);
-        FUZZ_CHECK(st->collisions == w.cb_collisions);
-        FUZZ_CHECK(st->port_errors == w.cb_port_errors);
+        FUZZ_CHECK(w.stop_frames == 0u && st->estops == 0u);
     }
+    /* A stop gets out within J288_ESTOP_ATTEMPTS transmits or is given up after exactly that
+     * many (the fuzzer never reports J288_LINE_GONE, which would end it sooner). */
+    FUZZ_CHECK(st->estop_failures <= st->estops);
+    FUZZ_CHECK(w.stop_frames <= st->estops * J288_ESTOP_ATTEMPTS);
+    FUZZ_CHECK(w.stop_frames >= st->estops + st->estop_failures * (J288_ESTOP_ATTEMPTS - 1u));
     return 0;
 }

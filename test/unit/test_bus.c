@@ -741,6 +741,20 @@ static void test_line_gone_is_offline_without_retry(void)
     TEST_ASSERT_EQUAL_UINT8(1u, cb.txn.attempts);
     TEST_ASSERT_TRUE(fake_port_run_until_idle(&fp, 5000u * US));
     TEST_ASSERT_EQUAL_UINT32(1u, fp.nframes);
+
+    /* gone while waiting to retry: ends there, nothing more is sent */
+    setup_cfg(&cfg);
+    fp.start_tx_fail = 1;
+    fake_port_error_at(&fp, 50u * US, J288_LINE_GONE);
+    submit_ok(&cmd);
+    TEST_ASSERT_TRUE(fake_port_run_until_idle(&fp, 5000u * US));
+    TEST_ASSERT_EQUAL_INT(1, cb.calls);
+    TEST_ASSERT_EQUAL_INT(J288_ERR_OFFLINE, cb.txn.result);
+    TEST_ASSERT_EQUAL_UINT8(1u, cb.txn.attempts);
+    TEST_ASSERT_EQUAL_INT(J288_ERR_PORT, cb.txn.attempt_result[0]);
+    TEST_ASSERT_EQUAL_UINT32(50u, cb.txn.latency_us);
+    TEST_ASSERT_EQUAL_UINT32(0u, fp.nframes);
+    TEST_ASSERT_EQUAL_UINT32(1u, j288_bus_stats(&bus)->failed);
 }
 
 /* ---- caller errors, busy, tx timeout */
@@ -931,6 +945,144 @@ static void test_estop_counts_in_estops_only(void)
     TEST_ASSERT_EQUAL_UINT32(2u, j288_bus_stats(&bus)->transactions);
     TEST_ASSERT_EQUAL_UINT32(1u, j288_bus_stats(&bus)->ok);
     TEST_ASSERT_EQUAL_UINT32(1u, j288_bus_stats(&bus)->aborted);
+}
+
+/* A stop frame that did not get out is sent again (with the default retries 0): the lock
+ * must reach the servos. Each failure kind, then a dead port (bounded), then a vanished
+ * line (at once), then a request merged into a stop that then fails. */
+static void test_estop_resent_after_port_error(void)
+{
+    j288_cmd_raw_t cmd = lock_cmd(3u);
+    j288_cmd_raw_t stop = lock_cmd(J288_BROADCAST_ID);
+    setup();
+    fp.start_tx_fail = 1;
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_bus_estop(&bus, 0u));
+    TEST_ASSERT_EQUAL_UINT32(0u, fp.nframes);
+    TEST_ASSERT_EQUAL_INT(J288_ERR_BUSY, j288_bus_submit(&bus, &cmd, 0u, on_done, &cb));
+    TEST_ASSERT_TRUE(fake_port_run_until_idle(&fp, 5000u * US));
+    TEST_ASSERT_EQUAL_UINT32(1u, fp.nframes);
+    assert_frame_cmd(0u, &stop);
+    TEST_ASSERT_EQUAL_UINT32(BUDGET_US, fake_port_frame(&fp, 0u)->start_us); /* after a guard */
+    TEST_ASSERT_EQUAL_UINT32(1u, j288_bus_stats(&bus)->estops);
+    TEST_ASSERT_EQUAL_UINT32(0u, j288_bus_stats(&bus)->estop_failures);
+    TEST_ASSERT_EQUAL_UINT32(2u, j288_bus_stats(&bus)->attempts);
+    TEST_ASSERT_EQUAL_UINT32(1u, j288_bus_stats(&bus)->port_errors);
+    TEST_ASSERT_EQUAL_INT(0, cb.calls);
+}
+
+static void test_estop_resent_after_collision(void)
+{
+    j288_bus_config_t cfg;
+    j288_cmd_raw_t stop = lock_cmd(J288_BROADCAST_ID);
+    memset(&cfg, 0, sizeof cfg);
+    cfg.echo = true;
+    setup_cfg(&cfg);
+    fp.echo = true;
+    fp.echo_flip_at = 7;
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_bus_estop(&bus, 0u));
+    fake_port_run_until(&fp, TX_END_NS);
+    TEST_ASSERT_EQUAL_UINT32(1u, j288_bus_stats(&bus)->collisions);
+    fp.echo_flip_at = -1;
+    TEST_ASSERT_TRUE(fake_port_run_until_idle(&fp, 5000u * US));
+    TEST_ASSERT_EQUAL_UINT32(2u, fp.nframes);
+    assert_frame_cmd(1u, &stop);
+    TEST_ASSERT_EQUAL_UINT32(33u + BUDGET_US, fake_port_frame(&fp, 1u)->start_us);
+    TEST_ASSERT_EQUAL_UINT32(1u, j288_bus_stats(&bus)->collisions);
+    TEST_ASSERT_EQUAL_UINT32(1u, j288_bus_stats(&bus)->estops);
+    TEST_ASSERT_EQUAL_UINT32(0u, j288_bus_stats(&bus)->estop_failures);
+}
+
+static void test_estop_resent_after_tx_timeout_and_line_error(void)
+{
+    j288_cmd_raw_t stop = lock_cmd(J288_BROADCAST_ID);
+    setup();
+    fp.txdone = FAKE_TXDONE_MANUAL; /* the first transmit never completes */
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_bus_estop(&bus, 0u));
+    fake_port_run_until(&fp, BUDGET_US * US);
+    TEST_ASSERT_EQUAL_UINT32(1u, j288_bus_stats(&bus)->timeouts);
+    fp.txdone = FAKE_TXDONE_TIMED;
+    fp.tx_busy = false; /* the port gave that transmit up */
+    /* the second is heard with a line error on the wire: sent a third time */
+    fake_port_error_at(&fp, 2u * BUDGET_US * US + 10u * US, J288_LINE_FRAMING);
+    TEST_ASSERT_TRUE(fake_port_run_until_idle(&fp, 5000u * US));
+    TEST_ASSERT_EQUAL_UINT32(3u, fp.nframes);
+    assert_frame_cmd(1u, &stop);
+    assert_frame_cmd(2u, &stop);
+    TEST_ASSERT_EQUAL_UINT32(2u * BUDGET_US, fake_port_frame(&fp, 1u)->start_us);
+    TEST_ASSERT_EQUAL_UINT32(2u * BUDGET_US + 33u + BUDGET_US, fake_port_frame(&fp, 2u)->start_us);
+    TEST_ASSERT_EQUAL_UINT32(1u, j288_bus_stats(&bus)->estops);
+    TEST_ASSERT_EQUAL_UINT32(0u, j288_bus_stats(&bus)->estop_failures);
+    TEST_ASSERT_EQUAL_UINT32(3u, j288_bus_stats(&bus)->attempts);
+    TEST_ASSERT_EQUAL_INT(0, fp.tx_overlap_errors);
+}
+
+static void test_estop_dead_port_gives_up_bounded(void)
+{
+    j288_cmd_raw_t cmd = lock_cmd(3u);
+    setup();
+    fp.start_tx_fail = 1000;
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_bus_estop(&bus, 0u));
+    TEST_ASSERT_TRUE(fake_port_run_until_idle(&fp, 50000u * US));
+    TEST_ASSERT_EQUAL_UINT32(J288_ESTOP_ATTEMPTS, j288_bus_stats(&bus)->attempts);
+    TEST_ASSERT_EQUAL_UINT32(J288_ESTOP_ATTEMPTS, j288_bus_stats(&bus)->port_errors);
+    TEST_ASSERT_EQUAL_UINT32(1u, j288_bus_stats(&bus)->estops);
+    TEST_ASSERT_EQUAL_UINT32(1u, j288_bus_stats(&bus)->estop_failures);
+    TEST_ASSERT_EQUAL_INT(1000 - (int)J288_ESTOP_ATTEMPTS, fp.start_tx_fail);
+    /* each re-send after a reply budget; idle one more budget after the last */
+    TEST_ASSERT_EQUAL_UINT32((J288_ESTOP_ATTEMPTS + 0u) * BUDGET_US, fake_port_now_us(&fp));
+    TEST_ASSERT_EQUAL_UINT32(0u, j288_bus_stats(&bus)->transactions);
+    TEST_ASSERT_EQUAL_UINT32(0u, j288_bus_stats(&bus)->failed);
+    /* given up: the bus takes work again (and reports the port's error) */
+    fp.start_tx_fail = 0;
+    submit_ok(&cmd);
+    TEST_ASSERT_EQUAL_UINT32(1u, fp.nframes);
+}
+
+static void test_estop_line_gone_ends_at_once(void)
+{
+    setup();
+    fp.txdone = FAKE_TXDONE_MANUAL;
+    fake_port_error_at(&fp, 20u * US, J288_LINE_GONE); /* during the transmit */
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_bus_estop(&bus, 0u));
+    TEST_ASSERT_TRUE(fake_port_run_until_idle(&fp, 5000u * US));
+    TEST_ASSERT_EQUAL_UINT32(1u, fp.nframes);
+    TEST_ASSERT_EQUAL_UINT32(1u, j288_bus_stats(&bus)->attempts);
+    TEST_ASSERT_EQUAL_UINT32(1u, j288_bus_stats(&bus)->estop_failures);
+
+    setup();
+    fp.start_tx_fail = 1;
+    fake_port_error_at(&fp, 50u * US, J288_LINE_GONE); /* while waiting to send again */
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_bus_estop(&bus, 0u));
+    TEST_ASSERT_TRUE(fake_port_run_until_idle(&fp, 5000u * US));
+    TEST_ASSERT_EQUAL_UINT32(0u, fp.nframes);
+    TEST_ASSERT_EQUAL_UINT32(1u, j288_bus_stats(&bus)->attempts);
+    TEST_ASSERT_EQUAL_UINT32(1u, j288_bus_stats(&bus)->estop_failures);
+}
+
+static void test_estop_merged_into_failing_stop_starts_again(void)
+{
+    setup();
+    fp.start_tx_fail = 1000;
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_bus_estop(&bus, 0u));
+    fake_port_run_until(&fp, 100u * US);
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_bus_estop(&bus, 100u)); /* merged into the stop */
+    TEST_ASSERT_EQUAL_UINT32(1u, j288_bus_stats(&bus)->estops);
+    TEST_ASSERT_TRUE(fake_port_run_until_idle(&fp, 50000u * US));
+    /* the first stop failed: the merged request was a stop of its own */
+    TEST_ASSERT_EQUAL_UINT32(2u, j288_bus_stats(&bus)->estops);
+    TEST_ASSERT_EQUAL_UINT32(2u, j288_bus_stats(&bus)->estop_failures);
+    TEST_ASSERT_EQUAL_UINT32(2u * J288_ESTOP_ATTEMPTS, j288_bus_stats(&bus)->attempts);
+
+    /* merged into a stop that then gets out: sent once */
+    setup();
+    fp.start_tx_fail = 1;
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_bus_estop(&bus, 0u));
+    fake_port_run_until(&fp, 100u * US);
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_bus_estop(&bus, 100u));
+    TEST_ASSERT_TRUE(fake_port_run_until_idle(&fp, 50000u * US));
+    TEST_ASSERT_EQUAL_UINT32(1u, fp.nframes);
+    TEST_ASSERT_EQUAL_UINT32(1u, j288_bus_stats(&bus)->estops);
+    TEST_ASSERT_EQUAL_UINT32(0u, j288_bus_stats(&bus)->estop_failures);
 }
 
 /* ---- advance in ISR */
@@ -1302,6 +1454,12 @@ int main(void)
     RUN_TEST(test_estop_while_busy);
     RUN_TEST(test_estop_idle_and_with_queued_work);
     RUN_TEST(test_estop_counts_in_estops_only);
+    RUN_TEST(test_estop_resent_after_port_error);
+    RUN_TEST(test_estop_resent_after_collision);
+    RUN_TEST(test_estop_resent_after_tx_timeout_and_line_error);
+    RUN_TEST(test_estop_dead_port_gives_up_bounded);
+    RUN_TEST(test_estop_line_gone_ends_at_once);
+    RUN_TEST(test_estop_merged_into_failing_stop_starts_again);
     RUN_TEST(test_advance_in_isr_chains_without_poll);
     RUN_TEST(test_advance_in_isr_with_inline_tx_done);
     RUN_TEST(test_failure_ranking);

@@ -22,7 +22,8 @@
  *   stale; a frame from another id is never taken: a late reply is never credited to a
  *   later transaction. A broadcast ends when its transmit (and echo) is complete.
  * - Retries (config.retries): a failed attempt is re-sent after the guard; each attempt's
- *   reason is kept in the j288_txn_t. J288_ERR_OFFLINE and an emergency stop end it at once.
+ *   reason is kept in the j288_txn_t. J288_ERR_OFFLINE (also a J288_LINE_GONE reported while
+ *   waiting to retry) and an emergency stop end it at once.
  * - Line errors (j288_bus_on_error) during an attempt mark it: when no good reply comes, the
  *   result is J288_ERR_LINE (ranked wrong id > line > crc/truncated > timeout); a reply whose
  *   CRC checks out after a line error is still taken. J288_LINE_GONE ends the attempt at once
@@ -65,6 +66,12 @@ extern "C" {
 #define J288_DEFAULT_TURNAROUND_US 50u /* servo's reply delay allowance        */
 #define J288_DEFAULT_MARGIN_US 20u     /* host latency on an MCU                */
 #define J288_DEFAULT_GUARD_US 2u       /* quiet gap between transactions        */
+
+/* Transmit attempts an emergency stop frame gets before it is given up (j288_bus_estop). */
+#define J288_ESTOP_ATTEMPTS (J288_CONFIG_MAX_RETRIES + 1u)
+#if J288_CONFIG_MAX_RETRIES < 1
+#error "J288_CONFIG_MAX_RETRIES must be at least 1: the emergency stop frame is re-sent"
+#endif
 
 typedef enum {
     J288_BUS_IDLE = 0,
@@ -123,8 +130,11 @@ typedef struct {
     uint32_t aborted;      /* transactions ended J288_ERR_ABORTED by an estop */
     uint32_t stale_bytes;   /* discarded outside a reply window (late replies, noise) */
     uint32_t rx_overflows;  /* bytes lost because the ring was full */
-    uint32_t estops;        /* stop frames put on the wire by j288_bus_estop() (not counted in
-                               transactions, ok or aborted: the stop is not a user transaction) */
+    uint32_t estops;        /* stops started by j288_bus_estop() (re-sends of one stop count
+                               in attempts, not here; not counted in transactions, ok or
+                               aborted: the stop is not a user transaction) */
+    uint32_t estop_failures; /* stops given up: every one of their J288_ESTOP_ATTEMPTS
+                                transmits failed, or the line went away (j288_bus_estop) */
 } j288_bus_stats_t;
 
 typedef struct j288_bus {
@@ -161,7 +171,8 @@ typedef struct j288_bus {
     bool queued;          /* an accepted submit waits for the guard to end */
     bool retry_pending;   /* the failed attempt is re-sent when the guard ends */
     bool estop_pending;   /* a stop was requested and is not on the wire yet */
-    bool estop_active;    /* the frame in flight is the stop frame */
+    bool estop_active;    /* the frame in flight (or to be re-sent) is the stop frame */
+    bool estop_rearm;     /* an estop was requested while the stop was active */
     int attempt_fail;     /* most specific failure seen in this attempt, or J288_OK */
     uint32_t deadline;    /* reply deadline of the attempt in flight */
     uint32_t guard_end;
@@ -209,8 +220,17 @@ void j288_bus_on_timer(j288_bus_t *bus);
  * reply is not talked over: it ends with J288_ERR_ABORTED when its attempt ends (reply taken,
  * deadline, collision; at most one reply budget), without retries, its real reason kept in
  * attempt_result[]; a submit queued behind a guard ends J288_ERR_ABORTED with 0 attempts.
- * The stop frame then goes out at once (skipping the guard). Submits are refused
- * (J288_ERR_BUSY) until the stop frame is out; a second estop meanwhile changes nothing.
+ * The stop frame then goes out at once (skipping the guard).
+ * A stop frame whose transmit fails (start_tx error, echo collision or incomplete echo, no tx
+ * done by its deadline, a line error during it) is sent again after a reply budget's guard,
+ * whatever config.retries says, up to J288_ESTOP_ATTEMPTS transmits in all; J288_LINE_GONE
+ * (during a transmit or while waiting to re-send) ends it at once. A stop given up this way
+ * counts in stats.estop_failures (stats.estops counts every stop started); the port's own
+ * errors are counted as usual (port_errors, collisions, timeouts, line_errors).
+ * Submits are refused (J288_ERR_BUSY) until the stop frame is out or given up. An estop
+ * meanwhile is merged into the stop in progress: nothing more is sent if that stop gets out,
+ * and a new stop (J288_ESTOP_ATTEMPTS more transmits) starts at once if it is given up.
+ * The stop has no completion callback and is not a transaction in the statistics.
  * Returns J288_OK or J288_ERR_NULL. Thread only (or the owning ISR). */
 int j288_bus_estop(j288_bus_t *bus, uint32_t now_us);
 
