@@ -83,16 +83,18 @@ t_log_frames() {
         grep -q ' bad-crc id=0$' "$tmp/log" &&
         grep -q 'commands 1 .*bad-crc 1 ' "$tmp/err" && grep -q ' replies 1 ' "$tmp/err"
 }
-# wait_err PATTERN: up to 3 s for a line of the simulator's stderr to match.
+# wait_err PATTERN: up to 10 s for a line of the simulator's stderr to match.
 wait_err() {
-    for _ in $(seq 1 60); do
+    for _ in $(seq 1 200); do
         grep -Eq "$1" "$tmp/err" && return 0
         sleep 0.05
     done
     return 1
 }
 # status_ok / status_fails: one status exchange with servo 1, no retries.
-status_ok() { timeout 10 "$J288" --port "$SIM_PTY" status --id 1 --retries 0 >/dev/null 2>"$tmp/st"; }
+status_ok() {
+    timeout 10 "$J288" --port "$SIM_PTY" status --id 1 --retries 0 >/dev/null 2>"$tmp/st"
+}
 status_fails() {
     timeout 10 "$J288" --port "$SIM_PTY" status --id 1 --retries 0 >/dev/null 2>"$tmp/st"
     [ $? -eq 1 ] && grep -q 'no reply from servo 1' "$tmp/st"
