@@ -19,8 +19,8 @@
  *    frame accepted or a reply credited to the wrong servo or transaction would show up here;
  *  - its result is tallied by cause; at the end each slot's statistics must equal the tally
  *    (every failure counted, under the cause the transaction reported), the slot counters
- *    must add up (transactions = successes + failures), and the bus's transaction and success
- *    counts must equal the slots' sums;
+ *    must add up (transactions = successes + failures), and the bus's transaction, success
+ *    and failure counts must equal the slots' sums (ok + failed + aborted = transactions);
  *  - failures are explained by the injected faults: no more failures than faults the
  *    simulator reports having injected, and at least one timeout and one CRC error when it
  *    dropped and corrupted replies;
@@ -458,6 +458,12 @@ static void check_statistics(const soak_t *k, tally_t *sum, const char *when)
           when, bs->transactions, sum->transactions);
     CHECK(bs->ok == sum->successes, "%s: bus counted %u successes, the slots %u", when, bs->ok,
           sum->successes);
+    CHECK(bs->failed == sum->transactions - sum->successes && bs->aborted == 0u,
+          "%s: bus counted %u failed and %u aborted, the slots %u failures", when, bs->failed,
+          bs->aborted, sum->transactions - sum->successes);
+    CHECK(bs->transactions == bs->ok + bs->failed + bs->aborted,
+          "%s: bus transactions %u != ok %u + failed %u + aborted %u between sweeps", when,
+          bs->transactions, bs->ok, bs->failed, bs->aborted);
 }
 
 /* The bus's failure and stale-byte counters, to compare before and after the clean phase. */
