@@ -198,7 +198,8 @@ hard-cov-run: $(COVERAGE_TESTS)
 	@echo "coverage: HTML report in $(BUILD)/coverage/index.html"
 
 # ---------------------------------------------------------------------------------------------
-# Fault soak (test/soak/): the Linux port and scheduler against j288-sim on a pty.
+# Fault soak (test/soak/): the Linux port and scheduler against j288-sim on a pty, faults on,
+# then switched off in the same simulator (SIGUSR1): the next sweep must be all healthy.
 # soak-short runs under valgrind memcheck when it is there (leaks, invalid accesses), with a
 # wider reply margin since valgrind slows the host side down.
 SOAK_TXNS ?= 100000
