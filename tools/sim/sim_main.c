@@ -138,8 +138,9 @@ static void usage(FILE *f)
           "                      replies from the next command on (a reply already delayed by\n"
           "                      --late still arrives when due); --fault bits are servo state\n"
           "                      and stay. Unless --quiet, prints 'j288-sim: faults off: stats:\n"
-          "                      ...' (the statistics line so far) once it applies.\n"
+          "                      ...' (the statistics line so far) when it takes effect.\n"
           "  SIGUSR2             wire faults on again as configured ('faults on: stats: ...').\n"
+          "                      A signal that changes nothing prints nothing.\n"
           "log lines: SECONDS HEX20 then 'id=N status=N wd=0|1 tau= speed= pos= kp= kd='\n"
           "for a good frame, or 'bad-crc id=N' for a frame whose CRC failed.\n",
           f);
