@@ -5,7 +5,8 @@
 
 #define RING_MASK  (J288_CONFIG_RX_RING_SIZE - 1u)
 #define MAX_CFG_US 60000000u /* longest turnaround, margin or guard: 1 minute */
-#define MAX_STEPS  16u       /* transitions per advance call; more is a bug, not a hang */
+#define MAX_STEPS  16u /* transitions per advance call; more is a bug, not a hang (no event
+                          sequence takes more than a few: a re-send always waits a guard) */
 
 /* Failure ranking at the deadline: the most specific observation names the result. */
 static unsigned fail_rank(int err)
@@ -249,9 +250,7 @@ static void end_attempt(j288_bus_t *bus, int result, uint32_t now)
     j288_txn_t *t = &bus->txn[bus->cur];
     bool final = attempt_is_final(bus, result, t->attempts);
 
-    if (t->attempts != 0u) {
-        t->attempt_result[t->attempts - 1u] = result;
-    }
+    t->attempt_result[t->attempts - 1u] = result; /* only attempts end: attempts >= 1 */
     count_result(bus, result);
     if (final) {
         finish(bus, result, now);
@@ -419,14 +418,11 @@ static uint32_t take_bytes(j288_bus_t *bus, uint32_t pos, const uint8_t *p, uint
     return take_reply_bytes(bus, p, n, now);
 }
 
-/* Consume the ring up to index limit (not beyond what has been received). */
+/* Consume the ring up to index limit, between the tail and the head. */
 static void consume_to(j288_bus_t *bus, uint32_t limit, uint32_t now)
 {
     uint32_t tail = bus->ring_tail;
 
-    if ((uint32_t)(limit - tail) > J288_CONFIG_RX_RING_SIZE) {
-        return; /* limit is behind the tail: already consumed */
-    }
     while (tail != limit) {
         uint32_t off = tail & RING_MASK;
         uint32_t n = limit - tail;
@@ -454,31 +450,40 @@ static void flush_partial(j288_bus_t *bus)
     }
 }
 
-/* Take what the event calls recorded, in the order it happened. */
+/* The line went idle at ring index mark: a frame in progress there was cut short. A mark
+ * behind the tail was taken already: in poll mode an ISR can record a second idle between
+ * take_events' reads of ev_idle and idle_mark; that advance then consumed and flushed up to
+ * the second idle's mark, and must not flush again in the middle of what followed. */
+static void take_idle(j288_bus_t *bus, uint32_t mark, uint32_t now)
+{
+    if ((uint32_t)(mark - bus->ring_tail) > J288_CONFIG_RX_RING_SIZE) {
+        return;
+    }
+    consume_to(bus, mark, now);
+    if (in_reply_window(bus)) {
+        flush_partial(bus);
+    }
+}
+
+/* Take what the event calls recorded, in the order it happened. Called in an active state
+ * only (events recorded while quiet are dropped by the next start_attempt). */
 static void take_events(j288_bus_t *bus, uint32_t now)
 {
     uint32_t n;
 
     if (bus->ev_tx_done != bus->seen_tx_done) {
         bus->seen_tx_done = bus->ev_tx_done;
-        if (is_active(bus->state)) {
-            bus->tx_complete = true;
-        }
+        bus->tx_complete = true;
     }
     n = bus->ev_line;
     if (n != bus->seen_line) {
         bus->seen_line = n;
-        if (is_active(bus->state)) {
-            note_fail(bus, J288_ERR_LINE);
-        }
+        note_fail(bus, J288_ERR_LINE);
     }
     n = bus->ev_idle;
     if (n != bus->seen_idle) {
         bus->seen_idle = n;
-        consume_to(bus, bus->idle_mark, now);
-        if (in_reply_window(bus)) {
-            flush_partial(bus);
-        }
+        take_idle(bus, bus->idle_mark, now);
     }
     consume_to(bus, bus->ring_head, now);
 }
@@ -575,7 +580,7 @@ static void advance(j288_bus_t *bus, uint32_t now)
             step_quiet(bus, now);
         }
         steps++;
-    } while (bus->again && (steps < MAX_STEPS));
+    } while (bus->again && (steps < MAX_STEPS)); /* GCOVR_EXCL_BR_LINE: limit = bug backstop */
     bus->in_advance = false;
 }
 
@@ -710,12 +715,13 @@ int j288_bus_estop(j288_bus_t *bus, uint32_t now_us)
     return J288_OK;
 }
 
-/* Force the transaction in progress (or queued) to end, e.g. the device went away. */
+/* Force the pending transaction to end, e.g. the device went away: its attempt if one is on
+ * the wire (the result is final), else the submit queued or waiting to retry. */
 static void abort_txn(j288_bus_t *bus, int result, uint32_t now)
 {
     if (is_active(bus->state)) {
         end_attempt(bus, result, now);
-    } else if (bus->queued || bus->retry_pending) {
+    } else {
         finish(bus, result, now);
     }
 }
@@ -764,12 +770,11 @@ int j288_bus_transfer_blocking(j288_bus_t *bus, const j288_cmd_raw_t *cmd, j288_
         }
         rc = bus->port->wait(bus->port_ctx, bus->timer_at);
         if (rc < 0) {
+            /* Not done: ours is in flight, queued or waiting to retry; this ends it (with
+             * J288_ERR_OFFLINE, or J288_ERR_ABORTED under a pending estop) and calls back. */
             port_lock(bus);
             abort_txn(bus, J288_ERR_OFFLINE, bus->port->now_us(bus->port_ctx));
             port_unlock(bus);
-            if (!b.done) {
-                return J288_ERR_OFFLINE; /* unreachable: abort_txn always completes it */
-            }
             break;
         }
     }

@@ -415,7 +415,7 @@ static int op_wait(void *ctx, uint32_t until_us)
     fake_port_t *fp = (fake_port_t *)ctx;
     uint64_t until = deadline_ns(fp, until_us);
     fp->wait_calls++;
-    if (fp->gone) {
+    if (fp->gone || ((fp->gone_after_ns != 0u) && (fp->now_ns >= fp->gone_after_ns))) {
         return J288_ERR_OFFLINE;
     }
     if (!deliver_next(fp, until) && (until > fp->now_ns)) {

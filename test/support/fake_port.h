@@ -94,6 +94,7 @@ struct fake_port {
                                idle-line DMA interrupt, ISR latency); idle too */
     int start_tx_fail;      /* > 0: that many next start_tx calls return J288_ERR_PORT */
     bool gone;              /* wait() returns J288_ERR_OFFLINE */
+    uint64_t gone_after_ns; /* and from this virtual time on, if not 0 (unplugged mid-run) */
     fake_poll_fn poll_fn;
     void *poll_user;
     fake_servo_t servo[J288_MAX_SERVOS];

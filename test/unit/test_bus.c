@@ -154,6 +154,14 @@ static void test_init_rejections(void)
     memset(&cfg, 0, sizeof cfg);
     cfg.margin_us = 60000001u;
     TEST_ASSERT_EQUAL_INT(J288_ERR_BAD_CONFIG, j288_bus_init(&bus, &fp.ops, &fp, &cfg));
+    memset(&cfg, 0, sizeof cfg);
+    cfg.turnaround_us = 60000001u;
+    TEST_ASSERT_EQUAL_INT(J288_ERR_BAD_CONFIG, j288_bus_init(&bus, &fp.ops, &fp, &cfg));
+    memset(&cfg, 0, sizeof cfg);
+    cfg.guard_us = 60000001u;
+    TEST_ASSERT_EQUAL_INT(J288_ERR_BAD_CONFIG, j288_bus_init(&bus, &fp.ops, &fp, &cfg));
+    cfg.guard_us = 60000000u; /* the limit itself is fine */
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_bus_init(&bus, &fp.ops, &fp, &cfg));
 
     /* Only the two required ops: fine. */
     memset(&ops, 0, sizeof ops);
@@ -180,6 +188,29 @@ static void test_reply_budget_and_wire_time(void)
     cfg.margin_us = 3000u;
     setup_cfg(&cfg);
     TEST_ASSERT_EQUAL_UINT32(460u + 100u + 3000u, j288_bus_reply_budget_us(&bus));
+    TEST_ASSERT_EQUAL_UINT32(0u, j288_bus_reply_budget_us(NULL));
+}
+
+/* A configured guard is the gap between a reply and the next transmit. */
+static void test_configured_guard(void)
+{
+    j288_bus_config_t cfg;
+    j288_cmd_raw_t cmd = lock_cmd(3u);
+    j288_reply_raw_t r = reply_for(3u, 31);
+    memset(&cfg, 0, sizeof cfg);
+    cfg.guard_us = 40u;
+    setup_cfg(&cfg);
+    fake_port_add_servo(&fp, 3u, &r);
+    submit_ok(&cmd);
+    fake_port_run_until(&fp, 87u * US); /* reply taken at 86 us */
+    TEST_ASSERT_EQUAL_INT(J288_OK, cb.txn.result);
+    submit_ok(&cmd); /* queued behind the guard */
+    fake_port_run_until(&fp, 125u * US);
+    TEST_ASSERT_EQUAL_UINT32(1u, fp.nframes);
+    TEST_ASSERT_EQUAL_INT(J288_BUS_GUARD, j288_bus_state(&bus));
+    fake_port_run_until(&fp, 126u * US);
+    TEST_ASSERT_EQUAL_UINT32(2u, fp.nframes);
+    TEST_ASSERT_EQUAL_UINT32(86u + 40u, fake_port_frame(&fp, 1u)->start_us);
 }
 
 /* ---- the normal transaction, step by step */
@@ -694,6 +725,67 @@ static void test_failed_counts_transactions(void)
     assert_stats_add_up(0u);
 }
 
+/* While a failed attempt waits to be re-sent: a submit is refused, an estop ends the
+ * transaction (its attempts' reasons kept) and the stop goes out at once. */
+static void test_estop_and_submit_while_waiting_to_retry(void)
+{
+    j288_bus_config_t cfg;
+    j288_cmd_raw_t cmd = lock_cmd(3u);
+    j288_cmd_raw_t stop = lock_cmd(J288_BROADCAST_ID);
+    memset(&cfg, 0, sizeof cfg);
+    cfg.retries = 2u;
+    setup_cfg(&cfg);
+    submit_ok(&cmd);
+    fake_port_run_until(&fp, 150u * US); /* attempt 1 timed out at 147; retry due at 294 */
+    TEST_ASSERT_EQUAL_INT(J288_BUS_GUARD, j288_bus_state(&bus));
+    TEST_ASSERT_EQUAL_INT(J288_ERR_BUSY, j288_bus_submit(&bus, &cmd, 150u, on_done, &cb));
+    TEST_ASSERT_EQUAL_INT(0, cb.calls);
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_bus_estop(&bus, 150u));
+    TEST_ASSERT_EQUAL_INT(1, cb.calls);
+    TEST_ASSERT_EQUAL_INT(J288_ERR_ABORTED, cb.txn.result);
+    TEST_ASSERT_EQUAL_UINT8(1u, cb.txn.attempts);
+    TEST_ASSERT_EQUAL_INT(J288_ERR_TIMEOUT, cb.txn.attempt_result[0]);
+    TEST_ASSERT_EQUAL_UINT32(2u, fp.nframes);
+    assert_frame_cmd(1u, &stop);
+    TEST_ASSERT_EQUAL_UINT32(150u, fake_port_frame(&fp, 1u)->start_us);
+    TEST_ASSERT_TRUE(fake_port_run_until_idle(&fp, 5000u * US));
+    TEST_ASSERT_EQUAL_UINT32(2u, fp.nframes); /* the retry never went out */
+    assert_stats_add_up(0u);
+
+    /* estop while the attempt is on the wire, which then fails: no retry either */
+    setup_cfg(&cfg);
+    submit_ok(&cmd);
+    fake_port_run_until(&fp, 50u * US);
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_bus_estop(&bus, 50u));
+    fake_port_run_until(&fp, BUDGET_US * US);
+    TEST_ASSERT_EQUAL_INT(1, cb.calls);
+    TEST_ASSERT_EQUAL_INT(J288_ERR_ABORTED, cb.txn.result);
+    TEST_ASSERT_EQUAL_UINT8(1u, cb.txn.attempts);
+    TEST_ASSERT_EQUAL_INT(J288_ERR_TIMEOUT, cb.txn.attempt_result[0]);
+    TEST_ASSERT_EQUAL_UINT32(2u, fp.nframes);
+    assert_frame_cmd(1u, &stop);
+    TEST_ASSERT_EQUAL_UINT32(BUDGET_US, fake_port_frame(&fp, 1u)->start_us);
+}
+
+/* A broadcast heard with a line error on the wire is a failed attempt: retried. */
+static void test_broadcast_with_line_error_is_retried(void)
+{
+    j288_bus_config_t cfg;
+    j288_cmd_raw_t cmd = lock_cmd(J288_BROADCAST_ID);
+    memset(&cfg, 0, sizeof cfg);
+    cfg.retries = 1u;
+    setup_cfg(&cfg);
+    fake_port_error_at(&fp, 10u * US, J288_LINE_NOISE);
+    submit_ok(&cmd);
+    TEST_ASSERT_TRUE(fake_port_run_until_idle(&fp, 5000u * US));
+    TEST_ASSERT_EQUAL_INT(1, cb.calls);
+    TEST_ASSERT_EQUAL_INT(J288_OK, cb.txn.result);
+    TEST_ASSERT_EQUAL_UINT8(2u, cb.txn.attempts);
+    TEST_ASSERT_EQUAL_INT(J288_ERR_LINE, cb.txn.attempt_result[0]);
+    TEST_ASSERT_EQUAL_UINT32(2u, fp.nframes);
+    TEST_ASSERT_EQUAL_UINT32(33u + BUDGET_US, fake_port_frame(&fp, 1u)->start_us);
+}
+
 /* ---- line errors */
 
 static void test_line_error_marks_attempt(void)
@@ -784,7 +876,14 @@ static void test_submit_errors_send_nothing(void)
     j288_bus_on_error(NULL, 1u);
     j288_bus_on_timer(NULL);
     j288_bus_poll(NULL, 0u);
+    j288_bus_on_rx(&bus, WORKED_REPLY3, 0u); /* an empty chunk records nothing */
+    j288_bus_poll(&bus, 0u);
+    TEST_ASSERT_EQUAL_UINT32(0u, j288_bus_stats(&bus)->stale_bytes);
+    TEST_ASSERT_EQUAL_UINT32(0u, j288_bus_stats(&bus)->rx_overflows);
     TEST_ASSERT_NULL(j288_bus_stats(NULL));
+    TEST_ASSERT_NULL(j288_bus_parser_stats(NULL));
+    TEST_ASSERT_EQUAL_INT(J288_BUS_IDLE, j288_bus_state(NULL));
+    TEST_ASSERT_EQUAL_INT(J288_ERR_NULL, j288_bus_transfer_blocking(NULL, &cmd, NULL));
     TEST_ASSERT_EQUAL_INT(J288_ERR_NULL, j288_bus_estop(NULL, 0u));
     /* a NULL callback is fine */
     cmd = lock_cmd(3u);
@@ -1253,6 +1352,37 @@ static void test_idle_splits_frames_in_order(void)
     TEST_ASSERT_EQUAL_UINT32(1u, j288_bus_stats(&bus)->crc_errors);
 }
 
+/* In poll mode an ISR may record a second idle between the advance's reads of ev_idle and
+ * idle_mark: that advance consumes and flushes up to the second idle, and the next one finds
+ * an idle whose mark lies behind the tail. The test builds that state directly (no
+ * single-threaded call sequence can interleave there): the frame that started after the
+ * mark must not be cut, nor any byte taken twice. */
+static void test_idle_already_consumed_is_not_taken_again(void)
+{
+    static const uint8_t noise[7] = {1, 2, 3, 4, 5, 6, 7};
+    j288_cmd_raw_t cmd = worked_cmd();
+    setup();
+    fp.poll_fn = NULL;
+    submit_ok(&cmd);
+    fake_port_run_until(&fp, TX_END_NS);
+    j288_bus_poll(&bus, fake_port_now_us(&fp));
+    TEST_ASSERT_EQUAL_INT(J288_BUS_WAIT_REPLY, j288_bus_state(&bus));
+    j288_bus_on_rx(&bus, noise, sizeof noise);
+    j288_bus_on_rx_idle(&bus); /* the idle at index 7 */
+    j288_bus_on_rx(&bus, WORKED_REPLY3, 10u);
+    j288_bus_poll(&bus, fake_port_now_us(&fp));
+    bus.ev_idle++; /* the racing advance took the idle at index 7 under the previous count */
+    j288_bus_poll(&bus, fake_port_now_us(&fp));
+    j288_bus_on_rx(&bus, &WORKED_REPLY3[10], J288_REPLY_LEN - 10u);
+    j288_bus_poll(&bus, fake_port_now_us(&fp));
+    TEST_ASSERT_EQUAL_INT(1, cb.calls);
+    TEST_ASSERT_EQUAL_INT(J288_OK, cb.txn.result);
+    TEST_ASSERT_EQUAL_INT32(5215, cb.txn.reply.pos);
+    TEST_ASSERT_EQUAL_UINT32(0u, j288_bus_parser_stats(&bus)->truncated);
+    TEST_ASSERT_EQUAL_UINT32(7u, j288_bus_parser_stats(&bus)->garbage_bytes);
+    TEST_ASSERT_EQUAL_UINT32(0u, j288_bus_stats(&bus)->crc_errors);
+}
+
 /* ---- time wrap-around */
 
 static void test_time_wraps_at_2_pow_32(void)
@@ -1393,6 +1523,64 @@ static void test_transfer_blocking_edge_cases(void)
     TEST_ASSERT_EQUAL_UINT32(2u, fp.nframes);
 }
 
+/* The device vanishes while the blocking call waits for the guard (its submit queued) or
+ * for a retry: it ends J288_ERR_OFFLINE without sending anything more. */
+static void test_transfer_blocking_gone_between_attempts(void)
+{
+    j288_bus_config_t cfg;
+    j288_cmd_raw_t cmd = lock_cmd(3u);
+    j288_reply_raw_t r = reply_for(3u, 77);
+    j288_txn_t txn;
+    memset(&cfg, 0, sizeof cfg);
+    cfg.retries = 1u;
+    setup_cfg(&cfg);
+    fp.poll_fn = NULL;
+    fake_port_add_servo(&fp, 3u, &r);
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_bus_transfer_blocking(&bus, &cmd, &txn));
+    TEST_ASSERT_EQUAL_INT(J288_BUS_GUARD, j288_bus_state(&bus)); /* 2 us to go */
+    fp.gone = true;
+    TEST_ASSERT_EQUAL_INT(J288_ERR_OFFLINE, j288_bus_transfer_blocking(&bus, &cmd, &txn));
+    TEST_ASSERT_EQUAL_INT(J288_ERR_OFFLINE, txn.result);
+    TEST_ASSERT_EQUAL_UINT8(0u, txn.attempts);
+    TEST_ASSERT_EQUAL_UINT32(1u, fp.nframes);
+    fp.gone = false;
+
+    fp.servo[3].present = false; /* attempt 1 times out; unplugged before the retry */
+    fp.gone_after_ns = fp.now_ns + 200u * US;
+    TEST_ASSERT_EQUAL_INT(J288_ERR_OFFLINE, j288_bus_transfer_blocking(&bus, &cmd, &txn));
+    TEST_ASSERT_EQUAL_UINT8(1u, txn.attempts);
+    TEST_ASSERT_EQUAL_INT(J288_ERR_TIMEOUT, txn.attempt_result[0]);
+    TEST_ASSERT_EQUAL_UINT32(2u, fp.nframes);
+    TEST_ASSERT_EQUAL_UINT32(1u, j288_bus_stats(&bus)->ok);
+    TEST_ASSERT_EQUAL_UINT32(2u, j288_bus_stats(&bus)->failed);
+    assert_stats_add_up(0u);
+}
+
+/* advance_in_isr on a port without lock/unlock (one interrupt priority, nothing to mask). */
+static void test_advance_in_isr_without_lock_ops(void)
+{
+    j288_bus_config_t cfg;
+    j288_cmd_raw_t cmd = lock_cmd(0u);
+    j288_reply_raw_t r = reply_for(0u, 500);
+    memset(&cb, 0, sizeof cb);
+    memset(&cfg, 0, sizeof cfg);
+    cfg.advance_in_isr = true;
+    fake_port_init(&fp);
+    fp.ops.lock = NULL;
+    fp.ops.unlock = NULL;
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_bus_init(&bus, &fp.ops, &fp, &cfg));
+    fake_port_attach(&fp, &bus);
+    fake_port_add_servo(&fp, 0u, &r);
+    submit_ok(&cmd);
+    TEST_ASSERT_TRUE(fake_port_run_until_idle(&fp, 5000u * US));
+    TEST_ASSERT_EQUAL_INT(J288_OK, cb.txn.result);
+    TEST_ASSERT_EQUAL_INT32(500, cb.txn.reply.pos);
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_bus_estop(&bus, fake_port_now_us(&fp)));
+    TEST_ASSERT_TRUE(fake_port_run_until_idle(&fp, fp.now_ns + 5000u * US));
+    TEST_ASSERT_EQUAL_UINT32(2u, fp.nframes);
+    TEST_ASSERT_EQUAL_UINT32(0u, fp.lock_calls);
+}
+
 /* ---- poll mode without a timer op: the application's polls find the deadline */
 
 static void test_poll_only_port(void)
@@ -1422,6 +1610,7 @@ int main(void)
     UNITY_BEGIN();
     RUN_TEST(test_init_rejections);
     RUN_TEST(test_reply_budget_and_wire_time);
+    RUN_TEST(test_configured_guard);
     RUN_TEST(test_normal_transaction);
     RUN_TEST(test_worked_lock_frame_through_bus);
     RUN_TEST(test_reply_in_many_chunks);
@@ -1444,6 +1633,8 @@ int main(void)
     RUN_TEST(test_retries_keep_each_reason);
     RUN_TEST(test_retries_exhausted);
     RUN_TEST(test_failed_counts_transactions);
+    RUN_TEST(test_estop_and_submit_while_waiting_to_retry);
+    RUN_TEST(test_broadcast_with_line_error_is_retried);
     RUN_TEST(test_line_error_marks_attempt);
     RUN_TEST(test_line_gone_is_offline_without_retry);
     RUN_TEST(test_submit_errors_send_nothing);
@@ -1466,10 +1657,13 @@ int main(void)
     RUN_TEST(test_noise_while_idle_is_not_echo);
     RUN_TEST(test_bytes_after_broadcast_in_same_poll);
     RUN_TEST(test_idle_splits_frames_in_order);
+    RUN_TEST(test_idle_already_consumed_is_not_taken_again);
     RUN_TEST(test_time_wraps_at_2_pow_32);
     RUN_TEST(test_several_buses_are_independent);
     RUN_TEST(test_transfer_blocking);
     RUN_TEST(test_transfer_blocking_edge_cases);
+    RUN_TEST(test_transfer_blocking_gone_between_attempts);
+    RUN_TEST(test_advance_in_isr_without_lock_ops);
     RUN_TEST(test_poll_only_port);
     return UNITY_END();
 }

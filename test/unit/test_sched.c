@@ -31,12 +31,16 @@ static void on_event(void *user, const j288_event_t *ev)
     nev++;
 }
 
+static bool estop_on_sweep; /* on_sweep makes an emergency stop */
+
 static void on_sweep(void *user, uint32_t sweep, uint32_t now_us)
 {
     (void)user;
-    (void)now_us;
     sweep_calls++;
     last_sweep_no = sweep;
+    if (estop_on_sweep) {
+        TEST_ASSERT_EQUAL_INT(J288_OK, j288_sched_estop(&sch, now_us));
+    }
 }
 
 static j288_reply_raw_t reply_for(uint8_t id)
@@ -65,6 +69,7 @@ static void setup_all(bool isr, bool continuous, uint8_t offline_after)
     nev = 0;
     sweep_calls = 0u;
     last_sweep_no = 0u;
+    estop_on_sweep = false;
     fake_port_init(&fp);
     TEST_ASSERT_EQUAL_INT(J288_OK, j288_bus_init(&bus, &fp.ops, &fp, &bc));
     fake_port_attach(&fp, &bus);
@@ -169,6 +174,9 @@ static void test_init_and_set_cmd_checks(void)
     c = foc(3u, 5);
     c.kp = -1;
     TEST_ASSERT_EQUAL_INT(J288_ERR_NEG_GAIN, j288_sched_set_cmd(&sch, &c));
+    c = foc(3u, 5);
+    c.kd = -1;
+    TEST_ASSERT_EQUAL_INT(J288_ERR_NEG_GAIN, j288_sched_set_cmd(&sch, &c));
     TEST_ASSERT_EQUAL_INT32(0, j288_sched_slot(&sch, 3u)->cmd.pos); /* unchanged */
     c = foc(3u, 5);
     TEST_ASSERT_EQUAL_INT(J288_OK, j288_sched_set_cmd(&sch, &c));
@@ -177,6 +185,9 @@ static void test_init_and_set_cmd_checks(void)
     TEST_ASSERT_EQUAL_INT(J288_ERR_NULL, j288_sched_clear_watchdog(NULL, 1u));
     TEST_ASSERT_EQUAL_INT(J288_ERR_NULL, j288_sched_start_sweep(NULL, 0u));
     TEST_ASSERT_EQUAL_INT(J288_ERR_NULL, j288_sched_estop(NULL, 0u));
+    j288_sched_poll(NULL, 0u);
+    TEST_ASSERT_FALSE(j288_sched_busy(NULL));
+    TEST_ASSERT_EQUAL_UINT32(0u, j288_sched_sweeps(NULL));
     TEST_ASSERT_EQUAL_UINT32(0u, fp.nframes);
 }
 
@@ -510,6 +521,56 @@ static void test_estop_from_an_event_callback(void)
     TEST_ASSERT_EQUAL_INT(0, fp.lock_errors);
 }
 
+/* A continuous scheduler whose on_sweep makes an emergency stop does not start the next
+ * sweep: the stop is the last frame. */
+static void test_estop_from_on_sweep_ends_continuous_sweeps(void)
+{
+    static const uint8_t ids[3] = {0u, 1u, 2u};
+    j288_cmd_raw_t stop;
+    memset(&stop, 0, sizeof stop);
+    stop.id = 15u;
+    stop.watchdog = true;
+    setup_all(true, true, 0u);
+    add_servos(ids, 3u);
+    estop_on_sweep = true;
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_sched_start_sweep(&sch, 0u));
+    TEST_ASSERT_TRUE(fake_port_run_until_idle(&fp, 10000u * US));
+    TEST_ASSERT_FALSE(j288_sched_busy(&sch));
+    TEST_ASSERT_EQUAL_UINT32(1u, j288_sched_sweeps(&sch));
+    TEST_ASSERT_EQUAL_UINT32(1u, sweep_calls);
+    TEST_ASSERT_EQUAL_UINT32(4u, fp.nframes);
+    assert_frame_cmd(3u, &stop);
+    TEST_ASSERT_EQUAL_UINT32(1u, j288_bus_stats(&bus)->estops);
+    TEST_ASSERT_EQUAL_UINT32(3u, j288_bus_stats(&bus)->ok);
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_sched_slot(&sch, 0u)->last_result); /* not retried */
+}
+
+/* Interrupt-driven sweeps on a port without lock/unlock ops: thread-side calls simply run. */
+static void test_isr_sweeps_without_lock_ops(void)
+{
+    static const uint8_t ids[2] = {5u, 6u};
+    j288_bus_config_t bc;
+    j288_cmd_raw_t c = foc(5u, 55);
+    memset(&bc, 0, sizeof bc);
+    bc.advance_in_isr = true;
+    nev = 0;
+    fake_port_init(&fp);
+    fp.ops.lock = NULL;
+    fp.ops.unlock = NULL;
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_bus_init(&bus, &fp.ops, &fp, &bc));
+    fake_port_attach(&fp, &bus);
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_sched_init(&sch, &bus, NULL));
+    add_servos(ids, 2u);
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_sched_set_cmd(&sch, &c));
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_sched_clear_watchdog(&sch, 6u));
+    sweep_once();
+    TEST_ASSERT_EQUAL_UINT32(2u, fp.nframes);
+    assert_frame_cmd(0u, &c);
+    TEST_ASSERT_FALSE(frame_wd(1u));
+    TEST_ASSERT_EQUAL_UINT32(1u, j288_sched_slot(&sch, 6u)->stats.successes);
+    TEST_ASSERT_EQUAL_UINT32(0u, fp.lock_calls);
+}
+
 static void test_default_config_without_handlers(void)
 {
     static const uint8_t ids[2] = {3u, 4u};
@@ -563,6 +624,8 @@ int main(void)
     RUN_TEST(test_collision_in_slot_stats);
     RUN_TEST(test_estop_while_sweeping);
     RUN_TEST(test_estop_from_an_event_callback);
+    RUN_TEST(test_estop_from_on_sweep_ends_continuous_sweeps);
+    RUN_TEST(test_isr_sweeps_without_lock_ops);
     RUN_TEST(test_default_config_without_handlers);
     RUN_TEST(test_control_loop_ticks_in_poll_mode);
     return UNITY_END();

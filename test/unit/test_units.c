@@ -426,6 +426,9 @@ static void test_single_value_rejections(void)
         TEST_ASSERT_EQUAL_INT(J288_OK, j288_kp_to_raw((j288_real_t)-0.0, J288_SIDE_OUTPUT, &r));
         TEST_ASSERT_EQUAL_INT16(0, r);
     }
+    /* from_raw has no error path: an invalid side reads as the rotor side */
+    TEST_ASSERT_TRUE(j288_pos_from_raw(1000, (j288_side_t)7) ==
+                     j288_pos_from_raw(1000, J288_SIDE_ROTOR));
 }
 
 /* Exactly half an LSB past either end rounds away from zero, out of range (double builds:
