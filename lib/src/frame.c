@@ -112,6 +112,10 @@ uint32_t j288_cmd_crc_expected(const uint8_t in[J288_CMD_LEN], const j288_crc_t 
 
 uint32_t j288_frame_crc_field(const uint8_t *frame, size_t len)
 {
+    /* Public: a bad length must not read before the buffer. */
+    if ((frame == NULL) || ((len != J288_CMD_LEN) && (len != J288_REPLY_LEN))) {
+        return 0u;
+    }
     return j288_get_u32le(&frame[len - 4u]);
 }
 

@@ -454,6 +454,26 @@ static void test_decode_out_word(void)
     }
 }
 
+/* The CRC field accessor is public: a wrong length must read nothing (found in review: len 2
+ * read before the buffer). */
+static void test_crc_field_rejects_bad_lengths(void)
+{
+    uint8_t two[2] = {0xAAu, 0xBBu};
+    uint8_t frame[J288_REPLY_LEN];
+    size_t i;
+    for (i = 0; i < sizeof frame; i++) {
+        frame[i] = (uint8_t)(0x11u * (i + 1u));
+    }
+    TEST_ASSERT_EQUAL_HEX32(0u, j288_frame_crc_field(two, sizeof two));
+    TEST_ASSERT_EQUAL_HEX32(0u, j288_frame_crc_field(NULL, J288_CMD_LEN));
+    TEST_ASSERT_EQUAL_HEX32(0u, j288_frame_crc_field(frame, 0u));
+    TEST_ASSERT_EQUAL_HEX32(0u, j288_frame_crc_field(frame, J288_REPLY_LEN - 1u));
+    TEST_ASSERT_EQUAL_HEX32(0u, j288_frame_crc_field(frame, J288_REPLY_LEN + 1u));
+    TEST_ASSERT_EQUAL_HEX32(j288_get_u32le(&frame[16]), j288_frame_crc_field(frame, J288_CMD_LEN));
+    TEST_ASSERT_EQUAL_HEX32(j288_get_u32le(&frame[22]),
+                            j288_frame_crc_field(frame, J288_REPLY_LEN));
+}
+
 static void test_fault_and_warning_names(void)
 {
     unsigned bit;
@@ -536,6 +556,7 @@ int main(void)
     RUN_TEST(test_decode_bad_crc);
     RUN_TEST(test_decode_every_mode_byte);
     RUN_TEST(test_decode_out_word);
+    RUN_TEST(test_crc_field_rejects_bad_lengths);
     RUN_TEST(test_fault_and_warning_names);
     RUN_TEST(test_strerror_every_code);
     return UNITY_END();

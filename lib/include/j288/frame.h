@@ -130,7 +130,9 @@ void j288_reply_unpack(const uint8_t in[J288_REPLY_LEN], j288_reply_raw_t *reply
 void j288_cmd_unpack(const uint8_t in[J288_CMD_LEN], j288_cmd_raw_t *cmd);
 
 /* CRC of a frame as it should be (command: bytes 0-15; reply: bytes 2-21), and the CRC
- * field it carries. For tools that show both. */
+ * field it carries (its last four bytes). For tools that show both. j288_frame_crc_field()
+ * reads nothing and returns 0 unless frame is non-NULL and len is J288_CMD_LEN or
+ * J288_REPLY_LEN. */
 uint32_t j288_cmd_crc_expected(const uint8_t in[J288_CMD_LEN], const j288_crc_t *crc);
 uint32_t j288_reply_crc_expected(const uint8_t in[J288_REPLY_LEN], const j288_crc_t *crc);
 uint32_t j288_frame_crc_field(const uint8_t *frame, size_t len);
