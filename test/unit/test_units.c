@@ -448,6 +448,24 @@ static double find_exact_product(double target, double k)
 }
 #endif
 
+/* "Any negative gain is refused, however small": a mutant that only refused gains below
+ * -1e-300 survived review. Use the smallest negative value the real type holds. */
+static void test_smallest_negative_gain_refused(void)
+{
+    j288_real_t tiny = (j288_real_t)1;
+    j288_real_t half = tiny / (j288_real_t)2;
+    int16_t raw = 0x5A5A;
+    while (half > (j288_real_t)0) {
+        tiny = half;
+        half = tiny / (j288_real_t)2;
+    }
+    TEST_ASSERT_EQUAL_INT(J288_ERR_NEG_GAIN, j288_kp_to_raw(-tiny, J288_SIDE_ROTOR, &raw));
+    TEST_ASSERT_EQUAL_INT(J288_ERR_NEG_GAIN, j288_kd_to_raw(-tiny, J288_SIDE_OUTPUT, &raw));
+    TEST_ASSERT_EQUAL_INT(0x5A5A, raw);
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_kp_to_raw(-(j288_real_t)0, J288_SIDE_ROTOR, &raw));
+    TEST_ASSERT_EQUAL_INT(0, raw);
+}
+
 static void test_half_lsb_past_the_ends(void)
 {
 #if !J288_CONFIG_SI_FLOAT
@@ -731,6 +749,7 @@ int main(void)
     RUN_TEST(test_round_trip_si_half_lsb);
     RUN_TEST(test_gear_ratio_rules);
     RUN_TEST(test_single_value_rejections);
+    RUN_TEST(test_smallest_negative_gain_refused);
     RUN_TEST(test_half_lsb_past_the_ends);
     RUN_TEST(test_round_half_away);
     RUN_TEST(test_cmd_from_si_rejections);

@@ -105,6 +105,8 @@ int j288_speed_to_raw(j288_real_t rad_s, j288_side_t side, int16_t *raw);
 int j288_pos_to_raw(j288_real_t rad, j288_side_t side, int32_t *raw);
 int j288_kp_to_raw(j288_real_t nm_per_rad, j288_side_t side, int16_t *raw);
 int j288_kd_to_raw(j288_real_t nms_per_rad, j288_side_t side, int16_t *raw);
+/* *_from_raw cannot fail: a side other than J288_SIDE_OUTPUT or J288_SIDE_ROTOR is taken as
+ * the rotor side (the wire's own units). */
 j288_real_t j288_torque_from_raw(int32_t raw, j288_side_t side);
 j288_real_t j288_speed_from_raw(int32_t raw, j288_side_t side);
 j288_real_t j288_pos_from_raw(int32_t raw, j288_side_t side);
