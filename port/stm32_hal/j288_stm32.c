@@ -157,19 +157,20 @@ static HAL_TIM_ActiveChannel channel_active(uint32_t channel)
 }
 
 /* The timer counts at 1 MHz, free running (maybe 16 bits): the compare goes delay ticks
- * ahead of the counter, modulo its period, whatever clock now_us comes from. */
-static void op_arm_timeout(void *ctx, uint32_t deadline_us)
+ * ahead of the counter, modulo its period, whatever clock now_us comes from. A delay longer
+ * than the period is cut to one period; on_timer then sees that the deadline has not passed
+ * and sets the compare again for the rest. */
+static void timer_set(j288_stm32_t *p, uint32_t deadline_us)
 {
-    j288_stm32_t *p = ctx;
     TIM_HandleTypeDef *htim = p->cfg.htim;
     uint32_t it = channel_it(p->cfg.tim_channel);
-    int32_t delay = (int32_t)(deadline_us - op_now_us(p));
+    int32_t delay = (int32_t)(deadline_us - now_of(p));
     uint32_t arr = (uint32_t)__HAL_TIM_GET_AUTORELOAD(htim);
     uint32_t ticks = (delay < 1) ? 1u : (uint32_t)delay;
     uint32_t cmp;
 
     if ((arr != 0xFFFFFFFFu) && (ticks > arr)) {
-        ticks = arr; /* an early wake-up only re-arms: the bus checks the real deadline */
+        ticks = arr;
     }
     cmp = (uint32_t)__HAL_TIM_GET_COUNTER(htim) + ticks;
     if ((arr != 0xFFFFFFFFu) && (cmp > arr)) {
@@ -179,6 +180,15 @@ static void op_arm_timeout(void *ctx, uint32_t deadline_us)
     __HAL_TIM_SET_COMPARE(htim, p->cfg.tim_channel, cmp);
     __HAL_TIM_CLEAR_FLAG(htim, it); /* TIM_FLAG_CCn has the same bit as TIM_IT_CCn */
     __HAL_TIM_ENABLE_IT(htim, it);
+}
+
+/* The deadline is stored before the compare is written, so a compare interrupt taken in
+ * between re-arms for the new deadline, which the write below then repeats. */
+static void op_arm_timeout(void *ctx, uint32_t deadline_us)
+{
+    j288_stm32_t *p = ctx;
+    p->tim_deadline = deadline_us;
+    timer_set(p, deadline_us);
 }
 
 #if J288_STM32_HW_CRC
@@ -432,10 +442,18 @@ bool j288_stm32_on_timer(TIM_HandleTypeDef *htim)
             (htim->Channel != channel_active(p->cfg.tim_channel))) {
             continue;
         }
-        __HAL_TIM_DISABLE_IT(htim, channel_it(p->cfg.tim_channel)); /* one-shot */
         p->stats.timer_events++;
-        j288_bus_on_timer(&p->bus);
         mine = true;
+        /* The contract is "at or after the deadline": an early compare (a delay cut to the
+         * timer's period, or a timer running a little ahead of now_us) only re-arms, since
+         * the bus would take nothing from it and would not arm the timer again. */
+        if ((int32_t)(now_of(p) - p->tim_deadline) < 0) {
+            p->stats.timer_rearms++;
+            timer_set(p, p->tim_deadline);
+            continue;
+        }
+        __HAL_TIM_DISABLE_IT(htim, channel_it(p->cfg.tim_channel)); /* one-shot */
+        j288_bus_on_timer(&p->bus);
     }
     return mine;
 }

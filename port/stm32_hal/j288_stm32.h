@@ -156,7 +156,9 @@ typedef struct {
     uint32_t rx_bytes;     /* bytes handed to the bus */
     uint32_t line_errors;  /* error callbacks */
     uint32_t hal_failures; /* HAL calls that did not return HAL_OK */
-    uint32_t timer_events;
+    uint32_t timer_events; /* compare interrupts taken (timer_rearms included) */
+    uint32_t timer_rearms; /* of those, early ones (before the deadline): re-armed for the
+                              rest, the bus not called */
 } j288_stm32_stats_t;
 
 /* One bus on one UART. Caller-allocated (statically, usually); must not move while
@@ -167,6 +169,7 @@ typedef struct j288_stm32 {
     volatile uint16_t rx_pos;  /* bytes of the current reception already handed out */
     volatile uint8_t dir;      /* j288_dir_t last set */
     uint32_t lock_saved;
+    volatile uint32_t tim_deadline; /* last arm_timeout deadline (now_us clock) */
     j288_stm32_stats_t stats;
 } j288_stm32_t;
 

@@ -356,6 +356,43 @@ static void test_timer_on_16_bit_counter_wraps(void)
     TEST_ASSERT_TRUE(tim2_regs.CCR1 < 0x0200u); /* wrapped past 0xFFFF, not beyond ARR */
 }
 
+/* A 16-bit timer cannot hold a reply budget over 65.5 ms: the compare goes ARR ticks ahead,
+ * fires early, and the port must re-arm it for the rest instead of waking the bus (which
+ * would not re-arm it, and with advance_in_isr and no polling the transaction would never
+ * end). */
+static void test_16_bit_timer_long_budget_rearms_until_deadline(void)
+{
+    j288_bus_config_t bc;
+    uint32_t start, budget;
+    memset(&bc, 0, sizeof bc);
+    bc.advance_in_isr = true;
+    bc.margin_us = 100000u;
+    init_port1(&bc, true, false);
+    tim2_regs.ARR = 0xFFFFu;
+    tim2_regs.CNT = 0x1234u;
+    start = fake_now;
+    send_foc3();
+    budget = j288_bus_reply_budget_us(j288_stm32_bus(&port1));
+    TEST_ASSERT_TRUE(budget > 0xFFFFu);
+    TEST_ASSERT_EQUAL_HEX32(0x1233u, tim2_regs.CCR1); /* capped at a full period */
+
+    /* the capped compare fires after 65.5 ms: early, so re-armed for the remainder */
+    fake_now = start + 0xFFFFu;
+    tim2_regs.CNT = 0x1233u;
+    TEST_ASSERT_TRUE(fake_hal_tim_fire(&htim2, TIM_CHANNEL_1));
+    TEST_ASSERT_EQUAL_INT(0, done_count);
+    TEST_ASSERT_TRUE((tim2_regs.DIER & TIM_IT_CC1) != 0u);
+    TEST_ASSERT_EQUAL_HEX32((0x1233u + (start + budget - fake_now)) & 0xFFFFu, tim2_regs.CCR1);
+    TEST_ASSERT_EQUAL_UINT32(1u, j288_stm32_stats(&port1)->timer_rearms);
+
+    /* no polling at all: the re-armed compare alone ends the transaction */
+    fake_now += 1000000u;
+    TEST_ASSERT_TRUE(fake_hal_tim_fire(&htim2, TIM_CHANNEL_1));
+    TEST_ASSERT_EQUAL_INT(1, done_count);
+    TEST_ASSERT_EQUAL_INT(J288_ERR_TIMEOUT, last_txn.result);
+    TEST_ASSERT_EQUAL_UINT32(1u, j288_stm32_stats(&port1)->timer_rearms);
+}
+
 static void test_advance_in_isr_timeout_ends_in_timer_interrupt(void)
 {
     j288_bus_config_t bc;
@@ -549,6 +586,7 @@ int main(void)
     RUN_TEST(test_timeout_from_timer_channel);
     RUN_TEST(test_timer_on_16_bit_counter_wraps);
     RUN_TEST(test_advance_in_isr_timeout_ends_in_timer_interrupt);
+    RUN_TEST(test_16_bit_timer_long_budget_rearms_until_deadline);
     RUN_TEST(test_transmit_dma_failure_is_a_port_error);
     RUN_TEST(test_receive_arm_failure_is_reported);
     RUN_TEST(test_bytes_during_transmit_are_not_heard);
