@@ -316,7 +316,15 @@ static int parse_drive_opt(void *ctx, int key, const char *v)
         return cli_parse_real("--pos", v, &d->pos);
     case OPT_SPEED:
         d->have_speed = true;
-        return cli_parse_real("--speed", v, &d->speed);
+        if (cli_parse_real("--speed", v, &d->speed) != 0) {
+            return -1;
+        }
+        /* A ramp speed, not a velocity: the direction comes from --pos. */
+        if (d->speed <= 0.0) {
+            cli_error("--speed: %s is not above 0 (the ramp speed; --pos sets the direction)", v);
+            return -1;
+        }
+        return 0;
     case OPT_TAU:
         d->have_tau = true;
         return cli_parse_real("--tau", v, &d->tau);
@@ -410,16 +418,12 @@ static int plan_fields(const drive_args_t *d, drive_plan_t *p)
     }
     if (d->kind == DRIVE_MOVE) {
         double v = d->have_speed
-                       ? fabs(d->speed)
+                       ? d->speed
                        : (side == J288_SIDE_OUTPUT ? DEFAULT_MOVE_SPEED_OUTPUT
                                                    : DEFAULT_MOVE_SPEED_OUTPUT * J288_GEAR_RATIO);
         rc = j288_pos_to_raw((j288_real_t)d->pos, side, &p->target_pos);
         if (rc != J288_OK) {
             return si_error("--pos", d->pos, rc);
-        }
-        if (v <= 0.0) {
-            cli_error("--speed: must be above 0");
-            return -1;
         }
         rc = j288_speed_to_raw((j288_real_t)v, side, &p->ramp_speed_raw);
         if (rc != J288_OK) {

@@ -155,6 +155,7 @@ if [ $E2E_RC -eq 0 ]; then e2e_pass torque_runs; else e2e_fail torque_runs "rc $
 expect_true torque_frames grep -Eq 'id=3 status=1 wd=1 tau=444 speed=0 pos=[-0-9]+ kp=0 kd=0' "$MAIN_LOG"
 expect_bad torque_out_of_range 2 '--tau' "$J288" --port "$MAIN" torque --id 3 --tau 100
 expect_bad move_missing_pos 2 '--pos is required' "$J288" --port "$MAIN" move --id 3
+expect_bad move_negative_speed 2 '^j288 move: --speed: -1 is not above 0' "$J288" --port "$MAIN" move --id 3 --pos 0.5 --speed -1
 expect_bad move_negative_gain 2 '--kp: -1 is negative' "$J288" --port "$MAIN" move --id 3 --pos 0 --kp -1
 expect_bad hold_bad_rate 2 '--rate' "$J288" --port "$MAIN" hold --id 1 --rate 0
 expect_bad hold_absent_servo 1 'no reply from servo 7' "$J288" --port "$MAIN" hold --id 7 --duration 0.1

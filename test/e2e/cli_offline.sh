@@ -170,6 +170,10 @@ expect_bad encode_si_nan 2 "--tau: 'nan' is not a number" "$J288" encode --id 1 
 expect_bad encode_si_inf 2 "--pos: 'inf' is not a number" "$J288" encode --id 1 --pos inf
 expect_bad encode_si_overflow 2 "--pos: 1e999 is out of range" "$J288" encode --id 1 --pos 1e999
 expect_bad encode_field_twice 2 '--tau-raw: the field is already set' "$J288" encode --id 1 --tau 0.1 --tau-raw 3
+# A ramp speed must be above 0 (the sign is not a direction: --pos gives that); refused
+# before any device is needed.
+expect_bad move_speed_negative 2 '^j288 move: --speed: -1 is not above 0' env -u J288_PORT "$J288" move --id 1 --pos 0.5 --speed -1
+expect_bad move_speed_zero 2 '^j288 move: --speed: 0 is not above 0' env -u J288_PORT "$J288" move --id 1 --pos 0.5 --speed 0
 expect_bad no_command 2 'no command given' "$J288"
 expect_bad unknown_command 2 "unknown command 'frob'" "$J288" frob
 expect_bad global_unknown_option 2 "unknown option '--prot'" "$J288" --prot x scan
