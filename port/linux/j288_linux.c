@@ -153,10 +153,18 @@ static int take_exclusive(j288_linux_t *lp, const char *dev)
 
 /* ---- open: line settings ----------------------------------------------------------------- */
 
+bool j288_linux_baud_ok(uint32_t asked, uint32_t got)
+{
+    uint32_t diff = (got > asked) ? got - asked : asked - got;
+    /* 64-bit products: asked * 100 overflows 32 bits above 42.9 Mbaud. */
+    return asked != 0u && got != 0u &&
+           (uint64_t)diff * 100u <= (uint64_t)asked * J288_LINUX_BAUD_TOLERANCE_PCT;
+}
+
 static int set_raw_baud(j288_linux_t *lp, const char *dev, uint32_t baud)
 {
     struct termios2 t;
-    uint32_t got, diff;
+    uint32_t got;
     if (ioctl(lp->fd, TCGETS2, &t) != 0) {
         if (errno == ENOTTY || errno == EINVAL) {
             set_err(lp, "%s is not a serial device", dev);
@@ -185,8 +193,7 @@ static int set_raw_baud(j288_linux_t *lp, const char *dev, uint32_t baud)
         return J288_ERR_PORT;
     }
     got = (uint32_t)t.c_ospeed;
-    diff = (got > baud) ? got - baud : baud - got;
-    if (got == 0u || (uint64_t)diff * 100u > (uint64_t)baud * J288_LINUX_BAUD_TOLERANCE_PCT) {
+    if (!j288_linux_baud_ok(baud, got)) {
         set_err(lp, "%s: the adapter cannot do %lu baud (it reports %lu)", dev, (unsigned long)baud,
                 (unsigned long)got);
         return J288_ERR_BAD_CONFIG;

@@ -171,6 +171,12 @@ const char *j288_linux_error(const j288_linux_t *lp);
  * ending in '\n'; "" when there is nothing to say. Never NULL. */
 const char *j288_linux_notices(const j288_linux_t *lp);
 
+/* Whether a read-back rate `got` is close enough to the requested `asked`: got is not 0 and
+ * differs from asked by at most J288_LINUX_BAUD_TOLERANCE_PCT percent of asked (the boundary
+ * itself is accepted). False for asked 0. j288_linux_open() refuses a device for which this is
+ * false ("the adapter cannot do N baud"). Pure; callable from any thread. */
+bool j288_linux_baud_ok(uint32_t asked, uint32_t got);
+
 /* The baud rate the driver reports after open (0 when closed). */
 uint32_t j288_linux_baud(const j288_linux_t *lp);
 

@@ -182,6 +182,29 @@ static void test_open_missing_device(void)
     TEST_ASSERT_EQUAL_INT(J288_ERR_NULL, j288_linux_open(NULL, "/dev/null", 0, NULL));
 }
 
+/* The read-back check behind "the adapter cannot do N baud" (a pty takes any rate, so open()
+ * cannot be made to fail it here): 3 % of the requested rate, boundary included. */
+static void test_baud_read_back_tolerance(void)
+{
+    TEST_ASSERT_TRUE(j288_linux_baud_ok(6000000u, 6000000u));
+    TEST_ASSERT_TRUE(j288_linux_baud_ok(6000000u, 6180000u));  /* +3 % exactly */
+    TEST_ASSERT_FALSE(j288_linux_baud_ok(6000000u, 6180001u));
+    TEST_ASSERT_TRUE(j288_linux_baud_ok(6000000u, 5820000u));  /* -3 % exactly */
+    TEST_ASSERT_FALSE(j288_linux_baud_ok(6000000u, 5819999u));
+    TEST_ASSERT_FALSE(j288_linux_baud_ok(6000000u, 3000000u)); /* a 3 Mbaud adapter */
+    TEST_ASSERT_FALSE(j288_linux_baud_ok(6000000u, 0u));       /* driver reports nothing */
+    TEST_ASSERT_FALSE(j288_linux_baud_ok(0u, 0u));
+    TEST_ASSERT_FALSE(j288_linux_baud_ok(0u, 9600u));
+    TEST_ASSERT_TRUE(j288_linux_baud_ok(100u, 103u));
+    TEST_ASSERT_FALSE(j288_linux_baud_ok(100u, 104u));
+    TEST_ASSERT_FALSE(j288_linux_baud_ok(100u, 96u));
+    /* No 32-bit overflow near the top of the range. */
+    TEST_ASSERT_TRUE(j288_linux_baud_ok(4000000000u, 4120000000u));
+    TEST_ASSERT_FALSE(j288_linux_baud_ok(4000000000u, 4120000001u));
+    TEST_ASSERT_FALSE(j288_linux_baud_ok(4000000000u, 4294967295u));
+    TEST_ASSERT_FALSE(j288_linux_baud_ok(4294967295u, 1u));
+}
+
 static void test_open_not_a_tty(void)
 {
     TEST_ASSERT_EQUAL_INT(J288_ERR_BAD_CONFIG, j288_linux_open(&g_lp, "/dev/null", 0, NULL));
@@ -488,6 +511,7 @@ int main(void)
     UNITY_BEGIN();
     RUN_TEST(test_open_missing_device);
     RUN_TEST(test_open_not_a_tty);
+    RUN_TEST(test_baud_read_back_tolerance);
     RUN_TEST(test_open_pty_at_6mbps);
     RUN_TEST(test_transfer_blocking);
     RUN_TEST(test_scheduler_sweeps);
