@@ -1,7 +1,8 @@
-# `make demo` (the README's first command): builds everything, then runs scripts/demo.sh,
-# the j288 tool against j288-sim on a pseudo-terminal (results in $(BUILD)/demo/).
+# `make demo` (the README's first command): builds the tool and the simulator only (no
+# Unity, no download: a compiler and make suffice), then runs scripts/demo.sh, the j288 tool
+# against j288-sim on a pseudo-terminal (results in $(BUILD)/demo/).
 # Owner: cli.
 
 .PHONY: demo
-demo: all $(BIN)/j288 $(BIN)/j288-sim
+demo: $(BIN)/j288 $(BIN)/j288-sim
 	BUILD=$(BUILD) BIN=$(BIN) bash scripts/demo.sh
