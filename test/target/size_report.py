@@ -5,9 +5,12 @@ Usage: size_report.py VARIANT_DIR...   (each holds probe.map, probe.elf and obj/
 A variant dir is named <core>-<crc backend>. Flash = .text + .rodata + .data (its initial
 values), RAM = .data + .bss, taken per input object from the linker map of the probe linked
 with --gc-sections, i.e. only what a typical application really pulls in. Stack: from GCC's
--fcallgraph-info=su, the deepest path below each public function; an indirect call (port
-operation, CRC hook) counts as the deepest operation of the STM32 port; the application's own
-callbacks (completion, events) come on top.
+-fcallgraph-info=su, the deepest path below each public function; an indirect call in the
+library (port operation, CRC hook) counts as the deepest operation of the STM32 port or the
+scheduler's completion callback; the application's own callbacks (clock, completion, events)
+come on top. Recursion: the library has none. The one cycle in the static graph is the bus's
+step loop entered again from inside a port call, which returns at once (in_advance), so it
+counts with its own frame. Any other cycle is reported as an ERROR and make size fails.
 """
 import os
 import re
@@ -69,38 +72,103 @@ def parse_ci(root):
     return nodes, edges
 
 
-def stack_depths(nodes, edges):
-    memo = {}
-    ops = [n for n in nodes if re.search(r"j288_stm32\.c:op_", n)]
-    notes = set()
+# The bus's step loop: entered again from inside a port call (op_start_rx -> rx_arm ->
+# j288_bus_on_error -> advance_from_event -> advance), it returns at once (in_advance), so on a
+# path that is already inside it only its own frame counts.
+REENTRY_GUARD = re.compile(r"lib/src/bus\.c:advance(\.\w+)*$")
+# Indirect calls that go to the application (its clock, its event callback): on top, like the
+# completion callbacks.
+# What each indirect call site in the library calls, read from the source: port operations
+# by member name (op_<member> in the STM32 port), "sched_done" for the bus's completion
+# callback when the scheduler drives the bus, "app" for the application's own function
+# pointers (its clock, its event callback: on top, like the completion callbacks). A site not
+# listed here counts as every port operation and the scheduler's callback, with a note.
+INDIRECT_SITES = [
+    (r"bus\.c:arm_at", ["arm_timeout"]),
+    (r"bus\.c:finish", ["sched_done"]),
+    (r"bus\.c:port_lock", ["lock"]),
+    (r"bus\.c:port_unlock", ["unlock"]),
+    (r"bus\.c:start_attempt", ["set_dir", "start_tx", "start_rx", "now_us"]),
+    (r"bus\.c:advance_from_event", ["now_us"]),
+    (r"^j288_bus_on_tx_done", ["set_dir", "start_rx"]),
+    (r"^j288_bus_transfer_blocking", ["wait", "now_us", "lock", "unlock"]),
+    (r"^j288_crc32_run", ["crc32"]),
+    (r"sched\.c:(next_slot|sched_lock|sched_unlock)", ["lock", "unlock"]),
+    (r"sched\.c:emit", ["app"]),
+    (r"j288_stm32\.c:now_of", ["app"]),
+]
 
-    def depth(n, stack):
-        if n in memo:
-            return memo[n]
-        if n in stack:
-            notes.add("recursion through the port's callbacks cut at " + n.split(":")[-1])
-            return 0
-        own, kind = nodes.get(n, (0, "static"))
-        if kind != "static":
-            notes.add(n.split(":")[-1] + " has " + kind + " stack")
-        stack.add(n)
-        deepest = 0
+
+def stack_depths(nodes, edges):
+    """{public function: deepest stack}, notes, cycles.
+
+    Exact longest path, memoised per (function, inside the step loop already): that flag is
+    the only thing a depth depends on when the call graph has no cycle besides the guarded
+    re-entry. Any other cycle is recursion the library must not have: it is cut, reported in
+    `cycles`, and no depth computed below a cut is memoised (each caller gets its own, the
+    figures marked as lower bounds by the caller)."""
+    ops = {n.split(":op_")[1].split(".")[0]: n for n in nodes if re.search(r"j288_stm32\.c:op_", n)}
+    done_cbs = [n for n in nodes if re.search(r"sched\.c:sched_done(\.\w+)*$", n)]
+    memo = {}
+    notes = set()
+    cycles = set()
+
+    def indirect_targets(n):
+        for pat, members in INDIRECT_SITES:
+            if re.search(pat + r"(\.\w+)*$", n):
+                break
+        else:
+            notes.add("indirect call in %s not in INDIRECT_SITES: counted as any port operation" % n)
+            members = list(ops) + ["sched_done"]
+        for m in members:
+            if m == "app":
+                notes.add(n.split(":")[-1] + ": the application's function pointer, not counted")
+            elif m == "sched_done":
+                yield from done_cbs
+            elif m in ops:
+                yield ops[m]
+
+    def targets(n):
         for t in edges.get(n, ()):
             if t == "__indirect_call":
-                d = max([depth(o, stack) for o in ops] or [0])
+                yield from indirect_targets(n)
             else:
-                d = depth(t, stack)
+                yield t
+
+    def depth(n, guarded, path):
+        own, kind = nodes.get(n, (0, "static"))
+        if guarded and REENTRY_GUARD.search(n):
+            notes.add("bus.c:advance re-entered from a port call returns at once: counted as its own frame")
+            return own, True
+        if (n, guarded) in memo:
+            return memo[(n, guarded)], True
+        if n in path:
+            cyc = path[path.index(n):] + [n]
+            cycles.add(" -> ".join(c.split(":")[-1] for c in cyc))
+            if len(cycles) > 20:
+                raise SystemExit("size_report.py: ERROR: more than 20 call cycles; first: " + sorted(cycles)[0])
+            return 0, False
+        if kind != "static":
+            notes.add(n.split(":")[-1] + " has " + kind + " stack")
+        path.append(n)
+        inner = guarded or bool(REENTRY_GUARD.search(n))
+        deepest, clean = 0, True
+        for t in targets(n):
+            d, c = depth(t, inner, path)
             deepest = max(deepest, d)
-        stack.discard(n)
-        memo[n] = own + deepest
-        return memo[n]
+            clean = clean and c
+        path.pop()
+        if clean:
+            memo[(n, guarded)] = own + deepest
+        return own + deepest, clean
 
     result = {}
     for n in sorted(nodes):
         if ":" in n or not n.startswith("j288_"):
             continue  # static helpers carry a file: prefix
-        result[n] = depth(n, set())
-    return result, notes
+        d, clean = depth(n, False, [])
+        result[n] = d if clean else ">= %d (cycle)" % d
+    return result, notes, cycles
 
 
 def main(dirs):
@@ -137,10 +205,12 @@ def main(dirs):
     print()
     stacks = {}
     all_notes = set()
+    all_cycles = set()
     for d in dirs:
         nodes, edges = parse_ci(os.path.join(d, "obj"))
-        stacks[os.path.basename(d.rstrip("/"))], notes = stack_depths(nodes, edges)
+        stacks[os.path.basename(d.rstrip("/"))], notes, cycles = stack_depths(nodes, edges)
         all_notes |= notes
+        all_cycles |= cycles
     print("Stack per public call in bytes (deepest path; indirect calls = the deepest port operation;")
     print("the application's completion and event callbacks come on top):")
     print()
@@ -153,7 +223,15 @@ def main(dirs):
         print()
         for n in sorted(all_notes):
             print("note: " + n)
+    if all_cycles:
+        print()
+        for c in sorted(all_cycles):
+            msg = "ERROR: recursion in the call graph (stack unbounded, figures above are lower bounds): " + c
+            print(msg)
+            print("size_report.py: " + msg, file=sys.stderr)
+        return 1
+    return 0
 
 
 if __name__ == "__main__":
-    main(sys.argv[1:])
+    sys.exit(main(sys.argv[1:]))
