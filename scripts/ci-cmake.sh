@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # The CMake side of CI, from the repository root:
-#   1. configure + build the library and the host unit tests, run them with ctest;
+#   1. configure + build the library, the host programs and every host test, check that ctest
+#      registers exactly the tests `make test` runs (same names, `make test-list`), run ctest;
 #   2. install to a temporary prefix and build/run a consumer with find_package(j288);
 #   3. build/run the same consumer embedding j288 with add_subdirectory;
 #   4. cross-configure and build the library with cmake/arm-none-eabi.cmake (Cortex-M0 soft
@@ -32,8 +33,23 @@ elif [ -f "${BUILD:-build}/unity/unity.c" ]; then
 fi
 
 echo "== cmake: host build and ctest"
-cmake -S . -B "$root/host" -DCMAKE_BUILD_TYPE=RelWithDebInfo "${unity_args[@]}" >/dev/null
+# RelWithDebInfo without -DNDEBUG: the Makefile's -O2 -g.
+cmake -S . -B "$root/host" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_C_FLAGS_RELWITHDEBINFO="-O2 -g" \
+    "${unity_args[@]}" >/dev/null
 cmake --build "$root/host" -j "$jobs"
+
+# The two builds must run the same tests: compare the names, not just the counts.
+make -s --no-print-directory BUILD="$root/make-list" test-list | sort >"$root/tests-make.txt"
+(cd "$root/host" && ctest -N) | sed -n 's/^ *Test *#[0-9]*: //p' | sort >"$root/tests-ctest.txt"
+n_make=$(wc -l <"$root/tests-make.txt")
+n_ctest=$(wc -l <"$root/tests-ctest.txt")
+if [ "$n_make" -eq 0 ] || ! cmp -s "$root/tests-make.txt" "$root/tests-ctest.txt"; then
+    echo "ci-cmake: ctest registers $n_ctest tests, make test runs $n_make; they differ" \
+         "(< only in make test-list, > only in ctest):" >&2
+    diff "$root/tests-make.txt" "$root/tests-ctest.txt" >&2 || true
+    exit 1
+fi
+echo "ci-cmake: ctest and make test run the same $n_ctest tests"
 (cd "$root/host" && ctest --output-on-failure -j "$jobs")
 
 echo "== cmake: install + find_package consumer"
