@@ -142,15 +142,17 @@ def stack_depths(nodes, edges):
             return own, True
         if (n, guarded) in memo:
             return memo[(n, guarded)], True
-        if n in path:
-            cyc = path[path.index(n):] + [n]
+        # A call state is (function, inside the step loop): the flag only turns on along a
+        # path, so a function met again with the other flag is not a cycle.
+        if (n, guarded) in path:
+            cyc = [m for m, _ in path[path.index((n, guarded)):]] + [n]
             cycles.add(" -> ".join(c.split(":")[-1] for c in cyc))
             if len(cycles) > 20:
                 raise SystemExit("size_report.py: ERROR: more than 20 call cycles; first: " + sorted(cycles)[0])
             return 0, False
         if kind != "static":
             notes.add(n.split(":")[-1] + " has " + kind + " stack")
-        path.append(n)
+        path.append((n, guarded))
         inner = guarded or bool(REENTRY_GUARD.search(n))
         deepest, clean = 0, True
         for t in targets(n):
