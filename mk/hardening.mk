@@ -5,7 +5,7 @@
 #   make fuzz-ci         the same, 60 s each (what .ci/run calls)
 #   make fuzz-corpus     regenerate the committed seed corpora from test/vectors
 #   make test-asan       the whole host test suite built with ASan+UBSan (no recovery)
-#   make test-valgrind   the host test binaries under valgrind memcheck
+#   make test-valgrind   the host test binaries, and the e2e scripts' j288 / j288-sim, under memcheck
 #   make lint            cppcheck (+ MISRA C:2012 addon) and clang-tidy over lib/, vs baseline
 #   make check-symbols   lib/ references no allocator, stdio or process-exit symbol
 #   make test-be         unit tests built for s390x (big-endian) and run under qemu-s390x
@@ -111,11 +111,31 @@ test-asan: $(UNITY)/unity.c
 HARD_VALGRIND := valgrind -q --error-exitcode=1 --leak-check=full --show-leak-kinds=all \
                  --errors-for-leak-kinds=definite,indirect,possible --track-origins=yes
 
+# The test binaries under $(HARD_VALGRIND), then the e2e scripts (TEST_SCRIPTS) with j288 and
+# j288-sim run under memcheck through test/e2e/valgrind-wrap.sh (symlinks in $(HARD_VG_E2E)/bin;
+# reports in $(HARD_VG_E2E)/logs: any line but valgrind's notice about the tty ioctls it does
+# not know (TIOCEXCL/TIOCNXCL) fails the run, the simulator's reports included). The golden
+# vector checks there take every 20th vector (all of them run in `make test`).
 # (Fragments included after this one add to HOST_TESTS: the list is taken at run time.)
+HARD_VG_E2E = $(BUILD)/valgrind-e2e
 test-valgrind:
 	@$(call HARD_REQUIRE,valgrind,valgrind); \
 	 $(MAKE) --no-print-directory $(HOST_TESTS) $(TEST_DEPS) && \
-	 TEST_WRAPPER="$(HARD_VALGRIND)" BUILD=$(BUILD) BIN=$(BIN) bash scripts/run-tests.sh $(HOST_TESTS)
+	 TEST_WRAPPER="$(HARD_VALGRIND)" BUILD=$(BUILD) BIN=$(BIN) bash scripts/run-tests.sh $(HOST_TESTS); \
+	 rc=$$?; \
+	 rm -rf $(HARD_VG_E2E) && mkdir -p $(HARD_VG_E2E)/bin $(HARD_VG_E2E)/logs && \
+	 ln -s $(abspath test/e2e/valgrind-wrap.sh) $(HARD_VG_E2E)/bin/j288 && \
+	 ln -s $(abspath test/e2e/valgrind-wrap.sh) $(HARD_VG_E2E)/bin/j288-sim && \
+	 echo "test-valgrind: e2e scripts with j288 and j288-sim under memcheck" && \
+	 J288=$(abspath $(HARD_VG_E2E))/bin/j288 J288_SIM=$(abspath $(HARD_VG_E2E))/bin/j288-sim \
+	 J288_VALGRIND=$$(command -v valgrind) J288_VALGRIND_BIN=$(abspath $(BIN)) \
+	 J288_VALGRIND_LOGS=$(abspath $(HARD_VG_E2E))/logs J288_E2E_VECTOR_STRIDE=20 \
+	   BUILD=$(BUILD) BIN=$(BIN) bash scripts/run-tests.sh $(TEST_SCRIPTS) || rc=1; \
+	 bad=$$(grep -lEv 'unhandled ioctl 0x|could cause spurious value errors|README_MISSING_SYSCALL_OR_IOCTL' \
+	        $(HARD_VG_E2E)/logs/* 2>/dev/null | sort); \
+	 if [ -n "$$bad" ]; then head -n 40 $$bad; echo "test-valgrind: memcheck errors in: $$bad"; rc=1; fi; \
+	 echo "test-valgrind: $$(ls $(HARD_VG_E2E)/logs | wc -l) program runs checked by memcheck in the e2e scripts"; \
+	 exit $$rc
 
 # ---------------------------------------------------------------------------------------------
 # Static analysis and the symbol check

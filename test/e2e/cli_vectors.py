@@ -19,16 +19,24 @@ import sys
 
 
 def run(binary, args):
-    p = subprocess.run([binary] + args, capture_output=True, text=True, timeout=10)
+    p = subprocess.run([binary] + args, capture_output=True, text=True, timeout=60)
     return p.returncode, p.stdout, p.stderr
 
 
+# J288_E2E_VECTOR_STRIDE=N checks every N-th vector of each file only (make test-valgrind:
+# each run of the tool under memcheck costs a fraction of a second).
+STRIDE = max(1, int(os.environ.get("J288_E2E_VECTOR_STRIDE", "1")))
+
+
 def vectors(path):
+    n = 0
     with open(path) as f:
         for line in f:
             line = line.strip()
             if line and not line.startswith("#"):
-                yield line.split()
+                if n % STRIDE == 0:
+                    yield line.split()
+                n += 1
 
 
 class Checker:
@@ -147,7 +155,8 @@ def main():
         path = os.path.join(vdir, fname)
         if os.path.exists(path):
             counts[fname] = fn(c, path)
-    if counts.get("commands.txt", 0) < 300 or counts.get("replies.txt", 0) < 300:
+    least = 300 // STRIDE
+    if counts.get("commands.txt", 0) < least or counts.get("replies.txt", 0) < least:
         c.fail("vectors", f"too few vectors found: {counts}")
     for f in c.failures[:40]:
         print("FAIL", f)
