@@ -14,6 +14,7 @@
 set -u
 cd "$(dirname "$0")/../.."
 . test/e2e/lib_e2e.sh
+e2e_need_python
 SIM=${J288_SIM:-$BIN/j288-sim}
 SIM_PIDS=()
 BG_PIDS=()

@@ -6,6 +6,7 @@
 set -u
 cd "$(dirname "$0")/../.."
 . test/e2e/lib_e2e.sh
+e2e_need_python
 trap e2e_cleanup_tmp EXIT
 
 if [ ! -x "$J288" ]; then
