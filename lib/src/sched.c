@@ -254,6 +254,9 @@ static void sched_done(void *user, const j288_txn_t *txn)
     slot->last_result = txn->result;
     if (txn->result == J288_OK) {
         take_reply(s, slot, txn);
+        if (s->cfg.on_reply != NULL) {
+            s->cfg.on_reply(s->cfg.user, txn->id, slot);
+        }
     } else {
         take_failure(s, slot, txn->id, txn->result);
     }

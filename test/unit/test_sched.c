@@ -608,6 +608,50 @@ static void test_control_loop_ticks_in_poll_mode(void)
     TEST_ASSERT_EQUAL_UINT32(9000u + 2u * TXN_US, fake_port_frame(&fp, 29u)->start_us);
 }
 
+/* ---- the per-reply hook */
+
+static uint32_t nreply_calls;
+static int events_at_reply; /* nev when the hook ran */
+
+/* Replaces servo 2's next command with a lock, as the joint layer does on a mismatch. */
+static void on_reply_lock_two(void *user, uint8_t id, const j288_slot_t *slot)
+{
+    TEST_ASSERT_EQUAL_PTR(&sch, user);
+    TEST_ASSERT_TRUE(slot->has_reply);
+    TEST_ASSERT_EQUAL_UINT8(id, slot->reply.id);
+    TEST_ASSERT_EQUAL_PTR(j288_sched_slot(&sch, id), slot);
+    nreply_calls++;
+    events_at_reply = nev;
+    if (id == 2u) {
+        j288_cmd_raw_t lock;
+        memset(&lock, 0, sizeof lock);
+        lock.id = 2u;
+        TEST_ASSERT_EQUAL_INT(J288_OK, j288_sched_set_cmd(&sch, &lock));
+    }
+}
+
+static void test_reply_hook_sees_every_good_reply_and_may_change_the_next_command(void)
+{
+    static const uint8_t ids[2] = {2u, 3u};
+    j288_cmd_raw_t c2 = foc(2u, 777);
+    j288_cmd_raw_t lock2;
+    memset(&lock2, 0, sizeof lock2);
+    lock2.id = 2u;
+    setup_all(false, false, 0u);
+    sch.cfg.on_reply = on_reply_lock_two;
+    nreply_calls = 0u;
+    add_servos(ids, 2u);
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_sched_set_cmd(&sch, &c2));
+    sweep_once();
+    TEST_ASSERT_EQUAL_UINT32(2u, nreply_calls);
+    TEST_ASSERT_EQUAL_INT(2, events_at_reply); /* after servo 3's ONLINE event */
+    assert_frame_cmd(0u, &c2);
+    fp.servo[3].present = false; /* a failure is not a reply */
+    sweep_once();
+    TEST_ASSERT_EQUAL_UINT32(3u, nreply_calls);
+    assert_frame_cmd(2u, &lock2); /* the hook's command went out next time */
+}
+
 int main(void)
 {
     UNITY_BEGIN();
@@ -628,5 +672,6 @@ int main(void)
     RUN_TEST(test_isr_sweeps_without_lock_ops);
     RUN_TEST(test_default_config_without_handlers);
     RUN_TEST(test_control_loop_ticks_in_poll_mode);
+    RUN_TEST(test_reply_hook_sees_every_good_reply_and_may_change_the_next_command);
     return UNITY_END();
 }

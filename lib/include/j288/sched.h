@@ -84,6 +84,12 @@ typedef struct {
 
 typedef void (*j288_event_fn)(void *user, const j288_event_t *ev);
 typedef void (*j288_sweep_fn)(void *user, uint32_t sweep, uint32_t now_us);
+/* Every good reply, once it is stored in slot id (slot->reply, reply_us, statistics) and its
+ * events have been reported, before the scheduler submits anything else. Layers above the
+ * scheduler (the joint layer) turn the reply into their state here, and may replace the
+ * slot's next command with j288_sched_set_cmd() (e.g. a safe lock when the reply says the
+ * angle can no longer be trusted). */
+typedef void (*j288_reply_fn)(void *user, uint8_t id, const j288_slot_t *slot);
 
 /* All-zero means defaults. */
 typedef struct {
@@ -91,6 +97,7 @@ typedef struct {
     bool continuous;        /* start the next sweep as soon as one ends */
     j288_event_fn on_event; /* may be NULL; called from the advancing context */
     j288_sweep_fn on_sweep; /* may be NULL; called when a sweep ends */
+    j288_reply_fn on_reply; /* may be NULL; called for every good reply (see above) */
     void *user;
 } j288_sched_config_t;
 
