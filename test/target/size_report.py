@@ -95,6 +95,7 @@ INDIRECT_SITES = [
     (r"^j288_crc32_run", ["crc32"]),
     (r"sched\.c:(next_slot|sched_lock|sched_unlock)", ["lock", "unlock"]),
     (r"sched\.c:emit", ["app"]),
+    (r"sched\.c:sched_done", ["app"]),  # on_reply
     (r"j288_stm32\.c:now_of", ["app"]),
 ]
 
