@@ -1,6 +1,9 @@
-# j288 - plain-Make host build. `make` builds the library, tools and tests into build/;
-# `make test` runs every host test; `make demo` runs the CLI against the built-in simulator.
-# Areas add their own rules in mk/*.mk (included below); this file holds what they share.
+# j288 - the build and the test suite (GNU Make; CMake in CMakeLists.txt serves consumers).
+#   make            library, tools and host tests into build/
+#   make test       every host test          make demo      the CLI against the simulator
+#   make install    PREFIX=/usr/local, DESTDIR honoured
+#   make help       the other targets
+# This file holds what every area shares; mk/*.mk add an area each, mk/cpu/*.mk a CPU each.
 
 BUILD ?= build
 CC ?= cc
@@ -20,36 +23,54 @@ LDFLAGS_COMMON := $(EXTRA_LDFLAGS)
 BIN := $(BUILD)/bin
 OBJ := $(BUILD)/obj
 
+# "tool X is needed": $(call REQUIRE,tool,packages) at the start of a recipe line skips the
+# rest of the line (status 0) with a notice when the tool is missing, fails with CI=true.
+NEED := bash scripts/need.sh
+REQUIRE = $(NEED) $(1) $(2) || { [ $$? -eq 1 ] && exit 0; exit 1; }
+
+# ---- the library -----------------------------------------------------------------------------
 LIB_SRC := $(sort $(wildcard lib/src/*.c))
 LIB_OBJ := $(LIB_SRC:%.c=$(OBJ)/%.o)
 LIB_A := $(BUILD)/lib/libj288.a
 LIB_HDR := $(wildcard lib/include/j288/*.h)
 
+# What the fragments build and use (named here so that any fragment can depend on them).
+LINUX_A := $(BUILD)/lib/libj288_linux.a
+J288_BIN := $(BIN)/j288
+SIM_BIN := $(BIN)/j288-sim
+
+# ---- the test suite --------------------------------------------------------------------------
 # Unity (fetched, never committed; see scripts/fetch-unity.sh).
 UNITY := $(BUILD)/unity
 UNITY_OBJ := $(OBJ)/unity/unity.o
-UNITY_CFLAGS := -std=c99 -O1 -g -I$(UNITY) -DUNITY_INCLUDE_DOUBLE -DUNITY_SUPPORT_64 $(EXTRA_CFLAGS)
+UNITY_DEFS := -DUNITY_INCLUDE_DOUBLE -DUNITY_SUPPORT_64
+UNITY_CFLAGS := -std=c99 -O1 -g -I$(UNITY) $(UNITY_DEFS) $(EXTRA_CFLAGS)
 
 # Shared test helpers, linked into every host unit test.
 TEST_SUPPORT_SRC := $(sort $(wildcard test/support/*.c))
 TEST_SUPPORT_OBJ := $(TEST_SUPPORT_SRC:%.c=$(OBJ)/%.o)
-TEST_CPPFLAGS := $(CPPFLAGS_LIB) -I$(UNITY) -Itest/support -Itest/vectors -DUNITY_INCLUDE_DOUBLE -DUNITY_SUPPORT_64
+TEST_CPPFLAGS := $(CPPFLAGS_LIB) -I$(UNITY) -Itest/support -Itest/vectors $(UNITY_DEFS)
+TEST_HDR := $(LIB_HDR) $(wildcard test/support/*.h test/vectors/*.h)
 
 # test/unit/test_*.c -> build/test/test_*: each a plain main() with RUN_TEST lines.
 UNIT_TEST_SRC := $(sort $(wildcard test/unit/test_*.c))
 UNIT_TESTS := $(UNIT_TEST_SRC:test/unit/%.c=$(BUILD)/test/%)
 
-# Fragments append: HOST_TESTS (binaries run by `make test`), TEST_SCRIPTS (shell tests run
-# after them, from the repo root, with BUILD and BIN in the environment), ALL_TARGETS.
+# Fragments append: HOST_TESTS (binaries `make test` runs), TEST_SCRIPTS (shell tests run
+# after them from the repository root, with BUILD, BIN and CC in the environment), TEST_DEPS
+# (what the scripts need), ALL_TARGETS (what `make` builds).
 HOST_TESTS := $(UNIT_TESTS)
 TEST_SCRIPTS :=
+TEST_DEPS :=
 ALL_TARGETS := $(LIB_A) $(UNIT_TESTS)
 
-.PHONY: all lib test unit-tests unity clean help
+.PHONY: all lib test unit-tests unity clean help install
 .DEFAULT_GOAL := all
 .SECONDARY:
 
-include $(sort $(wildcard mk/*.mk))
+# Each fragment may use what the ones before it define.
+include $(sort $(wildcard mk/cpu/*.mk))
+include mk/tools.mk mk/tests.mk mk/target.mk mk/bench.mk mk/hardening.mk
 
 all: $(ALL_TARGETS)
 
@@ -73,7 +94,7 @@ $(UNITY_OBJ): $(UNITY)/unity.c
 	@mkdir -p $(@D)
 	$(CC) $(UNITY_CFLAGS) -c $< -o $@
 
-$(OBJ)/test/%.o: test/%.c $(LIB_HDR) $(UNITY)/unity.c $(wildcard test/support/*.h test/vectors/*.h)
+$(OBJ)/test/%.o: test/%.c $(TEST_HDR) $(UNITY)/unity.c
 	@mkdir -p $(@D)
 	$(CC) $(TEST_CPPFLAGS) $(CFLAGS_COMMON) -c $< -o $@
 
@@ -81,18 +102,46 @@ $(BUILD)/test/%: $(OBJ)/test/unit/%.o $(TEST_SUPPORT_OBJ) $(UNITY_OBJ) $(LIB_A)
 	@mkdir -p $(@D)
 	$(CC) $(CFLAGS_COMMON) $^ -o $@ $(LDFLAGS_COMMON) -lm
 
+# $(call RUN_TESTS,tests...): the runner, with what the test scripts expect to find.
+TEST_ENV = BUILD=$(BUILD) BIN=$(BIN) CC="$(CC)" J288_CFLAGS="$(CFLAGS_COMMON)" \
+    J288_LDFLAGS="$(LDFLAGS_COMMON)"
+RUN_TESTS = $(TEST_ENV) bash scripts/run-tests.sh $(1)
+
 unit-tests: $(UNIT_TESTS)
-	BUILD=$(BUILD) bash scripts/run-tests.sh $(UNIT_TESTS)
+	$(call RUN_TESTS,$(UNIT_TESTS))
 
 test: $(HOST_TESTS) $(TEST_DEPS)
-	BUILD=$(BUILD) BIN=$(BIN) bash scripts/run-tests.sh $(HOST_TESTS) $(TEST_SCRIPTS)
+	$(call RUN_TESTS,$(HOST_TESTS) $(TEST_SCRIPTS))
+
+# ---- install ---------------------------------------------------------------------------------
+# The static library, the public headers, the CMake package config (the same files
+# `cmake --install` writes, from cmake/*.in) and the two tools.
+PREFIX ?= /usr/local
+BINDIR ?= $(PREFIX)/bin
+LIBDIR ?= $(PREFIX)/lib
+INCLUDEDIR ?= $(PREFIX)/include
+J288_VERSION := $(shell sed -n 's/.*J288_VERSION_STRING "\(.*\)"/\1/p' lib/include/j288/j288.h)
+
+install: $(LIB_A) $(J288_BIN) $(SIM_BIN)
+	install -d $(DESTDIR)$(LIBDIR) $(DESTDIR)$(INCLUDEDIR)/j288 $(DESTDIR)$(BINDIR)
+	install -m 644 $(LIB_A) $(DESTDIR)$(LIBDIR)/
+	install -m 644 $(LIB_HDR) $(DESTDIR)$(INCLUDEDIR)/j288/
+	install -m 755 $(J288_BIN) $(SIM_BIN) $(DESTDIR)$(BINDIR)/
+	bash scripts/cmake-config.sh $(DESTDIR)$(LIBDIR)/cmake/j288 $(J288_VERSION) \
+	    $(patsubst $(PREFIX)/%,%,$(LIBDIR)) $(patsubst $(PREFIX)/%,%,$(INCLUDEDIR))
+	@# (a pkg-config file and a shared library, once the build makes them, install here)
 
 clean:
 	rm -rf $(BUILD)
 
 help:
-	@echo "make            build library, tools and host tests into $(BUILD)/"
-	@echo "make test       run every host test (fetches Unity on first use)"
-	@echo "make demo       the CLI against the built-in servo simulator"
-	@echo "make arm        cross-build lib/ for Cortex-M0 and Cortex-M4F, size table"
-	@echo "see mk/*.mk for the other targets"
+	@echo "make                build library, tools and host tests into $(BUILD)/"
+	@echo "make test           every host test (fetches Unity on first use)"
+	@echo "make demo           the CLI against the built-in servo simulator"
+	@echo "make install        library, headers, CMake package, j288, j288-sim (PREFIX, DESTDIR)"
+	@echo "make arm            lib/ for each Cortex-M, size table, STM32 example, port template"
+	@echo "make test-target    unit tests on each CPU under QEMU ($(CPUS))"
+	@echo "make size           flash, RAM and stack per module on Cortex-M0 and M4F"
+	@echo "make bench          bus timing model and instruction counts (bench-* for one)"
+	@echo "make test-asan test-valgrind test-be test-32 coverage lint check-symbols"
+	@echo "make fuzz soak      (hardening: docs/security.md)"

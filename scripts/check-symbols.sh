@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# check-symbols.sh ARCHIVE [NM]: lib/ must reference no allocator, stdio, process-exit or
-# other OS symbol. Fails, naming the object and symbol, on:
+# usage: scripts/check-symbols.sh ARCHIVE [NM]
+# lib/ must reference no allocator, stdio, process-exit or other OS symbol. Fails, naming the
+# object and symbol, on:
 #  - any undefined symbol on the deny list (malloc family, printf family, stdio, abort/exit,
 #    assert's helper, time and signal functions), and
 #  - any undefined symbol outside the allow list: the archive's own j288_* functions and the

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# usage: scripts/ci-install.sh
 # Install every Debian package CI needs (idempotent: only what is missing is installed).
 # One list; each area adds its packages here with a comment saying which target needs them.
 set -euo pipefail
@@ -7,7 +8,8 @@ packages=(
     # build and host tests (Makefile, make test, make test CC=clang-14, make demo)
     make gcc clang-14 coreutils
     gnuplot-nox                     # make demo / cli_bus.sh plot test (PNG); CI treats it as required
-    cmake                           # scripts/ci-cmake.sh
+    cmake                           # scripts/check-consumers.sh
+    gcc-arm-none-eabi libnewlib-arm-none-eabi  # make arm, test-target, size, check-symbols
     qemu-system-arm                 # make test-target, bench-target, bench-bus-target (Cortex-M)
     # hardening (mk/hardening.mk)
     clang-14 libclang-rt-14-dev     # make fuzz / fuzz-ci (libFuzzer, ASan, UBSan)
@@ -18,7 +20,7 @@ packages=(
     gcc-arm-linux-gnueabihf libc6-dev-armhf-cross    # make test-32 (gcc-multilib conflicts
                                                      # with the s390x cross gcc in Debian 12)
     qemu-user                       # make test-be / test-32 (qemu-s390x, qemu-arm)
-    binutils gcc-arm-none-eabi libnewlib-arm-none-eabi  # make check-symbols (nm, M0 archive)
+    binutils                        # make check-symbols (nm)
     python3                         # make fuzz-corpus, golden vectors
 )
 

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# usage: [BUILD=build] [BIN=$BUILD/bin] scripts/demo.sh
 # `make demo`: the j288 tool against the built-in servo simulator, no hardware needed.
 # Starts j288-sim with servos 1, 2, 3 on a pseudo-terminal, scans the bus, moves the three
 # servos through a 2-second swing at 1 kHz while logging (achieved loop rate, tracking error

@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Put Unity (unity.c, unity.h, unity_internals.h) into $1 (default build/unity).
+# usage: [UNITY_DIR=DIR] scripts/fetch-unity.sh [DEST]
+# Put Unity (unity.c, unity.h, unity_internals.h) into DEST (default build/unity).
 # Order of preference: UNITY_DIR (a Unity checkout or its src/ folder the user points at),
 # a copy already fetched, then the unmodified Unity that Debian's cjson source package
 # carries under tests/unity/ (fetched with a private apt configuration: no root, /etc/apt

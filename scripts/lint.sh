@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# make lint: static analysis of lib/.
+# usage: [BUILD=build] scripts/lint.sh [--update]
+# `make lint`: static analysis of lib/.
 #  1. cppcheck --std=c99 with the MISRA C:2012 addon (+ warning/style/performance/portability).
 #     Rules the library deliberately departs from everywhere are suppressed here with the
 #     reason in docs/misra.md. Every other finding is counted per (file, check id), with no
@@ -7,7 +8,7 @@
 #     baseline scripts/lint/cppcheck-baseline.txt: a count above its baseline (or a new key)
 #     fails. Counts below it print a reminder to ratchet the baseline down (--update).
 #  2. clang-tidy with the repository's .clang-tidy; any warning fails.
-# Usage: scripts/lint.sh [--update]   (--update rewrites the baseline from the current tree)
+# --update rewrites the baseline from the current tree.
 set -uo pipefail
 cd "$(dirname "$0")/.."
 build=${BUILD:-build}
@@ -16,14 +17,9 @@ update=${1:-}
 out=$build/lint
 mkdir -p "$out/cppcheck-cache"
 
-need() { # tool package
-    command -v "$1" >/dev/null 2>&1 && return 0
-    if [ "${CI:-}" = true ]; then echo "lint: $1 missing (CI=true); install $2" >&2; exit 2; fi
-    echo "notice: lint skipped, $1 not found; install with: apt-get install -y --no-install-recommends $2" >&2
-    exit 0
-}
-need cppcheck cppcheck
-need clang-tidy clang-tidy
+for tool in cppcheck clang-tidy; do
+    bash scripts/need.sh $tool $tool || exit $(($? == 1 ? 0 : 1))
+done
 
 # Deviations kept library-wide (docs/misra.md says why): advisory rules only.
 deviations=(misra-c2012-2.4 misra-c2012-2.5 misra-c2012-8.7 misra-c2012-15.5)

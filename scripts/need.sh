@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
-# hard-need.sh TOOL PACKAGE...: succeed when TOOL is on PATH. Otherwise, with CI=true fail;
-# outside CI print a one-line notice naming the Debian packages to install and fail with
-# status 1 so that the caller can skip its step (`hard-need.sh x pkg || exit 0`).
+# usage: scripts/need.sh TOOL PACKAGE...
+# "TOOL is needed": succeed when TOOL is on PATH. Otherwise, with CI=true, an error naming the
+# Debian packages (exit 2); outside CI a one-line notice saying what to install (exit 1), so
+# that the caller skips its step. In make: $(call REQUIRE,tool,packages) (Makefile); in a
+# script: bash scripts/need.sh tool packages || exit $(( $? == 1 ? 0 : 1 ))
 tool=$1; shift
 command -v "$tool" >/dev/null 2>&1 && exit 0
 if [ "${CI:-}" = true ]; then

@@ -1,17 +1,14 @@
 #!/usr/bin/env bash
-# Run Cortex-M test images under qemu-system-arm with semihosting.
-# Arguments: one "core:machine:cpu:elf" per test image. Prints each image's Unity summary and
-# ends with "N passed, N failed"; the exit status says whether all passed.
+# usage: scripts/run-target.sh CPU:QEMU:MACHINE:MODEL:ELF...
+# `make test-target`: run each test image under its QEMU system emulator (e.g.
+# m0:qemu-system-arm:microbit:cortex-m0:build/target/m0/test_bus.elf) with semihosting. Prints
+# each image's Unity summary and ends with "N passed, N failed"; the exit status says whether
+# all passed.
 set -u
-if ! command -v qemu-system-arm >/dev/null 2>&1; then
-    echo "test-target: qemu-system-arm not found. Install the Debian package qemu-system-arm:" >&2
-    echo "    sudo apt-get install --no-install-recommends qemu-system-arm" >&2
-    exit 1
-fi
 per_test_timeout=${TARGET_TIMEOUT:-120}
 passed=0 failed=0 failed_names=()
 for spec in "$@"; do
-    IFS=: read -r core machine cpu elf <<<"$spec"
+    IFS=: read -r core qemu machine cpu elf <<<"$spec"
     # An image too big for its board's RAM names the machine it was linked for instead.
     [ -f "$elf.qemu" ] && IFS=: read -r machine cpu <"$elf.qemu"
     name="$core/$(basename "$elf" .elf)"
@@ -22,7 +19,7 @@ for spec in "$@"; do
         continue
     fi
     log=$(mktemp)
-    timeout -k 5 "$per_test_timeout" qemu-system-arm -M "$machine" -cpu "$cpu" -nographic \
+    timeout -k 5 "$per_test_timeout" "$qemu" -M "$machine" -cpu "$cpu" -nographic \
         -monitor none -serial none -semihosting-config enable=on,target=native \
         -kernel "$elf" >"$log" 2>&1
     rc=$?

@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Bus timing model and instructions per transaction; run by `make bench-bus`.
+# usage: BIN=... BUILD=... test/bench/bus_bench.sh
+# `make bench-bus`: the bus timing model, and instructions per transaction (callgrind).
 set -euo pipefail
 bin=${BIN:-build/bin}/bus_timing
 turn=${ENGINE_BENCH_TURNAROUND:-0 10 20 50}
@@ -15,11 +16,7 @@ echo
 "$bin" --turnaround "10" --rx-latency 1667
 
 echo
-if ! command -v valgrind >/dev/null 2>&1; then
-    if [ "${CI:-}" = true ]; then echo "bench-bus: valgrind not found (CI=true: failure)" >&2; exit 1; fi
-    echo "bench-bus: skipping instruction counts; install with: apt-get install -y --no-install-recommends valgrind"
-    exit 0
-fi
+bash scripts/need.sh valgrind valgrind || exit $(($? == 1 ? 0 : 1)) # the instruction counts
 # Collected only inside the library's entry points (fake_port_deliver: the port's events;
 # bench_poll/bench_start: the application's calls). Two run lengths, the difference divided by
 # the difference in transactions, so set-up costs cancel.

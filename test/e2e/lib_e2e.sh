@@ -86,7 +86,7 @@ e2e_summary() {
 # e2e_need_python: the JSON and golden-vector checks use python3. Without it: outside CI the
 # whole script is skipped with a one-line notice (what to install), with CI=true it fails.
 e2e_need_python() {
-    bash scripts/hard-need.sh python3 python3 && return 0
+    bash scripts/need.sh python3 python3 && return 0
     [ $? -eq 1 ] && { echo "0 Tests 0 Failures 1 Ignored"; exit 0; }
     exit 1
 }

@@ -1,11 +1,12 @@
 #!/usr/bin/env bash
+# usage: [BUILD=build] [PYTHON=python3] tools/vectors/check-drift.sh
 # The committed golden vectors (test/vectors/) must equal what the generator produces now:
 # regenerate into $BUILD/vectors-fresh and compare file by file. Run from the repository root.
 set -euo pipefail
 build=${BUILD:-build}
 python=${PYTHON:-python3}
 # python3 is not on every fresh machine: outside CI skip with a notice, in CI fail.
-bash scripts/hard-need.sh "$python" python3 || { [ $? -eq 1 ] && { echo "0 Tests 0 Failures 1 Ignored"; exit 0; }; exit 1; }
+bash scripts/need.sh "$python" python3 || { [ $? -eq 1 ] && { echo "0 Tests 0 Failures 1 Ignored"; exit 0; }; exit 1; }
 fresh="$build/vectors-fresh"
 rm -rf "$fresh"
 mkdir -p "$fresh"

@@ -1,0 +1,85 @@
+# Benchmarks: figures for docs/performance.md, printed, never enforced.
+#   make bench              bench-bus and bench-bus-target
+#   make bench-bus          sweep time for 1, 4 and 15 servos against the wire time on the fake
+#                           port's virtual clock (servo turnaround ENGINE_BENCH_TURNAROUND us);
+#                           with valgrind, host instructions per transaction (callgrind)
+#   make bench-codec        host instructions per call of the codec's hot paths (callgrind)
+#   make bench-linux        round trip and sweep rate over the simulator's pty (wall clock)
+#   make bench-target       instructions per codec transaction on Cortex-M4F (QEMU -icount)
+#   make bench-bus-target   instructions per engine transaction on Cortex-M0 and M4F (QEMU)
+.PHONY: bench bench-bus bench-codec bench-linux bench-target bench-bus-target
+bench: bench-bus bench-bus-target
+
+# ---- host ------------------------------------------------------------------------------------
+ENGINE_BENCH := $(BIN)/bus_timing
+ENGINE_BENCH_TURNAROUND ?= 0 10 20 50
+# -fno-inline keeps the benchmark's entry points visible to callgrind; lib/ stays as built.
+$(ENGINE_BENCH): test/bench/bus_timing.c test/support/fake_port.c test/support/fake_port.h $(LIB_A)
+	@mkdir -p $(@D)
+	$(CC) $(CPPFLAGS_LIB) -Itest/support $(CSTD) $(WARN) -O2 -g -fno-inline $(EXTRA_CFLAGS) \
+	    test/bench/bus_timing.c test/support/fake_port.c $(LIB_A) -o $@ $(LDFLAGS_COMMON)
+
+bench-bus: $(ENGINE_BENCH)
+	BIN=$(BIN) BUILD=$(BUILD) ENGINE_BENCH_TURNAROUND="$(ENGINE_BENCH_TURNAROUND)" \
+	    bash test/bench/bus_bench.sh
+
+CODEC_BENCH := $(BUILD)/bench/codec_bench
+CODEC_BENCH_N ?= 20000
+$(CODEC_BENCH): test/bench/codec_bench.c $(LIB_A) $(LIB_HDR)
+	@mkdir -p $(@D)
+	$(CC) $(CPPFLAGS_LIB) $(CFLAGS_COMMON) $< $(LIB_A) -o $@ $(LDFLAGS_COMMON) -lm
+
+bench-codec: $(CODEC_BENCH)
+	@$(call REQUIRE,valgrind,valgrind); \
+	 bash scripts/bench-codec.sh $(CODEC_BENCH) $(CODEC_BENCH_N) "$(CC), $(OPT)"
+
+LINUX_BENCH := $(BUILD)/bench/bench_linux_port
+$(LINUX_BENCH): $(OBJ)/test/linux/bench_linux_port.o $(LINUX_A) $(LIB_A)
+	@mkdir -p $(@D)
+	$(CC) $(CFLAGS_COMMON) $^ -o $@ $(LDFLAGS_COMMON) -lm
+
+bench-linux: $(LINUX_BENCH) $(SIM_BIN)
+	$(LINUX_BENCH) $(SIM_BIN) 5000
+
+ALL_TARGETS += $(ENGINE_BENCH) $(LINUX_BENCH)
+
+# ---- Cortex-M under QEMU -icount shift=0 (one instruction per ns) ----------------------------
+# $(call QEMU_BENCH,cpu,elf): run elf on the CPU's standard machine, instruction-counted.
+QEMU_BENCH = timeout 120 $(call QEMU_CMD,$(1),$(CPU_$(1)_QEMU)) -icount shift=0 -kernel $(2)
+BENCH_OPTS := O2 Os
+
+# $(call BENCH_IMAGE,name,cpu,sources,flags,opt): $(BUILD)/bench-target/name_opt.elf for cpu.
+define BENCH_IMAGE
+$(eval $(call TGT_OBJ_RULE,bench-target/$(1)_$(5),$(2),-$(5) -g $(CPPFLAGS_LIB) $(4)))
+$(BUILD)/bench-target/$(1)_$(5).elf: $(3:%.c=$(BUILD)/bench-target/$(1)_$(5)/obj/%.o) \
+    test/target/sections.ld test/target/$(CPU_$(2)_LD)
+	$(call TC,$(2),CC) $(call TGT_LINK_FLAGS,$(2),SEMIHOST,$(CPU_$(2)_LD)) $$(filter %.o,$$^) -o $$@ -lm
+endef
+
+# The codec per CRC backend on Cortex-M4F, the STM32 port's CRC unit path included.
+BENCH_CODEC_SRC := $(LIB_SRC) port/stm32_hal/j288_stm32.c test/stm32/stub/stm32_hal_stub.c \
+    test/target/bench.c test/target/startup.c
+$(foreach o,$(BENCH_OPTS),$(eval $(call BENCH_IMAGE,codec_m4f,m4f,$(BENCH_CODEC_SRC),\
+    -Iport/stm32_hal -Itest/stm32/stub -DJ288_STUB_OMIT_CRC,$(o))))
+
+bench-target:
+	@$(call REQUIRE_TC,m4f,QEMU); \
+	 $(MAKE) --no-print-directory $(BENCH_OPTS:%=$(BUILD)/bench-target/codec_m4f_%.elf) && \
+	 for o in $(BENCH_OPTS); do \
+	    echo "Cortex-M4F ($(CPU_m4f_QEMU), QEMU -icount shift=0), -$$o:"; \
+	    $(call QEMU_BENCH,m4f,$(BUILD)/bench-target/codec_m4f_$$o.elf) || exit 1; echo; \
+	 done
+
+# The bus engine and the scheduler, port operations empty.
+BENCH_BUS_CPUS := m0 m4f
+$(foreach c,$(BENCH_BUS_CPUS),$(foreach o,$(BENCH_OPTS),$(eval $(call BENCH_IMAGE,bus_$(c),$(c),\
+    test/bench/bus_target.c test/target/startup.c $(LIB_SRC),,$(o)))))
+
+bench-bus-target:
+	@$(call REQUIRE_TC,$(BENCH_BUS_CPUS),QEMU); \
+	 $(MAKE) --no-print-directory $(foreach c,$(BENCH_BUS_CPUS),$(BENCH_OPTS:%=$(BUILD)/bench-target/bus_$(c)_%.elf)) \
+	     >/dev/null && \
+	 $(foreach c,$(BENCH_BUS_CPUS),for o in $(BENCH_OPTS); do \
+	    echo "Cortex-$(c) -$$o ($(CPU_$(c)_QEMU), QEMU -icount shift=0), instructions per transaction:"; \
+	    $(call QEMU_BENCH,$(c),$(BUILD)/bench-target/bus_$(c)_$$o.elf) || exit 1; \
+	 done;)

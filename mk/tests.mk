@@ -1,0 +1,105 @@
+# The host test suite besides test/unit/ (whose test_*.c the Makefile picks up by itself).
+# Every binary here lands in HOST_TESTS and every script in TEST_SCRIPTS: `make test` runs
+# them all, and the sanitizer and valgrind runs (mk/hardening.mk) run the same lists.
+#   test/cli/          the j288 tool's helpers, linked with the helper objects (not main())
+#   test/sim/          the simulator's servo model
+#   test/linux/        the Linux port over a real pty served by j288-sim
+#   test/stm32/        the STM32 port against a fake HAL, with the real engine
+#   crc-<backend>/     the codec tests again with each compile-time CRC backend
+#   test/fuzz/         every fuzz target replaying its committed corpus
+#   scripts            test/e2e/*.sh (the tools end to end), the golden vectors' drift check
+
+# ---- the j288 tool's helpers -----------------------------------------------------------------
+CLI_TEST := $(BUILD)/test/test_cli_helpers
+$(OBJ)/test/cli/%.o: test/cli/%.c $(J288_HDR) $(TEST_HDR) $(UNITY)/unity.c
+	@mkdir -p $(@D)
+	$(CC) $(TEST_CPPFLAGS) -Itools/j288 $(TOOL_CPPFLAGS) $(CFLAGS_COMMON) -c $< -o $@
+
+$(CLI_TEST): $(OBJ)/test/cli/test_cli_helpers.o \
+    $(addprefix $(OBJ)/tools/j288/,args.o hexparse.o json.o frameview.o report.o) $(UNITY_OBJ) $(LIB_A)
+	@mkdir -p $(@D)
+	$(CC) $(CFLAGS_COMMON) $^ -o $@ $(LDFLAGS_COMMON) -lm
+
+# ---- the codec tests with each CRC backend (J288_CONFIG_CRC_BACKEND) -------------------------
+# nibble, bitwise, and HW through J288_CONFIG_CRC_HW_FUNCTION (a stand-in in test/support).
+# Each is a sub-build in $(BUILD)/crc-<backend>, one sub-make building all its binaries.
+CODEC_CRC_VARIANTS := nibble bitwise hw
+CODEC_CRC_FLAGS_nibble := -DJ288_CONFIG_CRC_BACKEND=J288_CRC_BACKEND_NIBBLE
+CODEC_CRC_FLAGS_bitwise := -DJ288_CONFIG_CRC_BACKEND=J288_CRC_BACKEND_BITWISE
+CODEC_CRC_FLAGS_hw := -DJ288_CONFIG_CRC_BACKEND=J288_CRC_BACKEND_HW \
+                      -DJ288_CONFIG_CRC_HW_FUNCTION=codec_hw_crc_stub
+CODEC_CRC_TEST_NAMES := test_crc32 test_frame test_parser
+.PHONY: codec-force
+codec-force:
+$(CODEC_CRC_TEST_NAMES:%=$(BUILD)/crc-\%/test/%): $(UNITY)/unity.c codec-force
+	@$(MAKE) --no-print-directory BUILD=$(BUILD)/crc-$* UNITY_DIR=$(abspath $(UNITY)) CC=$(CC) \
+	    EXTRA_CFLAGS='$(EXTRA_CFLAGS) $(CODEC_CRC_FLAGS_$*)' $(CODEC_CRC_TEST_NAMES:%=$(BUILD)/crc-$*/test/%)
+
+# ---- fuzz targets replaying their corpus -----------------------------------------------------
+# Every test/fuzz/fuzz_<name>.c also builds with the normal compiler as a plain program that
+# runs test/fuzz/corpus/<name>, so that every host, sanitizer and cross run re-checks the
+# invariants on the seeds and on saved crash inputs. FUZZ_EXTRA_<name>: the target's extra
+# sources (the cli target links the tool's parsers as functions, not by exec).
+FUZZ_NAMES := $(sort $(patsubst test/fuzz/fuzz_%.c,%,$(wildcard test/fuzz/fuzz_*.c)))
+FUZZ_REPLAY_TESTS := $(FUZZ_NAMES:%=$(BUILD)/test/fuzz_replay_%)
+FUZZ_EXTRA_cli := tools/j288/hexparse.c tools/j288/args.c
+FUZZ_CPPFLAGS_cli := -Itools/j288 $(TOOL_CPPFLAGS)
+
+$(OBJ)/test/fuzz/replay_%.o: test/fuzz/replay_main.c test/fuzz/fuzz_common.h
+	@mkdir -p $(@D)
+	$(CC) -Itest/fuzz -DFUZZ_CORPUS_DIR='"test/fuzz/corpus/$*"' $(CFLAGS_COMMON) -c $< -o $@
+
+$(OBJ)/test/fuzz/fuzz_%.o: test/fuzz/fuzz_%.c $(TEST_HDR) $(wildcard test/fuzz/*.h)
+	@mkdir -p $(@D)
+	$(CC) $(CPPFLAGS_LIB) -Itest/fuzz -Itest/support $(FUZZ_CPPFLAGS_$*) $(CFLAGS_COMMON) -c $< -o $@
+
+$(BUILD)/test/fuzz_replay_%: $(OBJ)/test/fuzz/fuzz_%.o $(OBJ)/test/fuzz/replay_%.o $(LIB_A)
+	@mkdir -p $(@D)
+	$(CC) $(CFLAGS_COMMON) $^ -o $@ $(LDFLAGS_COMMON) -lm
+$(foreach n,$(FUZZ_NAMES),$(eval $(BUILD)/test/fuzz_replay_$(n): $(FUZZ_EXTRA_$(n):%.c=$(OBJ)/%.o)))
+
+# ---- the Linux port, the simulator's model, the STM32 port -----------------------------------
+LINUX_PORT_TEST := $(BUILD)/test/test_linux_port
+$(OBJ)/test/linux/%.o: test/linux/%.c port/linux/j288_linux.h $(TEST_HDR) $(UNITY)/unity.c
+	@mkdir -p $(@D)
+	$(CC) $(TEST_CPPFLAGS) -Iport/linux -DJ288_SIM_DEFAULT='"$(SIM_BIN)"' $(CFLAGS_COMMON) -c $< -o $@
+
+$(LINUX_PORT_TEST): $(OBJ)/test/linux/test_linux_port.o $(UNITY_OBJ) $(LINUX_A) $(LIB_A)
+	@mkdir -p $(@D)
+	$(CC) $(CFLAGS_COMMON) $^ -o $@ $(LDFLAGS_COMMON) -lm
+
+SIM_MODEL_TEST := $(BUILD)/test/test_sim_model
+$(OBJ)/test/sim/%.o: test/sim/%.c tools/j288-sim/servo_model.h $(TEST_HDR) $(UNITY)/unity.c
+	@mkdir -p $(@D)
+	$(CC) $(TEST_CPPFLAGS) -Itools/j288-sim $(CFLAGS_COMMON) -c $< -o $@
+
+$(SIM_MODEL_TEST): $(OBJ)/test/sim/test_sim_model.o $(SIM_MODEL_OBJ) $(UNITY_OBJ) $(LIB_A)
+	@mkdir -p $(@D)
+	$(CC) $(CFLAGS_COMMON) $^ -o $@ $(LDFLAGS_COMMON) -lm
+
+# Built with the D-cache maintenance on and a 32-byte receive buffer (a reply then crosses the
+# half-transfer point), so that both paths are exercised; the target tests use the same.
+STM32_TEST_DEFS := -DJ288_STM32_DCACHE=1 -DJ288_STM32_RX_BUF_SIZE=32u
+STM32_HDRS := $(wildcard port/stm32_hal/*.h test/stm32/*.h test/stm32/stub/*.h) $(TEST_HDR)
+STM32_TEST := $(BUILD)/test/test_stm32_port
+STM32_TEST_SRC := port/stm32_hal/j288_stm32.c test/stm32/fake_hal.c test/stm32/test_stm32_port.c
+$(OBJ)/stm32host/%.o: %.c $(STM32_HDRS) $(UNITY)/unity.c
+	@mkdir -p $(@D)
+	$(CC) $(TEST_CPPFLAGS) -Iport/stm32_hal -Itest/stm32/stub -Itest/stm32 $(STM32_TEST_DEFS) \
+	    $(CFLAGS_COMMON) -c $< -o $@
+
+$(STM32_TEST): $(STM32_TEST_SRC:%.c=$(OBJ)/stm32host/%.o) $(UNITY_OBJ) $(LIB_A)
+	@mkdir -p $(@D)
+	$(CC) $(CFLAGS_COMMON) $^ -o $@ $(LDFLAGS_COMMON) -lm
+
+# ---- the lists -------------------------------------------------------------------------------
+HOST_TESTS += $(CLI_TEST) $(foreach v,$(CODEC_CRC_VARIANTS),$(CODEC_CRC_TEST_NAMES:%=$(BUILD)/crc-$(v)/test/%)) \
+    $(FUZZ_REPLAY_TESTS) $(LINUX_PORT_TEST) $(SIM_MODEL_TEST) $(STM32_TEST)
+TEST_SCRIPTS += test/e2e/cli_offline.sh test/e2e/cli_bus.sh tools/vectors/check-drift.sh \
+    test/e2e/sim_cli.sh
+TEST_DEPS += $(J288_BIN) $(SIM_BIN)
+ALL_TARGETS += $(CLI_TEST) $(FUZZ_REPLAY_TESTS) $(LINUX_PORT_TEST) $(SIM_MODEL_TEST) $(STM32_TEST)
+
+.PHONY: vectors-check
+vectors-check:
+	$(call RUN_TESTS,tools/vectors/check-drift.sh)

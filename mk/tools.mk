@@ -1,0 +1,52 @@
+# The Linux port and the programs built on it:
+#   $(LINUX_A)     libj288_linux.a, port/linux (termios2): -Iport/linux, link it before $(LIB_A)
+#   $(J288_BIN)    tools/j288: offline frame calculator and bus commands over the Linux port
+#   $(SIM_BIN)     tools/j288-sim: simulated servos on a pseudo-terminal
+#   make demo      the README's first command: j288 against j288-sim (scripts/demo.sh)
+#   make vectors   regenerate the golden vectors from tools/vectors/gen_vectors.py
+.PHONY: linux cli sim demo vectors
+
+LINUX_CPPFLAGS := $(CPPFLAGS_LIB) -Iport/linux
+$(OBJ)/port/linux/%.o: port/linux/%.c port/linux/j288_linux.h $(LIB_HDR)
+	@mkdir -p $(@D)
+	$(CC) $(LINUX_CPPFLAGS) $(CFLAGS_COMMON) -c $< -o $@
+
+$(LINUX_A): $(OBJ)/port/linux/j288_linux.o
+	@mkdir -p $(@D)
+	rm -f $@
+	$(AR) rcs $@ $^
+
+# The tools are POSIX programs (signals, realpath, popen for gnuplot); lib/ stays pure C99.
+TOOL_CPPFLAGS := $(LINUX_CPPFLAGS) -D_XOPEN_SOURCE=700
+J288_SRC := $(sort $(wildcard tools/j288/*.c))
+J288_HDR := $(wildcard tools/j288/*.h)
+$(OBJ)/tools/j288/%.o: tools/j288/%.c $(J288_HDR) $(LIB_HDR) port/linux/j288_linux.h
+	@mkdir -p $(@D)
+	$(CC) $(TOOL_CPPFLAGS) $(CFLAGS_COMMON) -c $< -o $@
+
+$(J288_BIN): $(J288_SRC:%.c=$(OBJ)/%.o) $(LINUX_A) $(LIB_A)
+	@mkdir -p $(@D)
+	$(CC) $(CFLAGS_COMMON) $^ -o $@ $(LDFLAGS_COMMON) -lm
+
+# The simulator: servo_model.c (servos and bus, no I/O) and sim_main.c (the pty front end).
+SIM_MODEL_OBJ := $(OBJ)/tools/j288-sim/servo_model.o
+$(OBJ)/tools/j288-sim/%.o: tools/j288-sim/%.c tools/j288-sim/servo_model.h $(LIB_HDR)
+	@mkdir -p $(@D)
+	$(CC) $(CPPFLAGS_LIB) -Itools/j288-sim $(CFLAGS_COMMON) -c $< -o $@
+
+$(SIM_BIN): $(SIM_MODEL_OBJ) $(OBJ)/tools/j288-sim/sim_main.o $(LIB_A)
+	@mkdir -p $(@D)
+	$(CC) $(CFLAGS_COMMON) $^ -o $@ $(LDFLAGS_COMMON) -lm
+
+linux: $(LINUX_A)
+cli: $(J288_BIN)
+sim: $(SIM_BIN)
+ALL_TARGETS += $(LINUX_A) $(J288_BIN) $(SIM_BIN)
+
+# Builds only what it runs (no Unity, no download: a compiler and make suffice).
+demo: $(J288_BIN) $(SIM_BIN)
+	BUILD=$(BUILD) BIN=$(BIN) bash scripts/demo.sh
+
+# Commit the result together with the generator change; `make test` checks they agree.
+vectors:
+	$(PYTHON) tools/vectors/gen_vectors.py --out test/vectors

@@ -1,0 +1,50 @@
+#!/usr/bin/env bash
+# usage: scripts/check-consumers.sh   (from anywhere; build trees under $BUILD/consumers)
+# The ways a project takes j288, each built and run (test/cmake_consumer encodes the
+# protocol's worked frame): find_package(j288) after `cmake --install` and after
+# `make install DESTDIR=...` into temporary prefixes (the tools installed with them must run),
+# add_subdirectory, and the library cross-built with cmake/arm-none-eabi.cmake for Cortex-M4F
+# and Cortex-M0 (SI off). Needs cmake; the cross build needs arm-none-eabi-gcc.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+bash scripts/need.sh cmake cmake || exit $(($? == 1 ? 0 : 1))
+root=${BUILD:-build}/consumers
+rm -rf "$root" && mkdir -p "$root" && root=$(cd "$root" && pwd)
+jobs=$(nproc 2>/dev/null || echo 2)
+quiet() { "$@" >"$root/last.log" 2>&1 || { cat "$root/last.log" >&2; return 1; }; }
+
+# consumer NAME CMAKE_ARGS...: configure, build and run test/cmake_consumer.
+consumer() {
+    local name=$1; shift
+    quiet cmake -S test/cmake_consumer -B "$root/$name" "$@"
+    quiet cmake --build "$root/$name" -j "$jobs"
+    echo "$name: $("$root/$name/j288_consumer")"
+}
+# installed PREFIX: what an install must hold, then a find_package consumer against it.
+installed() {
+    local p=$1 f
+    for f in include/j288/j288.h lib/libj288.a lib/cmake/j288/j288Config.cmake bin/j288 bin/j288-sim; do
+        [ -f "$p/$f" ] || { echo "check-consumers: $p/$f not installed" >&2; exit 1; }
+    done
+    quiet "$p/bin/j288" --version
+    quiet "$p/bin/j288-sim" --help
+    consumer "find_package-$(basename "$p")" -DCMAKE_PREFIX_PATH="$p"
+}
+
+quiet cmake -S . -B "$root/host" -DCMAKE_BUILD_TYPE=RelWithDebInfo
+quiet cmake --build "$root/host" -j "$jobs"
+quiet cmake --install "$root/host" --prefix "$root/cmake-prefix"
+installed "$root/cmake-prefix"
+quiet make -j"$jobs" BUILD="${BUILD:-build}" PREFIX=/usr DESTDIR="$root/make-destdir" install
+installed "$root/make-destdir/usr"
+consumer add_subdirectory -DJ288_SOURCE_DIR="$PWD"
+
+bash scripts/need.sh arm-none-eabi-gcc gcc-arm-none-eabi || exit $(($? == 1 ? 0 : 1))
+for cpu in cortex-m4f cortex-m0; do
+    args=(-DCMAKE_TOOLCHAIN_FILE=cmake/arm-none-eabi.cmake -DCMAKE_BUILD_TYPE=MinSizeRel -DJ288_CPU=$cpu)
+    [ $cpu = cortex-m0 ] && args+=(-DJ288_CONFIG_SI=OFF)
+    quiet cmake -S . -B "$root/$cpu" "${args[@]}"
+    quiet cmake --build "$root/$cpu" -j "$jobs"
+    echo "$cpu: $(arm-none-eabi-size -t "$root/$cpu/lib/libj288.a" | tail -n 1)"
+done
+echo "check-consumers: ok"
