@@ -1,33 +1,58 @@
 #!/usr/bin/env bash
-# Run test binaries and test scripts given as arguments; each is bounded in time. Unity
+# usage: [TEST_JOBS=N] [TEST_TIMEOUT=S] [TEST_WRAPPER=CMD] scripts/run-tests.sh TEST...
+# Run test binaries and test scripts (*.sh), each bounded in time (TEST_TIMEOUT, 300 s), up to
+# TEST_JOBS at once (default: the number of processors), reporting in the order given. Unity
 # binaries report "N Tests N Failures N Ignored"; scripts report by exit status (and may print
-# their own Unity-style summary). Ends with one line "N passed, N failed".
+# their own Unity-style summary). TEST_WRAPPER runs each binary (valgrind, qemu-user). Ends
+# with one line "N passed, N failed".
 set -u
 per_test_timeout=${TEST_TIMEOUT:-300}
-passed=0 failed=0 failed_names=()
-for t in "$@"; do
-    name=${t#./}
-    log=$(mktemp)
-    if [[ "$t" == *.sh ]]; then
-        timeout -k 5 "$per_test_timeout" bash "$t" >"$log" 2>&1
+jobs=${TEST_JOBS:-$(nproc 2>/dev/null || echo 1)}
+tests=("$@")
+out=$(mktemp -d)
+trap 'rm -rf "$out"' EXIT
+
+run_one() { # index test: the log in $out/i.log, then the exit status in $out/i.rc
+    local rc
+    if [[ "$2" == *.sh ]]; then
+        timeout -k 5 "$per_test_timeout" bash "$2" >"$out/$1.log" 2>&1
     else
-        timeout -k 5 "$per_test_timeout" ${TEST_WRAPPER:-} "$t" >"$log" 2>&1
+        timeout -k 5 "$per_test_timeout" ${TEST_WRAPPER:-} "$2" >"$out/$1.log" 2>&1
     fi
     rc=$?
-    summary=$(grep -E '^[0-9]+ Tests [0-9]+ Failures [0-9]+ Ignored' "$log" | tail -n1)
-    if [ $rc -eq 0 ]; then
-        passed=$((passed + 1))
-        echo "PASS  $name  ${summary}"
-    else
-        failed=$((failed + 1))
-        failed_names+=("$name")
-        echo "FAIL  $name  (exit $rc) ${summary}"
-        grep -E ':FAIL|FAIL:|Error|error|Assert' "$log" | head -n 30 | sed 's/^/      /'
-        [ $rc -eq 124 ] && echo "      timed out after ${per_test_timeout}s"
-        tail -n 15 "$log" | sed 's/^/    | /'
-    fi
-    rm -f "$log"
+    echo $rc >"$out/$1.rc.tmp" && mv "$out/$1.rc.tmp" "$out/$1.rc"
+}
+
+passed=0 failed=0 failed_names=() next=0
+report_ready() { # every finished test from $next on, in order
+    local name rc summary log
+    while [ $next -lt ${#tests[@]} ] && [ -f "$out/$next.rc" ]; do
+        name=${tests[$next]#./} rc=$(cat "$out/$next.rc") log=$out/$next.log
+        summary=$(grep -E '^[0-9]+ Tests [0-9]+ Failures [0-9]+ Ignored' "$log" | tail -n1)
+        if [ "$rc" -eq 0 ]; then
+            passed=$((passed + 1))
+            echo "PASS  $name  ${summary}"
+        else
+            failed=$((failed + 1))
+            failed_names+=("$name")
+            echo "FAIL  $name  (exit $rc) ${summary}"
+            grep -E ':FAIL|FAIL:|Error|error|Assert' "$log" | head -n 30 | sed 's/^/      /'
+            [ "$rc" -eq 124 ] && echo "      timed out after ${per_test_timeout}s"
+            tail -n 15 "$log" | sed 's/^/    | /'
+        fi
+        next=$((next + 1))
+    done
+}
+
+for i in "${!tests[@]}"; do
+    while [ "$(jobs -rp | wc -l)" -ge "$jobs" ]; do
+        wait -n
+        report_ready
+    done
+    run_one "$i" "${tests[$i]}" &
 done
+wait
+report_ready
 echo
 [ $failed -gt 0 ] && echo "failed: ${failed_names[*]}"
 echo "$passed passed, $failed failed"
