@@ -1,5 +1,5 @@
 # j288 - the build and the test suite (GNU Make; CMake in CMakeLists.txt serves consumers).
-#   make            library, tools and host tests into build/
+#   make            library, tools, example and host tests into build/
 #   make test       every host test          make demo      the CLI against the simulator
 #   make install    PREFIX=/usr/local, DESTDIR honoured
 #   make help       the other targets
@@ -135,7 +135,7 @@ clean:
 	rm -rf $(BUILD)
 
 help:
-	@echo "make                build library, tools and host tests into $(BUILD)/"
+	@echo "make                build library, tools, example and host tests into $(BUILD)/"
 	@echo "make test           every host test (fetches Unity on first use)"
 	@echo "make demo           the CLI against the built-in servo simulator"
 	@echo "make install        library, headers, CMake package, j288, j288-sim (PREFIX, DESTDIR)"

@@ -7,7 +7,8 @@
 #   test/stm32/        the STM32 port against a fake HAL, with the real engine
 #   crc-<backend>/     the codec tests again with each compile-time CRC backend
 #   test/fuzz/         every fuzz target replaying its committed corpus
-#   scripts            test/e2e/*.sh (the tools end to end), the golden vectors' drift check
+#   scripts            test/e2e/*.sh (tools and example end to end), the golden vectors'
+#                      drift check
 
 # ---- the j288 tool's helpers -----------------------------------------------------------------
 CLI_TEST := $(BUILD)/test/test_cli_helpers
@@ -96,8 +97,8 @@ $(STM32_TEST): $(STM32_TEST_SRC:%.c=$(OBJ)/stm32host/%.o) $(UNITY_OBJ) $(LIB_A)
 HOST_TESTS += $(CLI_TEST) $(foreach v,$(CODEC_CRC_VARIANTS),$(CODEC_CRC_TEST_NAMES:%=$(BUILD)/crc-$(v)/test/%)) \
     $(FUZZ_REPLAY_TESTS) $(LINUX_PORT_TEST) $(SIM_MODEL_TEST) $(STM32_TEST)
 TEST_SCRIPTS += test/e2e/cli_offline.sh test/e2e/cli_bus.sh tools/vectors/check-drift.sh \
-    test/e2e/sim_cli.sh
-TEST_DEPS += $(J288_BIN) $(SIM_BIN)
+    test/e2e/sim_cli.sh test/e2e/example_linux.sh
+TEST_DEPS += $(J288_BIN) $(SIM_BIN) $(EXAMPLE_LINUX)
 ALL_TARGETS += $(CLI_TEST) $(FUZZ_REPLAY_TESTS) $(LINUX_PORT_TEST) $(SIM_MODEL_TEST) $(STM32_TEST)
 
 .PHONY: vectors-check

@@ -2,6 +2,7 @@
 #   $(LINUX_A)     libj288_linux.a, port/linux (termios2): -Iport/linux, link it before $(LIB_A)
 #   $(J288_BIN)    tools/j288: offline frame calculator and bus commands over the Linux port
 #   $(SIM_BIN)     tools/j288-sim: simulated servos on a pseudo-terminal
+#   $(BIN)/linux-status   examples/linux: the library's smallest Linux program
 #   make demo      the README's first command: j288 against j288-sim (scripts/demo.sh)
 #   make vectors   regenerate the golden vectors from tools/vectors/gen_vectors.py
 .PHONY: linux cli sim demo vectors
@@ -38,10 +39,19 @@ $(SIM_BIN): $(SIM_MODEL_OBJ) $(OBJ)/tools/j288-sim/sim_main.o $(LIB_A)
 	@mkdir -p $(@D)
 	$(CC) $(CFLAGS_COMMON) $^ -o $@ $(LDFLAGS_COMMON) -lm
 
+EXAMPLE_LINUX := $(BIN)/linux-status
+$(OBJ)/examples/linux/%.o: examples/linux/%.c port/linux/j288_linux.h $(LIB_HDR)
+	@mkdir -p $(@D)
+	$(CC) $(TOOL_CPPFLAGS) $(CFLAGS_COMMON) -c $< -o $@
+
+$(EXAMPLE_LINUX): $(OBJ)/examples/linux/main.o $(LINUX_A) $(LIB_A)
+	@mkdir -p $(@D)
+	$(CC) $(CFLAGS_COMMON) $^ -o $@ $(LDFLAGS_COMMON) -lm
+
 linux: $(LINUX_A)
 cli: $(J288_BIN)
 sim: $(SIM_BIN)
-ALL_TARGETS += $(LINUX_A) $(J288_BIN) $(SIM_BIN)
+ALL_TARGETS += $(LINUX_A) $(J288_BIN) $(SIM_BIN) $(EXAMPLE_LINUX)
 
 # Builds only what it runs (no Unity, no download: a compiler and make suffice).
 demo: $(J288_BIN) $(SIM_BIN)
