@@ -143,5 +143,5 @@ help:
 	@echo "make test-target    unit tests on each CPU under QEMU ($(CPUS))"
 	@echo "make size           flash, RAM and stack per module on Cortex-M0 and M4F"
 	@echo "make bench          bus timing model and instruction counts (bench-* for one)"
-	@echo "make test-asan test-valgrind test-be test-32 coverage lint check-symbols"
+	@echo "make test-asan test-valgrind test-be test-32 coverage lint check-symbols check-abi"
 	@echo "make fuzz soak      (hardening: docs/security.md)"

@@ -8,7 +8,7 @@
 #   crc-<backend>/     the codec tests again with each compile-time CRC backend
 #   test/fuzz/         every fuzz target replaying its committed corpus
 #   scripts            test/e2e/*.sh (tools and example end to end), the golden vectors'
-#                      drift check
+#                      drift check, test/abi/check-abi.sh (layout options must match to link)
 
 # ---- the j288 tool's helpers -----------------------------------------------------------------
 CLI_TEST := $(BUILD)/test/test_cli_helpers
@@ -97,10 +97,12 @@ $(STM32_TEST): $(STM32_TEST_SRC:%.c=$(OBJ)/stm32host/%.o) $(UNITY_OBJ) $(LIB_A)
 HOST_TESTS += $(CLI_TEST) $(foreach v,$(CODEC_CRC_VARIANTS),$(CODEC_CRC_TEST_NAMES:%=$(BUILD)/crc-$(v)/test/%)) \
     $(FUZZ_REPLAY_TESTS) $(LINUX_PORT_TEST) $(SIM_MODEL_TEST) $(STM32_TEST)
 TEST_SCRIPTS += test/e2e/cli_offline.sh test/e2e/cli_bus.sh tools/vectors/check-drift.sh \
-    test/e2e/sim_cli.sh test/e2e/example_linux.sh
-TEST_DEPS += $(J288_BIN) $(SIM_BIN) $(EXAMPLE_LINUX)
+    test/e2e/sim_cli.sh test/e2e/example_linux.sh test/abi/check-abi.sh
+TEST_DEPS += $(J288_BIN) $(SIM_BIN) $(EXAMPLE_LINUX) $(LIB_A)
 ALL_TARGETS += $(CLI_TEST) $(FUZZ_REPLAY_TESTS) $(LINUX_PORT_TEST) $(SIM_MODEL_TEST) $(STM32_TEST)
 
-.PHONY: vectors-check
+.PHONY: check-abi vectors-check
+check-abi: $(LIB_A)
+	$(call RUN_TESTS,test/abi/check-abi.sh)
 vectors-check:
 	$(call RUN_TESTS,tools/vectors/check-drift.sh)

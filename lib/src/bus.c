@@ -107,8 +107,8 @@ static void apply_defaults(j288_bus_config_t *c)
     }
 }
 
-int j288_bus_init(j288_bus_t *bus, const j288_port_t *port, void *port_ctx,
-                  const j288_bus_config_t *cfg)
+int (j288_bus_init)(j288_bus_t *bus, const j288_port_t *port, void *port_ctx,
+                    const j288_bus_config_t *cfg)
 {
     j288_bus_config_t c;
     int err;

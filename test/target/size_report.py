@@ -17,7 +17,7 @@ import re
 import sys
 from collections import defaultdict
 
-MODULES = ["frame", "crc32", "parser", "bus", "sched", "units", "strerror", "j288_stm32"]
+MODULES = ["frame", "crc32", "parser", "bus", "sched", "units", "strerror", "abi", "j288_stm32"]
 
 
 def parse_map(path):

@@ -190,6 +190,15 @@ typedef struct j288_bus {
 int j288_bus_init(j288_bus_t *bus, const j288_port_t *port, void *port_ctx,
                   const j288_bus_config_t *cfg);
 
+/* The library's build of the [layout] options (config.h). Calls to j288_bus_init() go
+ * through this macro, which reads the object named after the caller's values: a program and
+ * a library built with different values do not link. (j288_bus_init) or &j288_bus_init
+ * bypasses it; the function keeps its name. */
+extern const unsigned char J288_ABI_TAG;
+#define j288_bus_init(bus, port, port_ctx, cfg)                                                   \
+    ((void)*(const volatile unsigned char *)&J288_ABI_TAG,                                       \
+     j288_bus_init((bus), (port), (port_ctx), (cfg)))
+
 /* Start a transaction: encode cmd and transmit it. done may be NULL. Accepted while idle
  * (transmits at once) or during the guard after the previous transaction (transmits when
  * the guard ends; this is how a done callback submits the next one). Errors, nothing sent:

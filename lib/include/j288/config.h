@@ -5,6 +5,12 @@
  * J288_USER_CONFIG and provide "j288_user_config.h" on the include path. No option changes a
  * function's name or the set of arguments it takes; J288_CONFIG_SI_FLOAT selects the width of
  * j288_real_t and J288_CONFIG_SI removes the SI-unit API altogether.
+ *
+ * Options marked [layout] change the layout of a public struct: the library and every file
+ * that uses its headers must be built with the same values. They make up J288_ABI_TAG, the
+ * name of an object the library defines and j288_bus_init() refers to, so that a program
+ * built with other values does not link: the linker reports an undefined reference to
+ * j288_abi_r<ring size>_m<max retries>_f<SI float>, the program's values.
  */
 #ifndef J288_CONFIG_H
 #define J288_CONFIG_H
@@ -19,7 +25,7 @@
 #define J288_CONFIG_SI 1
 #endif
 
-/* j288_real_t is double by default: a double holds every int32 position exactly, so
+/* [layout] j288_real_t is double by default: a double holds every int32 position exactly, so
  * raw -> SI -> raw round trips are exact. Set 1 on a single-precision FPU (Cortex-M4F/M33)
  * to make it float; positions beyond about 2^24 LSB (3217 rad rotor, 11 rad output) then
  * round trip to within a few LSB instead of exactly. */
@@ -50,8 +56,8 @@
 #error "J288_CONFIG_CRC_BACKEND must be one of the J288_CRC_BACKEND_* values"
 #endif
 
-/* Receive ring inside each bus object (bytes). Must be a power of two, at least 32: it holds
- * one reply (26 bytes) plus the echo of a command when the transceiver hears itself. */
+/* [layout] Receive ring inside each bus object (bytes): a power of two from 32 to 4096. It
+ * holds one reply (26 bytes) plus the echo of a command when the transceiver hears itself. */
 #ifndef J288_CONFIG_RX_RING_SIZE
 #define J288_CONFIG_RX_RING_SIZE 64u
 #endif
@@ -60,12 +66,75 @@
 #error "J288_CONFIG_RX_RING_SIZE must be a power of two and at least 32"
 #endif
 
-/* Most retries a bus may be configured for; each attempt's failure reason is kept. */
+/* [layout] Most retries a bus may be configured for; each attempt's failure reason is kept
+ * (j288_txn_t). */
 #ifndef J288_CONFIG_MAX_RETRIES
 #define J288_CONFIG_MAX_RETRIES 3u
 #endif
 #if J288_CONFIG_MAX_RETRIES > 15u
 #error "J288_CONFIG_MAX_RETRIES must be 15 or less"
 #endif
+
+/* J288_ABI_TAG: the [layout] options' values as one name (see the top of this file). Each
+ * value is matched, not pasted, so that 64, 64u and (64u) give the same name. */
+#define J288_ABI_NAME(r, m, f) J288_ABI_NAME_(r, m, f)
+/* cppcheck-suppress misra-c2012-20.10 ; only ## makes a name (docs/misra.md) */
+#define J288_ABI_NAME_(r, m, f) j288_abi_##r##_##m##_##f
+#if J288_CONFIG_RX_RING_SIZE == 32u
+#define J288_ABI_R r32
+#elif J288_CONFIG_RX_RING_SIZE == 64u
+#define J288_ABI_R r64
+#elif J288_CONFIG_RX_RING_SIZE == 128u
+#define J288_ABI_R r128
+#elif J288_CONFIG_RX_RING_SIZE == 256u
+#define J288_ABI_R r256
+#elif J288_CONFIG_RX_RING_SIZE == 512u
+#define J288_ABI_R r512
+#elif J288_CONFIG_RX_RING_SIZE == 1024u
+#define J288_ABI_R r1024
+#elif J288_CONFIG_RX_RING_SIZE == 2048u
+#define J288_ABI_R r2048
+#elif J288_CONFIG_RX_RING_SIZE == 4096u
+#define J288_ABI_R r4096
+#else
+#error "J288_CONFIG_RX_RING_SIZE must be at most 4096"
+#endif
+#if J288_CONFIG_MAX_RETRIES == 1u
+#define J288_ABI_M m1
+#elif J288_CONFIG_MAX_RETRIES == 2u
+#define J288_ABI_M m2
+#elif J288_CONFIG_MAX_RETRIES == 3u
+#define J288_ABI_M m3
+#elif J288_CONFIG_MAX_RETRIES == 4u
+#define J288_ABI_M m4
+#elif J288_CONFIG_MAX_RETRIES == 5u
+#define J288_ABI_M m5
+#elif J288_CONFIG_MAX_RETRIES == 6u
+#define J288_ABI_M m6
+#elif J288_CONFIG_MAX_RETRIES == 7u
+#define J288_ABI_M m7
+#elif J288_CONFIG_MAX_RETRIES == 8u
+#define J288_ABI_M m8
+#elif J288_CONFIG_MAX_RETRIES == 9u
+#define J288_ABI_M m9
+#elif J288_CONFIG_MAX_RETRIES == 10u
+#define J288_ABI_M m10
+#elif J288_CONFIG_MAX_RETRIES == 11u
+#define J288_ABI_M m11
+#elif J288_CONFIG_MAX_RETRIES == 12u
+#define J288_ABI_M m12
+#elif J288_CONFIG_MAX_RETRIES == 13u
+#define J288_ABI_M m13
+#elif J288_CONFIG_MAX_RETRIES == 14u
+#define J288_ABI_M m14
+#else
+#define J288_ABI_M m15
+#endif
+#if J288_CONFIG_SI_FLOAT
+#define J288_ABI_F f1
+#else
+#define J288_ABI_F f0
+#endif
+#define J288_ABI_TAG J288_ABI_NAME(J288_ABI_R, J288_ABI_M, J288_ABI_F)
 
 #endif /* J288_CONFIG_H */
