@@ -575,16 +575,13 @@ static int port_wait(void *ctx, uint32_t until_us)
     return J288_OK;
 }
 
+/* No start_rx (the receiver is always on), no set_dir (the adapter switches direction
+ * itself), no crc32, no lock/unlock (one thread owns the port and its bus). */
 const j288_port_t j288_linux_port = {
-    port_start_tx,    /* start_tx */
-    port_now_us,      /* now_us */
-    NULL,             /* start_rx: the receiver is always on */
-    NULL,             /* set_dir: the adapter switches direction itself */
-    port_arm_timeout, /* arm_timeout: wait() wakes at the deadline */
-    port_wait,        /* wait */
-    NULL,             /* crc32 */
-    NULL,             /* lock */
-    NULL,             /* unlock */
+    .start_tx = port_start_tx,
+    .now_us = port_now_us,
+    .arm_timeout = port_arm_timeout, /* wait() wakes at the deadline */
+    .wait = port_wait,
 };
 
 /* ---- bus glue and run helpers --------------------------------------------------------------- */

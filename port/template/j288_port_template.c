@@ -131,17 +131,16 @@ static void port_unlock(void *ctx)
     (void)p->irq_state; /* TODO: __set_PRIMASK(p->irq_state); */
 }
 
-/* wait is for OS ports (j288_bus_transfer_blocking); an MCU port leaves it NULL. */
+/* wait is for OS ports (j288_bus_transfer_blocking); an MCU port leaves it out. */
 const j288_port_t j288_port_template_ops = {
-    port_start_tx,    /* start_tx    */
-    port_now_us,      /* now_us      */
-    port_start_rx,    /* start_rx    (NULL with an always-running circular DMA) */
-    port_set_dir,     /* set_dir     (NULL without a DE pin) */
-    port_arm_timeout, /* arm_timeout */
-    NULL,             /* wait        */
-    port_crc32,       /* crc32       (NULL: software) */
-    port_lock,        /* lock        */
-    port_unlock       /* unlock      */
+    .start_tx = port_start_tx,
+    .now_us = port_now_us,
+    .start_rx = port_start_rx, /* leave out with an always-running circular DMA */
+    .set_dir = port_set_dir,   /* leave out without a DE pin */
+    .arm_timeout = port_arm_timeout,
+    .crc32 = port_crc32, /* leave out: software CRC */
+    .lock = port_lock,
+    .unlock = port_unlock,
 };
 
 int j288_port_template_init(j288_port_template_t *p, const j288_bus_config_t *cfg)

@@ -443,12 +443,11 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     in.p = &data[3];
     in.n = size - 3u;
 
-    memset(&port, 0, sizeof port);
-    port.start_tx = port_start_tx;
-    port.now_us = port_now;
-    if ((c0 & 0x20u) != 0u) {
-        port.arm_timeout = port_arm;
-    }
+    port = (j288_port_t){
+        .start_tx = port_start_tx,
+        .now_us = port_now,
+        .arm_timeout = ((c0 & 0x20u) != 0u) ? port_arm : NULL,
+    };
     memset(&cfg, 0, sizeof cfg);
     cfg.echo = (c0 & 1u) != 0u;
     cfg.advance_in_isr = (c0 & 2u) != 0u;
