@@ -507,30 +507,138 @@ static void drive_report(const drive_args_t *d, const drive_result_t *r, cli_bus
                                              : "servo locked");
 }
 
+typedef enum {
+    DRIVE_END_DONE,   /* --duration reached */
+    DRIVE_END_SIGNAL, /* SIGINT or SIGTERM */
+    DRIVE_END_GONE,   /* the device went away: nothing can be sent any more */
+    DRIVE_END_SILENT  /* the servo stopped answering: lock already sent */
+} drive_end_t;
+
+/* The options each command requires. */
+static int drive_check(const drive_args_t *d)
+{
+    if (d->id < 0) {
+        cli_error("--id is required (0-14)");
+        return -1;
+    }
+    if (d->kind == DRIVE_MOVE && !d->have_pos) {
+        cli_error("--pos is required");
+        return -1;
+    }
+    if (d->kind == DRIVE_TORQUE && !d->have_tau) {
+        cli_error("--tau is required");
+        return -1;
+    }
+    return 0;
+}
+
+/* Where is the servo now? (A lock: the protocol has no read-only query.) */
+static int drive_start(cli_bus_t *b, const drive_args_t *d, drive_plan_t *p, drive_result_t *res)
+{
+    j288_cmd_raw_t cmd;
+    j288_txn_t txn;
+    int rc;
+    cli_lock_cmd((uint8_t)d->id, &cmd);
+    rc = cli_bus_transfer(b, &cmd, &txn);
+    if (rc != J288_OK) {
+        cli_report_txn_failure(b, (uint8_t)d->id, rc);
+        return -1;
+    }
+    p->start_pos = txn.reply.pos;
+    res->last = txn.reply;
+    res->have_last = true;
+    return 0;
+}
+
+/* One refresh: the command at time t, sent and counted. Returns the transfer's result. */
+static int drive_step(cli_bus_t *b, const drive_args_t *d, const drive_plan_t *p, double t,
+                      drive_result_t *res)
+{
+    j288_cmd_raw_t cmd;
+    j288_txn_t txn;
+    int rc;
+    drive_setpoint(d, p, t, &cmd);
+    res->last_cmd = cmd;
+    res->sent++;
+    rc = cli_bus_transfer(b, &cmd, &txn);
+    if (rc == J288_OK) {
+        res->ok++;
+        res->last = txn.reply;
+    } else if (rc != J288_ERR_OFFLINE) {
+        res->failed++;
+    }
+    return rc;
+}
+
+/* Refresh the command at --rate until --duration or a stop signal; a late cycle never
+ * bursts to catch up. Gives up when the device goes away or after FAILS_BEFORE_GIVING_UP
+ * failures in a row (then sending lock). */
+static drive_end_t drive_loop(cli_bus_t *b, const drive_args_t *d, const drive_plan_t *p,
+                              drive_result_t *res)
+{
+    uint32_t period_us = (uint32_t)lround(1e6 / d->rate_hz);
+    uint32_t t0 = j288_linux_now_us(), next = t0, now;
+    int fails = 0, rc;
+    for (;;) {
+        double t = (double)(uint32_t)(j288_linux_now_us() - t0) / 1e6;
+        if (cli_stop_signal != 0) {
+            return DRIVE_END_SIGNAL;
+        }
+        if (d->duration_s >= 0.0 && t >= d->duration_s) {
+            return DRIVE_END_DONE;
+        }
+        rc = drive_step(b, d, p, t, res);
+        if (rc == J288_ERR_OFFLINE) {
+            cli_report_txn_failure(b, (uint8_t)d->id, rc);
+            return DRIVE_END_GONE;
+        }
+        fails = rc == J288_OK ? 0 : fails + 1;
+        if (fails >= FAILS_BEFORE_GIVING_UP) {
+            (void)cli_bus_lock_driven(b);
+            cli_error("servo %lld stopped answering (%d commands in a row failed, last: %s); "
+                      "lock sent",
+                      d->id, fails, j288_strerror(rc));
+            return DRIVE_END_SILENT;
+        }
+        next += period_us;
+        now = j288_linux_now_us();
+        if ((int32_t)(next - now) < 0) {
+            res->overruns++;
+            next = now;
+        }
+        if (cli_bus_sleep_until(b, next) == J288_ERR_OFFLINE) {
+            cli_report_txn_failure(b, (uint8_t)d->id, J288_ERR_OFFLINE);
+            return DRIVE_END_GONE;
+        }
+    }
+}
+
+/* After the loop: lock the servo (unless --keep at the end of --duration), report. Returns
+ * the exit status. */
+static int drive_finish(cli_bus_t *b, const drive_args_t *d, const drive_result_t *res,
+                        drive_end_t end, bool json)
+{
+    if (end == DRIVE_END_GONE || end == DRIVE_END_SILENT) {
+        return CLI_EXIT_FAIL;
+    }
+    if (cli_stop_signal != 0 || !d->keep) {
+        if (cli_bus_lock_driven(b) != 0) {
+            cli_error("servo %lld did not confirm the lock (a broadcast lock was sent)", d->id);
+            return cli_stop_signal != 0 ? cli_signal_exit_code() : CLI_EXIT_FAIL;
+        }
+    }
+    drive_report(d, res, b, end == DRIVE_END_SIGNAL ? "stopped by signal" : "done", json);
+    return cli_stop_signal != 0 ? cli_signal_exit_code() : CLI_EXIT_OK;
+}
+
 static int run_drive(drive_args_t *d, const cli_bus_opts_t *o)
 {
     cli_bus_t b;
     drive_plan_t plan;
     drive_result_t res;
-    j288_cmd_raw_t cmd;
-    j288_txn_t txn;
-    uint32_t t0, next, period_us;
-    int ec, rc, fails = 0;
-    const char *how = "done";
+    int ec;
 
-    if (d->id < 0) {
-        cli_error("--id is required (0-14)");
-        return CLI_EXIT_USAGE;
-    }
-    if (d->kind == DRIVE_MOVE && !d->have_pos) {
-        cli_error("--pos is required");
-        return CLI_EXIT_USAGE;
-    }
-    if (d->kind == DRIVE_TORQUE && !d->have_tau) {
-        cli_error("--tau is required");
-        return CLI_EXIT_USAGE;
-    }
-    if (plan_fields(d, &plan) != 0) {
+    if (drive_check(d) != 0 || plan_fields(d, &plan) != 0) {
         return CLI_EXIT_USAGE;
     }
     cli_signals_install();
@@ -538,84 +646,13 @@ static int run_drive(drive_args_t *d, const cli_bus_opts_t *o)
         return ec;
     }
     memset(&res, 0, sizeof res);
-    /* Where is it now? (A lock: the protocol has no read-only query.) */
-    cli_lock_cmd((uint8_t)d->id, &cmd);
-    rc = cli_bus_transfer(&b, &cmd, &txn);
-    if (rc != J288_OK) {
-        cli_report_txn_failure(&b, (uint8_t)d->id, rc);
-        cli_bus_close(&b);
-        return CLI_EXIT_FAIL;
+    if (drive_start(&b, d, &plan, &res) != 0) {
+        ec = CLI_EXIT_FAIL;
+    } else {
+        ec = drive_finish(&b, d, &res, drive_loop(&b, d, &plan, &res), o->json);
     }
-    plan.start_pos = txn.reply.pos;
-    res.last = txn.reply;
-    res.have_last = true;
-
-    period_us = (uint32_t)lround(1e6 / d->rate_hz);
-    t0 = j288_linux_now_us();
-    next = t0;
-    ec = CLI_EXIT_OK;
-    for (;;) {
-        uint32_t now = j288_linux_now_us();
-        double t = (double)(uint32_t)(now - t0) / 1e6;
-        if (cli_stop_signal != 0) {
-            how = "stopped by signal";
-            break;
-        }
-        if (d->duration_s >= 0.0 && t >= d->duration_s) {
-            break;
-        }
-        drive_setpoint(d, &plan, t, &cmd);
-        res.last_cmd = cmd;
-        res.sent++;
-        rc = cli_bus_transfer(&b, &cmd, &txn);
-        if (rc == J288_OK) {
-            res.ok++;
-            res.last = txn.reply;
-            fails = 0;
-        } else if (rc == J288_ERR_OFFLINE) {
-            cli_report_txn_failure(&b, (uint8_t)d->id, rc);
-            ec = CLI_EXIT_FAIL;
-            how = NULL;
-            break;
-        } else {
-            res.failed++;
-            if (++fails >= FAILS_BEFORE_GIVING_UP) {
-                (void)cli_bus_lock_driven(&b);
-                cli_error("servo %lld stopped answering (%d commands in a row failed, last: "
-                          "%s); lock sent",
-                          d->id, fails, j288_strerror(rc));
-                cli_bus_close(&b);
-                return CLI_EXIT_FAIL;
-            }
-        }
-        next += period_us;
-        now = j288_linux_now_us();
-        if ((int32_t)(next - now) < 0) {
-            res.overruns++;
-            next = now; /* never burst to catch up */
-        }
-        rc = cli_bus_sleep_until(&b, next);
-        if (rc == J288_ERR_OFFLINE) {
-            cli_report_txn_failure(&b, (uint8_t)d->id, rc);
-            ec = CLI_EXIT_FAIL;
-            how = NULL;
-            break;
-        }
-    }
-    if (how == NULL) { /* device gone: nothing can be sent any more */
-        cli_bus_close(&b);
-        return ec;
-    }
-    if (cli_stop_signal != 0 || !d->keep) {
-        if (cli_bus_lock_driven(&b) != 0) {
-            cli_error("servo %lld did not confirm the lock (a broadcast lock was sent)", d->id);
-            cli_bus_close(&b);
-            return cli_stop_signal != 0 ? cli_signal_exit_code() : CLI_EXIT_FAIL;
-        }
-    }
-    drive_report(d, &res, &b, how, o->json);
     cli_bus_close(&b);
-    return cli_stop_signal != 0 ? cli_signal_exit_code() : CLI_EXIT_OK;
+    return ec;
 }
 
 #define DRIVE_COMMON_HELP                                                                          \

@@ -290,66 +290,92 @@ typedef struct {
     double elapsed_s;
 } run_stats_t;
 
-static void print_summary(const log_args_t *a, cli_bus_t *b, const j288_sched_t *s,
-                          const servo_acc_t *acc, const run_stats_t *rs, bool json)
+/* Everything one run of `log` works with. */
+typedef struct {
+    log_args_t a;
+    cli_bus_opts_t o;
+    j288_side_t side;       /* of --swing, the gains and the CSV */
+    j288_cmd_raw_t base;    /* a driven servo's command: FOC, gains, watchdog */
+    cli_bus_t b;
+    j288_sched_t s;
+    FILE *csv;              /* NULL without --csv, and once closed */
+    servo_acc_t acc[J288_MAX_ID + 1u];
+    double pos_des[J288_MAX_ID + 1u];
+    uint32_t t0;            /* when the cycles began */
+    uint32_t sweep_timeout_us;
+    run_stats_t rs;
+} log_run_t;
+
+typedef enum { LOG_DONE, LOG_INTERRUPTED, LOG_FAILED } log_end_t;
+
+static bool listed(const log_run_t *r, uint8_t id)
 {
-    const j288_bus_stats_t *bs = j288_bus_stats(&b->bus);
-    const j288_parser_stats_t *ps = j288_bus_parser_stats(&b->bus);
-    const char *side_name = a->side == 0 ? "rotor" : "output";
-    double achieved = rs->elapsed_s > 0.0 ? (double)rs->cycles / rs->elapsed_s : 0.0;
+    return (r->a.ids & (1u << id)) != 0u;
+}
+
+static double mean_latency(const servo_acc_t *x)
+{
+    return x->latency_n != 0u ? x->latency_sum / x->latency_n : 0.0;
+}
+
+static void print_summary_json(const log_run_t *r, double achieved)
+{
+    const j288_bus_stats_t *bs = j288_bus_stats(&r->b.bus);
+    cli_json_t j;
     uint8_t id;
-    (void)s;
-    if (json) {
-        cli_json_t j;
-        cli_json_init(&j, stdout);
-        cli_json_begin_object(&j, NULL);
-        cli_json_uint(&j, "cycles", rs->cycles);
-        cli_json_real(&j, "elapsed_s", rs->elapsed_s);
-        cli_json_real(&j, "rate_hz", a->rate_hz);
-        cli_json_real(&j, "achieved_hz", achieved);
-        cli_json_uint(&j, "missed_deadlines", rs->missed);
-        cli_json_uint(&j, "skipped_ticks", rs->skipped);
-        cli_json_uint(&j, "csv_rows", rs->rows);
-        cli_json_begin_object(&j, "bus");
-        cli_json_uint(&j, "transactions", bs->transactions);
-        cli_json_uint(&j, "ok", bs->ok);
-        cli_json_uint(&j, "timeouts", bs->timeouts);
-        cli_json_uint(&j, "crc_errors", bs->crc_errors);
-        cli_json_uint(&j, "wrong_id", bs->wrong_id);
-        cli_json_uint(&j, "collisions", bs->collisions);
-        cli_json_uint(&j, "line_errors", bs->line_errors);
-        cli_json_uint(&j, "stale_bytes", bs->stale_bytes);
-        cli_json_uint(&j, "garbage_bytes", ps->garbage_bytes);
-        cli_json_end_object(&j);
-        cli_json_begin_array(&j, "servos");
-        for (id = 0; id <= J288_MAX_ID; id++) {
-            const servo_acc_t *x = &acc[id];
-            if ((a->ids & (1u << id)) == 0u) {
-                continue;
-            }
-            cli_json_begin_object(&j, NULL);
-            cli_json_int(&j, "id", id);
-            cli_json_uint(&j, "replies", x->replies);
-            cli_json_uint(&j, "failures", x->failures);
-            cli_json_real(&j, "latency_mean_us",
-                          x->latency_n != 0u ? x->latency_sum / x->latency_n : 0.0);
-            cli_json_uint(&j, "latency_max_us", x->latency_max);
-            if (a->motion != MOTION_NONE && x->err_n != 0u) {
-                cli_json_real(&j, "tracking_rms_rad", sqrt(x->err_sq_sum / x->err_n));
-                cli_json_real(&j, "tracking_max_rad", x->err_max);
-            }
-            cli_json_end_object(&j);
+    cli_json_init(&j, stdout);
+    cli_json_begin_object(&j, NULL);
+    cli_json_uint(&j, "cycles", r->rs.cycles);
+    cli_json_real(&j, "elapsed_s", r->rs.elapsed_s);
+    cli_json_real(&j, "rate_hz", r->a.rate_hz);
+    cli_json_real(&j, "achieved_hz", achieved);
+    cli_json_uint(&j, "missed_deadlines", r->rs.missed);
+    cli_json_uint(&j, "skipped_ticks", r->rs.skipped);
+    cli_json_uint(&j, "csv_rows", r->rs.rows);
+    cli_json_begin_object(&j, "bus");
+    cli_json_uint(&j, "transactions", bs->transactions);
+    cli_json_uint(&j, "ok", bs->ok);
+    cli_json_uint(&j, "timeouts", bs->timeouts);
+    cli_json_uint(&j, "crc_errors", bs->crc_errors);
+    cli_json_uint(&j, "wrong_id", bs->wrong_id);
+    cli_json_uint(&j, "collisions", bs->collisions);
+    cli_json_uint(&j, "line_errors", bs->line_errors);
+    cli_json_uint(&j, "stale_bytes", bs->stale_bytes);
+    cli_json_uint(&j, "garbage_bytes", j288_bus_parser_stats(&r->b.bus)->garbage_bytes);
+    cli_json_end_object(&j);
+    cli_json_begin_array(&j, "servos");
+    for (id = 0; id <= J288_MAX_ID; id++) {
+        const servo_acc_t *x = &r->acc[id];
+        if (!listed(r, id)) {
+            continue;
         }
-        cli_json_end_array(&j);
-        cli_json_str(&j, "side", side_name);
+        cli_json_begin_object(&j, NULL);
+        cli_json_int(&j, "id", id);
+        cli_json_uint(&j, "replies", x->replies);
+        cli_json_uint(&j, "failures", x->failures);
+        cli_json_real(&j, "latency_mean_us", mean_latency(x));
+        cli_json_uint(&j, "latency_max_us", x->latency_max);
+        if (r->a.motion != MOTION_NONE && x->err_n != 0u) {
+            cli_json_real(&j, "tracking_rms_rad", sqrt(x->err_sq_sum / x->err_n));
+            cli_json_real(&j, "tracking_max_rad", x->err_max);
+        }
         cli_json_end_object(&j);
-        cli_json_newline(&j);
-        return;
     }
+    cli_json_end_array(&j);
+    cli_json_str(&j, "side", r->a.side == 0 ? "rotor" : "output");
+    cli_json_end_object(&j);
+    cli_json_newline(&j);
+}
+
+static void print_summary_text(const log_run_t *r, double achieved)
+{
+    const j288_bus_stats_t *bs = j288_bus_stats(&r->b.bus);
+    const j288_parser_stats_t *ps = j288_bus_parser_stats(&r->b.bus);
+    uint8_t id;
     printf("log: %lu cycles in %.3f s: achieved %.1f Hz (asked %.1f Hz), %lu missed "
            "deadlines, %lu ticks skipped\n",
-           (unsigned long)rs->cycles, rs->elapsed_s, achieved, a->rate_hz,
-           (unsigned long)rs->missed, (unsigned long)rs->skipped);
+           (unsigned long)r->rs.cycles, r->rs.elapsed_s, achieved, r->a.rate_hz,
+           (unsigned long)r->rs.missed, (unsigned long)r->rs.skipped);
     printf("bus: %lu transactions, %lu ok, %lu timeouts, %lu CRC errors, %lu wrong id, "
            "%lu collisions, %lu line errors, %lu stale bytes, %lu garbage bytes\n",
            (unsigned long)bs->transactions, (unsigned long)bs->ok, (unsigned long)bs->timeouts,
@@ -357,246 +383,310 @@ static void print_summary(const log_args_t *a, cli_bus_t *b, const j288_sched_t 
            (unsigned long)bs->collisions, (unsigned long)bs->line_errors,
            (unsigned long)bs->stale_bytes, (unsigned long)ps->garbage_bytes);
     for (id = 0; id <= J288_MAX_ID; id++) {
-        const servo_acc_t *x = &acc[id];
-        if ((a->ids & (1u << id)) == 0u) {
+        const servo_acc_t *x = &r->acc[id];
+        if (!listed(r, id)) {
             continue;
         }
         printf("servo %u: %lu replies, %lu failed, latency mean %.0f us, worst %lu us",
                (unsigned)id, (unsigned long)x->replies, (unsigned long)x->failures,
-               x->latency_n != 0u ? x->latency_sum / x->latency_n : 0.0,
-               (unsigned long)x->latency_max);
-        if (a->motion != MOTION_NONE && x->err_n != 0u) {
+               mean_latency(x), (unsigned long)x->latency_max);
+        if (r->a.motion != MOTION_NONE && x->err_n != 0u) {
             printf("; tracking error rms %.4g rad, max %.4g rad (%s side)",
-                   sqrt(x->err_sq_sum / x->err_n), x->err_max, side_name);
+                   sqrt(x->err_sq_sum / x->err_n), x->err_max, r->a.side == 0 ? "rotor" : "output");
         }
         printf("\n");
     }
-    if (a->csv != NULL) {
-        printf("csv: %s (%lu rows)\n", a->csv, (unsigned long)rs->rows);
+    if (r->a.csv != NULL) {
+        printf("csv: %s (%lu rows)\n", r->a.csv, (unsigned long)r->rs.rows);
     }
 }
 
-int cli_cmd_log(int argc, char **argv, const cli_global_t *g)
+/* Parse and check everything that needs no bus. Returns 0, or -1 with *ec the exit status
+ * (CLI_EXIT_OK after --help). */
+static int log_prepare(log_run_t *r, int argc, char **argv, const cli_global_t *g, int *ec)
 {
-    static cli_bus_t b;
-    static j288_sched_t s;
-    servo_acc_t acc[J288_MAX_ID + 1u];
-    double pos_des[J288_MAX_ID + 1u];
-    log_args_t a;
-    cli_bus_opts_t o;
-    run_stats_t rs;
-    j288_cmd_raw_t base, cmd;
-    j288_side_t side;
-    FILE *csv = NULL;
-    uint32_t t0, next, period_us, sweep_timeout_us;
-    int ec, rc;
-    uint8_t id;
-    bool interrupted = false, failed = false;
-
-    memset(&a, 0, sizeof a);
-    a.rate_hz = 100.0;
-    a.duration_s = 1.0;
-    a.side = 1;
-    a.watchdog = true;
-    cli_bus_opts_init(&o, g);
-    if (parse_args(argc, argv, &a, &o, &ec) != 0) {
-        return ec;
+    log_args_t *a = &r->a;
+    a->rate_hz = 100.0;
+    a->duration_s = 1.0;
+    a->side = 1;
+    a->watchdog = true;
+    cli_bus_opts_init(&r->o, g);
+    if (parse_args(argc, argv, a, &r->o, ec) != 0) {
+        return -1;
     }
-    if (!a.have_period) {
-        a.period_s = a.duration_s;
+    if (!a->have_period) {
+        a->period_s = a->duration_s;
     }
-    side = a.side == 0 ? J288_SIDE_ROTOR : J288_SIDE_OUTPUT;
-    if (a.motion != MOTION_NONE && base_command(&a, &base) != 0) {
-        return CLI_EXIT_USAGE;
+    r->side = a->side == 0 ? J288_SIDE_ROTOR : J288_SIDE_OUTPUT;
+    *ec = CLI_EXIT_USAGE;
+    if (a->motion != MOTION_NONE && base_command(a, &r->base) != 0) {
+        return -1;
     }
-    if (a.motion == MOTION_SWING) {
+    if (a->motion == MOTION_SWING) {
         int32_t probe;
-        if (j288_pos_to_raw((j288_real_t)a.amp, side, &probe) != J288_OK) {
-            cli_error("--swing: %g rad is out of range", a.amp);
-            return CLI_EXIT_USAGE;
+        if (j288_pos_to_raw((j288_real_t)a->amp, r->side, &probe) != J288_OK) {
+            cli_error("--swing: %g rad is out of range", a->amp);
+            return -1;
         }
     }
+    return 0;
+}
+
+/* Signals, the bus, the CSV file, and the scheduler with every listed servo sent lock.
+ * Returns CLI_EXIT_OK, or the exit status with nothing left open. */
+static int log_open(log_run_t *r)
+{
+    j288_cmd_raw_t cmd;
+    uint8_t id;
+    int ec;
     cli_signals_install();
     /* Best effort: wake from the tick sleeps within a microsecond rather than the default
      * 50 us timer slack. */
     (void)prctl(PR_SET_TIMERSLACK, 1ul, 0ul, 0ul, 0ul);
-    if ((ec = cli_bus_open(&b, &o, 0)) != CLI_EXIT_OK) {
+    if ((ec = cli_bus_open(&r->b, &r->o, 0)) != CLI_EXIT_OK) {
         return ec;
     }
-    if (a.csv != NULL) {
-        csv = fopen(a.csv, "w");
-        if (csv == NULL) {
-            cli_error("cannot write %s: %s", a.csv, strerror(errno));
-            cli_bus_close(&b);
+    if (r->a.csv != NULL) {
+        r->csv = fopen(r->a.csv, "w");
+        if (r->csv == NULL) {
+            cli_error("cannot write %s: %s", r->a.csv, strerror(errno));
+            cli_bus_close(&r->b);
             return CLI_EXIT_FAIL;
         }
-        setvbuf(csv, NULL, _IOFBF, 1u << 16);
-        csv_header(csv);
+        setvbuf(r->csv, NULL, _IOFBF, 1u << 16);
+        csv_header(r->csv);
     }
-    j288_sched_init(&s, &b.bus, NULL);
-    memset(acc, 0, sizeof acc);
+    j288_sched_init(&r->s, &r->b.bus, NULL);
     for (id = 0; id <= J288_MAX_ID; id++) {
-        if ((a.ids & (1u << id)) != 0u) {
+        if (listed(r, id)) {
             cli_lock_cmd(id, &cmd);
-            j288_sched_set_cmd(&s, &cmd);
-            j288_sched_enable(&s, id, true);
+            j288_sched_set_cmd(&r->s, &cmd);
+            j288_sched_enable(&r->s, id, true);
         }
-        pos_des[id] = NAN;
+        r->pos_des[id] = NAN;
     }
     /* The budget of one sweep: every servo's full reply window, plus slack. */
-    sweep_timeout_us = 15u * (j288_bus_reply_budget_us(&b.bus) * 2u + 1000u) + 100000u;
+    r->sweep_timeout_us = 15u * (j288_bus_reply_budget_us(&r->b.bus) * 2u + 1000u) + 100000u;
+    return CLI_EXIT_OK;
+}
 
-    /* First sweeps: who is there and where they start; a few tries so that one dropped
-     * reply does not fail the whole log. */
-    for (rc = 0; rc < PROBE_SWEEPS && !all_answered(&s, a.ids); rc++) {
-        int r = sweep(&b, &s, sweep_timeout_us, false);
-        if (r == J288_ERR_OFFLINE || r == J288_ERR_ABORTED) {
-            if (r == J288_ERR_OFFLINE) {
-                cli_error("%s", j288_linux_error(&b.lp));
-            }
-            if (csv != NULL) {
-                fclose(csv);
-            }
-            cli_bus_close(&b);
-            return r == J288_ERR_ABORTED ? cli_signal_exit_code() : CLI_EXIT_FAIL;
+/* First sweeps: who is there and where each starts; a few tries so that one dropped reply
+ * does not fail the whole log. Returns CLI_EXIT_OK, or the exit status when a servo never
+ * answered, the device went away or a stop signal came. */
+static int log_probe(log_run_t *r)
+{
+    uint8_t id;
+    int i;
+    for (i = 0; i < PROBE_SWEEPS && !all_answered(&r->s, r->a.ids); i++) {
+        int rc = sweep(&r->b, &r->s, r->sweep_timeout_us, false);
+        if (rc == J288_ERR_ABORTED) {
+            return cli_signal_exit_code();
+        }
+        if (rc == J288_ERR_OFFLINE) {
+            cli_error("%s", j288_linux_error(&r->b.lp));
+            return CLI_EXIT_FAIL;
         }
     }
     for (id = 0; id <= J288_MAX_ID; id++) {
-        const j288_slot_t *sl = j288_sched_slot(&s, id);
-        if ((a.ids & (1u << id)) == 0u) {
+        const j288_slot_t *sl = j288_sched_slot(&r->s, id);
+        if (!listed(r, id)) {
             continue;
         }
         if (!sl->has_reply) {
             cli_error("no reply from servo %u on %s (check id, power, wiring and --baud)",
-                      (unsigned)id, b.dev);
-            if (csv != NULL) {
-                fclose(csv);
-            }
-            cli_bus_close(&b);
+                      (unsigned)id, r->b.dev);
             return CLI_EXIT_FAIL;
         }
-        acc[id].p0 = sl->reply.pos;
-        acc[id].seen_successes = sl->stats.successes;
-        if (a.motion != MOTION_NONE) {
-            b.driven = (uint16_t)(b.driven | (1u << id));
+        r->acc[id].p0 = sl->reply.pos;
+        r->acc[id].seen_successes = sl->stats.successes;
+        if (r->a.motion != MOTION_NONE) {
+            r->b.driven = (uint16_t)(r->b.driven | (1u << id));
         }
     }
+    return CLI_EXIT_OK;
+}
 
-    memset(&rs, 0, sizeof rs);
-    period_us = (uint32_t)lround(1e6 / a.rate_hz);
-    t0 = j288_linux_now_us();
-    next = t0;
+/* This cycle's commands: hold where each servo started, or the swing at time t. Observed
+ * servos keep the lock set at the start. */
+static void set_cycle_commands(log_run_t *r, double t)
+{
+    j288_cmd_raw_t cmd;
+    uint8_t id;
+    if (r->a.motion == MOTION_NONE) {
+        return;
+    }
+    for (id = 0; id <= J288_MAX_ID; id++) {
+        if (!listed(r, id)) {
+            continue;
+        }
+        cmd = r->base;
+        cmd.id = id;
+        if (r->a.motion == MOTION_HOLD) {
+            cmd.pos = r->acc[id].p0;
+        } else {
+            swing_setpoint(&r->a, r->acc[id].p0, t, &cmd.pos, &cmd.speed);
+        }
+        r->pos_des[id] = (double)j288_pos_from_raw(cmd.pos, r->side);
+        j288_sched_set_cmd(&r->s, &cmd);
+    }
+}
+
+/* A reply taken in this cycle: latency and, when driving, the tracking error. */
+static void account_reply(log_run_t *r, uint8_t id, const j288_slot_t *sl)
+{
+    servo_acc_t *x = &r->acc[id];
+    uint32_t lat = sl->stats.last_latency_us;
+    x->replies++;
+    x->latency_sum += (double)lat;
+    x->latency_n++;
+    if (lat > x->latency_max) {
+        x->latency_max = lat;
+    }
+    if (r->a.motion != MOTION_NONE) {
+        double e = fabs(r->pos_des[id] - (double)j288_pos_from_raw(sl->reply.pos, r->side));
+        x->err_sq_sum += e * e;
+        x->err_n++;
+        if (e > x->err_max) {
+            x->err_max = e;
+        }
+    }
+}
+
+/* Each listed servo after a cycle's sweep at time t: a reply or a failure, and a CSV row. */
+static void account_cycle(log_run_t *r, double t)
+{
+    uint8_t id;
+    for (id = 0; id <= J288_MAX_ID; id++) {
+        const j288_slot_t *sl = j288_sched_slot(&r->s, id);
+        servo_acc_t *x = &r->acc[id];
+        bool fresh;
+        if (!listed(r, id)) {
+            continue;
+        }
+        fresh = sl->stats.successes != x->seen_successes;
+        x->seen_successes = sl->stats.successes;
+        if (fresh) {
+            account_reply(r, id, sl);
+        } else {
+            x->failures++;
+        }
+        if (r->csv != NULL) {
+            double rt = fresh ? (double)(uint32_t)(sl->reply_us - r->t0) / 1e6 : t;
+            csv_row(r->csv, rt, id, sl, fresh, r->side, r->pos_des[id]);
+            r->rs.rows++;
+        }
+    }
+}
+
+/* Sleep until the next tick. A sweep that ran past it makes that tick start late, at once;
+ * ticks a whole period or more behind are skipped rather than sent in a burst. */
+static int wait_tick(log_run_t *r, uint32_t *next, uint32_t period_us)
+{
+    uint32_t now;
+    *next += period_us;
+    now = j288_linux_now_us();
+    if ((int32_t)(*next - now) < 0) {
+        r->rs.missed++;
+        while ((int32_t)(*next + period_us - now) <= 0) {
+            *next += period_us;
+            r->rs.skipped++;
+        }
+    }
+    return cli_bus_sleep_until(&r->b, *next);
+}
+
+/* Whether a sweep's or a sleep's result ends the run: a stop signal or a vanished device. */
+static bool run_ends(const log_run_t *r, int rc, log_end_t *end)
+{
+    if (rc == J288_ERR_ABORTED) {
+        *end = LOG_INTERRUPTED;
+        return true;
+    }
+    if (rc == J288_ERR_OFFLINE) {
+        cli_error("%s", j288_linux_error(&r->b.lp));
+        *end = LOG_FAILED;
+        return true;
+    }
+    return false;
+}
+
+/* One sweep per tick for --duration: commands, sweep, replies, CSV rows. */
+static log_end_t log_cycles(log_run_t *r)
+{
+    uint32_t period_us = (uint32_t)lround(1e6 / r->a.rate_hz);
+    uint32_t next;
+    log_end_t end = LOG_DONE;
+    r->t0 = j288_linux_now_us();
+    next = r->t0;
     for (;;) {
-        uint32_t now = j288_linux_now_us();
-        double t = (double)(uint32_t)(now - t0) / 1e6;
-        if (t >= a.duration_s) {
+        double t = (double)(uint32_t)(j288_linux_now_us() - r->t0) / 1e6;
+        if (t >= r->a.duration_s) {
             break;
         }
-        /* This cycle's commands. */
-        for (id = 0; id <= J288_MAX_ID; id++) {
-            if ((a.ids & (1u << id)) == 0u) {
-                continue;
-            }
-            if (a.motion == MOTION_NONE) {
-                continue; /* the lock set at the start stays */
-            }
-            cmd = base;
-            cmd.id = id;
-            if (a.motion == MOTION_HOLD) {
-                cmd.pos = acc[id].p0;
-            } else {
-                swing_setpoint(&a, acc[id].p0, t, &cmd.pos, &cmd.speed);
-            }
-            pos_des[id] = (double)j288_pos_from_raw(cmd.pos, side);
-            j288_sched_set_cmd(&s, &cmd);
-        }
-        rc = sweep(&b, &s, sweep_timeout_us, false);
-        if (rc == J288_ERR_ABORTED) {
-            interrupted = true;
+        set_cycle_commands(r, t);
+        if (run_ends(r, sweep(&r->b, &r->s, r->sweep_timeout_us, false), &end)) {
             break;
         }
-        if (rc == J288_ERR_OFFLINE) {
-            cli_error("%s", j288_linux_error(&b.lp));
-            failed = true;
-            break;
-        }
-        rs.cycles++;
-        for (id = 0; id <= J288_MAX_ID; id++) {
-            const j288_slot_t *sl = j288_sched_slot(&s, id);
-            servo_acc_t *x = &acc[id];
-            bool fresh;
-            if ((a.ids & (1u << id)) == 0u) {
-                continue;
-            }
-            fresh = sl->stats.successes != x->seen_successes;
-            x->seen_successes = sl->stats.successes;
-            if (fresh) {
-                uint32_t lat = sl->stats.last_latency_us;
-                x->replies++;
-                x->latency_sum += (double)lat;
-                x->latency_n++;
-                if (lat > x->latency_max) {
-                    x->latency_max = lat;
-                }
-                if (a.motion != MOTION_NONE) {
-                    double e = fabs(pos_des[id] - (double)j288_pos_from_raw(sl->reply.pos, side));
-                    x->err_sq_sum += e * e;
-                    x->err_n++;
-                    if (e > x->err_max) {
-                        x->err_max = e;
-                    }
-                }
-            } else {
-                x->failures++;
-            }
-            if (csv != NULL) {
-                double rt = fresh ? (double)(uint32_t)(sl->reply_us - t0) / 1e6 : t;
-                csv_row(csv, rt, id, sl, fresh, side, pos_des[id]);
-                rs.rows++;
-            }
-        }
-        next += period_us;
-        now = j288_linux_now_us();
-        if ((int32_t)(next - now) < 0) {
-            /* The sweep ran past the next tick: that tick starts late, at once. Ticks a
-             * whole period or more behind are skipped rather than sent in a burst. */
-            rs.missed++;
-            while ((int32_t)(next + period_us - now) <= 0) {
-                next += period_us;
-                rs.skipped++;
-            }
-        }
-        rc = cli_bus_sleep_until(&b, next);
-        if (rc == J288_ERR_ABORTED) {
-            interrupted = true;
-            break;
-        }
-        if (rc == J288_ERR_OFFLINE) {
-            cli_error("%s", j288_linux_error(&b.lp));
-            failed = true;
+        r->rs.cycles++;
+        account_cycle(r, t);
+        if (run_ends(r, wait_tick(r, &next, period_us), &end)) {
             break;
         }
     }
-    rs.elapsed_s = (double)(uint32_t)(j288_linux_now_us() - t0) / 1e6;
+    r->rs.elapsed_s = (double)(uint32_t)(j288_linux_now_us() - r->t0) / 1e6;
+    return end;
+}
+
+/* After the cycles: let a sweep cut short by a signal finish, lock every driven servo, close
+ * the CSV file, print the summary. Returns the exit status. */
+static int log_finish(log_run_t *r, log_end_t end)
+{
+    bool failed = end == LOG_FAILED;
     if (!failed) {
-        /* Let a sweep cut short by the signal finish, then lock every driven servo. */
-        (void)j288_linux_run(&b.lp, &s, j288_linux_now_us() + sweep_timeout_us,
+        (void)j288_linux_run(&r->b.lp, &r->s, j288_linux_now_us() + r->sweep_timeout_us,
                              J288_LINUX_RUN_UNTIL_IDLE | J288_LINUX_RUN_IGNORE_STOP);
-        if (cli_bus_lock_driven(&b) != 0) {
+        if (cli_bus_lock_driven(&r->b) != 0) {
             cli_error("a servo did not confirm the lock (a broadcast lock was sent)");
             failed = true;
         }
     }
-    if (csv != NULL && fclose(csv) != 0) {
-        cli_error("writing %s failed", a.csv);
-        failed = true;
+    if (r->csv != NULL) {
+        int rc = fclose(r->csv);
+        r->csv = NULL;
+        if (rc != 0) {
+            cli_error("writing %s failed", r->a.csv);
+            failed = true;
+        }
     }
     if (!failed) {
-        print_summary(&a, &b, &s, acc, &rs, o.json);
+        double achieved = r->rs.elapsed_s > 0.0 ? (double)r->rs.cycles / r->rs.elapsed_s : 0.0;
+        if (r->o.json) {
+            print_summary_json(r, achieved);
+        } else {
+            print_summary_text(r, achieved);
+        }
     }
-    cli_bus_close(&b);
-    if (interrupted) {
+    if (end == LOG_INTERRUPTED) {
         return cli_signal_exit_code();
     }
     return failed ? CLI_EXIT_FAIL : CLI_EXIT_OK;
+}
+
+int cli_cmd_log(int argc, char **argv, const cli_global_t *g)
+{
+    static log_run_t r;
+    int ec;
+    memset(&r, 0, sizeof r);
+    if (log_prepare(&r, argc, argv, g, &ec) != 0 || (ec = log_open(&r)) != CLI_EXIT_OK) {
+        return ec;
+    }
+    ec = log_probe(&r);
+    if (ec == CLI_EXIT_OK) {
+        ec = log_finish(&r, log_cycles(&r));
+    }
+    if (r.csv != NULL) {
+        (void)fclose(r.csv);
+    }
+    cli_bus_close(&r.b);
+    return ec;
 }
