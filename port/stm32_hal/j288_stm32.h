@@ -35,7 +35,7 @@
 
 /* The HAL header. "main.h" is what CubeMX generates in every project and it includes the
  * family's HAL (stm32f4xx_hal.h, stm32h7xx_hal.h, ...), so the default works on any family;
- * port/stm32_hal/stub/ provides a main.h of its own for builds without the HAL. */
+ * test/stm32/stub/ provides a main.h of its own for builds without the HAL. */
 #ifndef J288_STM32_HAL_HEADER
 #define J288_STM32_HAL_HEADER "main.h"
 #endif

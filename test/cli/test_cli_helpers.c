@@ -1,4 +1,4 @@
-/* Unit tests of the j288 tool's parsing and output helpers (examples/cli): hex text, strict
+/* Unit tests of the j288 tool's parsing and output helpers (tools/j288): hex text, strict
  * numbers, id lists, the option scanner, the JSON writer and fault names. Every refusal must
  * print exactly one error line. */
 #include "unity.h"

@@ -1,5 +1,5 @@
 /*
- * Fuzz target: the j288 tool's text parsing (examples/cli/hexparse.c and args.c), linked as
+ * Fuzz target: the j288 tool's text parsing (tools/j288/hexparse.c and args.c), linked as
  * functions (no exec). cli_error() is replaced here by a stub that formats into a buffer.
  *
  * Input: byte 0 chooses the case, bytes 1-2 are parameters, the rest is the text (or, for

@@ -1,4 +1,4 @@
-/* Unit tests of the simulator's servo and bus model (tools/sim/servo_model.c), no I/O. */
+/* Unit tests of the simulator's servo and bus model (tools/j288-sim/servo_model.c), no I/O. */
 #include "unity.h"
 
 #include <math.h>

@@ -1,5 +1,5 @@
 /*
- * fake_hal.h - a host-side fake of the HAL slice in port/stm32_hal/stub/: it records every
+ * fake_hal.h - a host-side fake of the HAL slice in test/stm32/stub/: it records every
  * call the port makes and lets a test play the hardware, firing the HAL's callbacks in the
  * order the real HAL fires them:
  *   transmit:  HAL_UART_Transmit_DMA ... fake_hal_tx_complete() -> HAL_UART_TxCpltCallback

@@ -2,47 +2,25 @@
  * j288/bus.h - the half-duplex bus engine: one transaction at a time on one physical bus.
  *
  * A transaction sends one 20-byte command and, unless it is a broadcast (id 15), waits for
- * the 26-byte reply of that servo:
+ * the addressed servo's 26-byte reply until a deadline: the wire time of command and reply
+ * at the configured baud plus turnaround_us plus margin_us, counted from the start of
+ * transmit. Its result is J288_OK or the most specific failure seen (wrong id > line >
+ * crc/truncated > timeout; a differing echo is a collision; a line gone ends it at once,
+ * J288_ERR_OFFLINE). A failed attempt is re-sent up to config.retries times, each attempt's
+ * result kept in the j288_txn_t. A quiet guard follows every transaction (the full reply
+ * budget after a failure, so that a late reply dies out): a frame from another id, or one
+ * received outside the reply window, is counted and never credited to a transaction. Bytes
+ * received before a poll are examined before its deadline check: a late poll does not turn a
+ * good reply into a timeout.
  *
- *   IDLE -> TX -> [ECHO] -> WAIT_REPLY -> (done | timeout | crc | wrong id | collision |
- *   line error) -> GUARD -> IDLE
- *
- * - TX: the command is on the wire; the port reports the end with j288_bus_on_tx_done().
- * - ECHO (config.echo): a transceiver that hears itself returns our 20 bytes first; they are
- *   compared byte for byte, and a difference is a collision (the attempt ends as soon as
- *   the transmit is complete; an echo still incomplete at the deadline is one too).
- * - WAIT_REPLY: bytes go through the reply parser; a good reply from the addressed id ends
- *   the transaction. A good reply from another id, or a corrupt frame, is recorded and the
- *   wait goes on until the deadline; the result then names the most specific failure
- *   (wrong id > line > crc > timeout). The deadline is the wire time of command and reply at the
- *   configured baud plus turnaround_us plus margin_us, counted from the start of transmit.
- * - GUARD: a quiet gap before the next transmit (guard_us after success; after a failure the
- *   full reply budget, so that a late reply dies out). Anything received while idle, during
- *   the guard, or (without echo) before our transmit completes, is discarded and counted as
- *   stale; a frame from another id is never taken: a late reply is never credited to a
- *   later transaction. A broadcast ends when its transmit (and echo) is complete.
- * - Retries (config.retries): a failed attempt is re-sent after the guard; each attempt's
- *   reason is kept in the j288_txn_t. J288_ERR_OFFLINE (also a J288_LINE_GONE reported while
- *   waiting to retry) and an emergency stop end it at once.
- * - Line errors (j288_bus_on_error) during an attempt mark it: when no good reply comes, the
- *   result is J288_ERR_LINE (ranked wrong id > line > crc/truncated > timeout); a reply whose
- *   CRC checks out after a line error is still taken. J288_LINE_GONE ends the attempt at once
- *   with J288_ERR_OFFLINE, without retries. Outside an attempt they are only counted.
- * - A reply frame cut short (the line went idle inside it, or the deadline came with a part
- *   of a frame held) is J288_ERR_TRUNCATED; it counts as a crc error in the statistics.
- * - Bytes the machine looks at during poll were received before that poll: they are examined
- *   before the deadline is checked, so a late poll does not turn a good reply into a timeout.
- *
- * Events come from the port, usually in interrupt context, and only record (the receive path
- * copies into a ring inside the bus object). The machine advances in j288_bus_poll() (thread
- * context), or directly inside the event calls when config.advance_in_isr is set: then every
- * event call and j288_bus_on_timer() advance the machine, which lets sweeps run back to back
- * from interrupts; the port's UART, DMA and timer interrupts must then share one priority,
- * and thread-context calls are wrapped in the port's lock/unlock.
+ * Contexts: the port's event calls (j288_bus_on_*) only record, lock-free, from any context
+ * (32-bit loads and stores must be atomic, as on every Cortex-M). The machine advances in
+ * j288_bus_poll() (thread), or inside the event calls when config.advance_in_isr is set; the
+ * port's UART, DMA and timer interrupts must then share one priority, and thread-context
+ * calls are wrapped in the port's lock/unlock.
  *
  * Zero allocation; the bus object is caller-allocated and must not move while in use.
- * Several buses are independent. Event recording is lock-free (each field has one writer);
- * it assumes 32-bit loads and stores are atomic, as on every Cortex-M.
+ * Several buses are independent. The states and the path of a byte: docs/architecture.md.
  */
 #ifndef J288_BUS_H
 #define J288_BUS_H
