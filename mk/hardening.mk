@@ -16,7 +16,8 @@
 #   make soak-short      the CI variant, under valgrind memcheck when it is there
 # Outside CI a missing tool skips its target with a notice; with CI=true it is a failure.
 
-# Sub-builds reuse this build's Unity instead of fetching it again.
+# Sub-builds reuse this build's Unity instead of fetching it again. (A recipe line that runs
+# one through a variable starts with + so that it shares make's job slots.)
 SUBMAKE = UNITY_DIR=$(abspath $(UNITY)) $(MAKE) --no-print-directory
 
 # ---- fuzzing ---------------------------------------------------------------------------------
@@ -53,7 +54,7 @@ VALGRIND := valgrind -q --error-exitcode=1 --leak-check=full --show-leak-kinds=a
 
 .PHONY: test-asan test-valgrind
 test-asan: $(UNITY)/unity.c
-	ASAN_OPTIONS=detect_leaks=1:abort_on_error=0:detect_stack_use_after_return=1:strict_string_checks=1 \
+	+ASAN_OPTIONS=detect_leaks=1:abort_on_error=0:detect_stack_use_after_return=1:strict_string_checks=1 \
 	UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
 	    $(SUBMAKE) BUILD=$(BUILD)/asan EXTRA_CFLAGS="$(SAN_FLAGS)" EXTRA_LDFLAGS="$(SAN_FLAGS)" test
 
@@ -83,7 +84,7 @@ CROSS_32 := arm-linux-gnueabihf gcc-arm-linux-gnueabihf libc6-dev-armhf-cross qe
 
 .PHONY: test-be test-32 cross-run
 test-be test-32: test-%: $(UNITY)/unity.c
-	@set -- $(CROSS_$*); \
+	+@set -- $(CROSS_$*); \
 	 $(call REQUIRE,$$1-gcc,$$2 $$3); $(call REQUIRE,$$4,qemu-user); \
 	 $$1-gcc -dM -E - </dev/null | grep -q "$$5" || { echo "$$1-gcc: not the expected ABI" >&2; exit 1; }; \
 	 $(SUBMAKE) BUILD=$(BUILD)/$* CC=$$1-gcc AR=$$1-ar CROSS_WRAPPER="$$4 -L /usr/$$1" cross-run
@@ -99,7 +100,7 @@ COVERAGE_TESTS ?= $(UNIT_TESTS)
 
 .PHONY: coverage coverage-run
 coverage: $(UNITY)/unity.c
-	@$(call REQUIRE,gcovr,gcovr); \
+	+@$(call REQUIRE,gcovr,gcovr); \
 	 $(SUBMAKE) BUILD=$(BUILD)/cov OPT="-O0 -g" EXTRA_CFLAGS=--coverage EXTRA_LDFLAGS=--coverage coverage-run
 
 coverage-run: $(COVERAGE_TESTS)
