@@ -230,12 +230,15 @@ expect_bad plot_missing_png 2 'usage: j288 plot' "$J288" plot "$CSV"
 # ---- safe stop on SIGINT / SIGTERM -----------------------------------------------------------
 # safe_stop NAME SIGNAL WANT_RC IDS CMD...: run a moving command in the background until the
 # simulator has seen FOC frames for every id, signal it, and check that it exits promptly
-# with WANT_RC and that the last frame each id received is a lock.
+# with WANT_RC and that the last frame each id received is a lock. (--foreground: timeout
+# passes the signal to the command alone. Without it, timeout also signals its process group
+# and follows with SIGCONT; a SIGCONT that lands while an ASan build's leak check stops the
+# process at exit can leave it stopped until -k kills it: exit 137 under make test-asan.)
 safe_stop() {
     local name=$1 sig=$2 want=$3 ids=$4; shift 4
     local id pid rc ok=1 why="" from
     from=$(log_lines "$MAIN_LOG")
-    timeout -k 2 60 "$@" >"$E2E_TMP/bg.out" 2>"$E2E_TMP/bg.err" &
+    timeout --foreground -k 2 60 "$@" >"$E2E_TMP/bg.out" 2>"$E2E_TMP/bg.err" &
     pid=$!
     BG_PIDS+=("$pid")
     for id in ${ids//,/ }; do
