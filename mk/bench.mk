@@ -58,7 +58,7 @@ endef
 
 # The codec per CRC backend on Cortex-M4F, the STM32 port's CRC unit path included.
 BENCH_CODEC_SRC := $(LIB_SRC) port/stm32_hal/j288_stm32.c test/stm32/stub/stm32_hal_stub.c \
-    test/target/bench.c test/target/startup.c
+    test/target/bench.c $(call TC,m4f,STARTUP)
 $(foreach o,$(BENCH_OPTS),$(eval $(call BENCH_IMAGE,codec_m4f,m4f,$(BENCH_CODEC_SRC),\
     -Iport/stm32_hal -Itest/stm32/stub -DJ288_STUB_OMIT_CRC,$(o))))
 
@@ -73,7 +73,7 @@ bench-target:
 # The bus engine and the scheduler, port operations empty.
 BENCH_BUS_CPUS := m0 m4f
 $(foreach c,$(BENCH_BUS_CPUS),$(foreach o,$(BENCH_OPTS),$(eval $(call BENCH_IMAGE,bus_$(c),$(c),\
-    test/bench/bus_target.c test/target/startup.c $(LIB_SRC),,$(o)))))
+    test/bench/bus_target.c $(call TC,$(c),STARTUP) $(LIB_SRC),,$(o)))))
 
 bench-bus-target:
 	@$(call REQUIRE_TC,$(BENCH_BUS_CPUS),QEMU); \

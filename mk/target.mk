@@ -13,6 +13,8 @@ TC_arm_SIZE := arm-none-eabi-size
 TC_arm_PACKAGES := gcc-arm-none-eabi libnewlib-arm-none-eabi
 TC_arm_QEMU := qemu-system-arm
 TC_arm_QEMU_PACKAGES := qemu-system-arm
+# The vector table and reset code of the images run under QEMU (tests, benchmarks).
+TC_arm_STARTUP := test/target/startup.c
 # Images that print through semihosting (tests, benchmarks), and images with no I/O.
 TC_arm_SEMIHOST_LDFLAGS := -nostartfiles --specs=nano.specs --specs=rdimon.specs
 TC_arm_BARE_LDFLAGS := -nostartfiles --specs=nano.specs --specs=nosys.specs
@@ -103,7 +105,7 @@ stm32-example: $(STM32_EX_ELF)
 # Every test/unit/test_*.c, and the STM32 port against the fake HAL, built for every CPU.
 TGT_CPPFLAGS := $(TEST_CPPFLAGS) -Iport/stm32_hal -Itest/stm32/stub -Itest/stm32 $(STM32_TEST_DEFS)
 TGT_UNIT_NAMES := $(notdir $(basename $(UNIT_TEST_SRC)))
-TGT_COMMON_SRC := $(LIB_SRC) $(TEST_SUPPORT_SRC) test/target/startup.c
+TGT_COMMON_SRC := $(LIB_SRC) $(TEST_SUPPORT_SRC)
 TGT_STM32_SRC := test/stm32/test_stm32_port.c test/stm32/fake_hal.c port/stm32_hal/j288_stm32.c
 
 # Link $(3) from objects $(2) for CPU $(1). A CPU with a small board (CPU_<cpu>_SMALL_LD) is
@@ -121,7 +123,8 @@ $(BUILD)/target/$(1)/obj/unity.o: $(UNITY)/unity.c
 	@mkdir -p $$(@D)
 	$(call CPU_CC,$(1)) -std=c99 -O2 -g -ffunction-sections -I$(UNITY) $(UNITY_DEFS) -c $$< -o $$@
 
-TGT_$(1)_LIBOBJ := $(TGT_COMMON_SRC:%.c=$(BUILD)/target/$(1)/obj/%.o) $(BUILD)/target/$(1)/obj/unity.o
+TGT_$(1)_LIBOBJ := $(patsubst %.c,$(BUILD)/target/$(1)/obj/%.o,$(TGT_COMMON_SRC) $(call TC,$(1),STARTUP)) \
+    $(BUILD)/target/$(1)/obj/unity.o
 $(BUILD)/target/$(1)/test_%.elf: $(BUILD)/target/$(1)/obj/test/unit/test_%.o $$(TGT_$(1)_LIBOBJ) \
     test/target/sections.ld $(addprefix test/target/,$(CPU_$(1)_LD) $(CPU_$(1)_SMALL_LD))
 	$$(call TGT_LINK,$(1),$$(filter %.o,$$^),$$@)

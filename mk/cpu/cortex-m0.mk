@@ -1,7 +1,8 @@
 # Cortex-M0 (ARMv6-M, no FPU): soft-float ABI; the SI API, when built, is soft double.
 # (A CPU fragment names the CPU in CPUS and gives, once, what every build for it uses:
-# toolchain (mk/target.mk), core flags, the configuration they go with, the QEMU machine
-# and the memory map in test/target/ of the images run there.)
+# toolchain (TC_<name>_* in mk/target.mk, or in the fragment for a new one), core flags,
+# the configuration they go with, the QEMU machine and the memory map in test/target/ of
+# the images run there.)
 CPUS += m0
 CPU_m0_TOOLCHAIN := arm
 CPU_m0_FLAGS := -mcpu=cortex-m0 -mthumb -mfloat-abi=soft
