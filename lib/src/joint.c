@@ -19,6 +19,8 @@
 #define COUNT_MASK (J288_OUT_POS_COUNTS - 1u)
 #define HALF_TURN_COUNTS 4096
 #define TURN_COUNTS 8192
+/* The fit's continued count stays within this (65536 output turns), far from int32's end. */
+#define CONT_LIMIT 0x20000000
 /* Finite bound for speed, torque and gain limits (a float holds it). */
 #define BIG ((j288_real_t)1e30)
 
@@ -684,7 +686,8 @@ int j288_cal_add(j288_cal_t *cal, uint16_t out_pos, int32_t rotor_pos)
     if (cal == NULL) {
         return J288_ERR_NULL;
     }
-    if (out_pos > COUNT_MASK) {
+    if ((out_pos > COUNT_MASK) || (cal->n == UINT32_MAX) || (cal->cont > CONT_LIMIT) ||
+        (cal->cont < -CONT_LIMIT)) {
         return J288_ERR_RANGE;
     }
     if (cal->n == 0u) {

@@ -330,8 +330,9 @@ typedef struct {
 int j288_cal_init(j288_cal_t *cal, const j288_joint_config_t *cfg);
 
 /* One pair: OutPos count (0-8191) and rotor position (LSB) from the same reply. Consecutive
- * pairs must be less than half an output turn apart. Errors: J288_ERR_NULL, J288_ERR_RANGE
- * (out_pos > 8191). */
+ * pairs must be less than half an output turn apart. Errors (nothing taken): J288_ERR_NULL,
+ * J288_ERR_RANGE (out_pos > 8191; or 2^32 - 1 pairs, or a motion of 65536 turns, taken
+ * already: bounds no real motion reaches, kept so that no input can overflow). */
 int j288_cal_add(j288_cal_t *cal, uint16_t out_pos, int32_t rotor_pos);
 
 /* The pair of a reply; a reply with fault bit 12 is counted as rejected and skipped. Errors:
