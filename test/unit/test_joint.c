@@ -75,6 +75,18 @@ static void move_to(model_t *m, double theta)
     m->theta = theta;
 }
 
+/* A servo at output angle theta with phase c, just powered up there. */
+static model_t servo_at(double theta, double c)
+{
+    model_t m;
+    memset(&m, 0, sizeof m);
+    m.side = 1.0;
+    m.theta = theta;
+    m.c = c;
+    power_up(&m);
+    return m;
+}
+
 static j288_reply_raw_t reply_of(const model_t *m, uint8_t id)
 {
     j288_reply_raw_t r;
@@ -307,10 +319,8 @@ static void test_default_is_the_encoder_angle_wrapped(void)
     for (trial = 0; trial < 300; trial++) {
         double want;
         unsigned ev;
-        memset(&m, 0, sizeof m);
-        m.c = urand(-J288_PI, J288_PI);
-        m.theta = urand(-20.0, 20.0);
-        power_up(&m);
+        double c0 = urand(-J288_PI, J288_PI); /* drawn first, as before */
+        m = servo_at(urand(-20.0, 20.0), c0);
         m.theta += urand(-3.0, 3.0);
         TEST_ASSERT_EQUAL_INT(J288_OK, j288_joint_init(&joint, &c));
         ev = start_joint(&joint, &m);
@@ -337,10 +347,7 @@ static void test_start_events_and_refusals(void)
     model_t m;
     int i;
 
-    memset(&m, 0, sizeof m);
-    m.theta = 1.0;
-    m.c = 0.3;
-    power_up(&m);
+    m = servo_at(1.0, 0.3);
     c.init_samples = 4u;
     TEST_ASSERT_EQUAL_INT(J288_OK, j288_joint_init(&joint, &c));
     memset(&before, 0x5A, sizeof before);
@@ -442,9 +449,7 @@ static void test_state_speed_torque_and_direction(void)
     model_t m;
     int d;
 
-    memset(&m, 0, sizeof m);
-    m.theta = 0.25;
-    power_up(&m);
+    m = servo_at(0.25, 0.0);
     for (d = -1; d <= 1; d += 2) {
         c.direction = (int8_t)d;
         c.zero = (j288_real_t)0.75;
@@ -479,10 +484,7 @@ static void test_start_while_moving_and_outlier(void)
     model_t m;
     int i;
 
-    memset(&m, 0, sizeof m);
-    m.c = -2.0;
-    m.theta = 2.0;
-    power_up(&m);
+    m = servo_at(2.0, -2.0);
     TEST_ASSERT_EQUAL_INT(J288_OK, j288_joint_init(&joint, &c));
     for (i = 0; i < 8; i++) {
         (void)feed(&joint, &m);
@@ -518,10 +520,8 @@ static void test_start_average_while_moving(void)
     c.init_samples = 64u;
     for (trial = 0; trial < 50; trial++) {
         double step = COUNT * urand(0.3, 0.7);
-        memset(&m, 0, sizeof m);
-        m.c = urand(-J288_PI, J288_PI);
-        m.theta = urand(-3.0, 2.5);
-        power_up(&m);
+        double c0 = urand(-J288_PI, J288_PI);
+        m = servo_at(urand(-3.0, 2.5), c0);
         TEST_ASSERT_EQUAL_INT(J288_OK, j288_joint_init(&joint, &c));
         for (i = 0; i < 64; i++) {
             (void)feed(&joint, &m);
@@ -543,11 +543,9 @@ static void test_turn_choice(void)
     model_t m;
     unsigned ev;
 
-    memset(&m, 0, sizeof m);
     c.pos_min = (j288_real_t)5.8; /* the encoder wraps inside: 2 pi = 6.283 */
     c.pos_max = (j288_real_t)6.8;
-    m.theta = 6.6;
-    power_up(&m);
+    m = servo_at(6.6, 0.0);
     TEST_ASSERT_EQUAL_INT(J288_OK, j288_joint_init(&joint, &c));
     TEST_ASSERT_EQUAL_HEX(EVB(ANGLE_UNKNOWN) | EVB(ANGLE_KNOWN), start_joint(&joint, &m));
     TEST_ASSERT_DOUBLE_WITHIN(UNCAL_TOL, 6.6, j288_joint_state(&joint)->pos); /* not 0.317 */
@@ -598,12 +596,9 @@ static void test_range_across_the_wrap(void)
             c.zero = (j288_real_t)(TAU * 3.0 + 0.2); /* theta = 6 pi + 0.2 is joint 0 */
             c.pos_min = (j288_real_t)-0.6;
             c.pos_max = (j288_real_t)0.6;
-            memset(&m, 0, sizeof m);
-            m.c = 1.7;
+            m = servo_at((double)c.zero + d * 0.5, 1.7);
             c.has_phase = (mode == 1);
             c.phase = (j288_real_t)m.c;
-            m.theta = (double)c.zero + d * 0.5;
-            power_up(&m);
             TEST_ASSERT_EQUAL_INT(J288_OK, j288_joint_init(&joint, &c));
             (void)start_joint(&joint, &m);
             TEST_ASSERT_DOUBLE_WITHIN(tol, 0.5, j288_joint_state(&joint)->pos);
@@ -721,10 +716,7 @@ static void test_slipped_gear(void)
     model_t m;
     int32_t p_before;
 
-    memset(&m, 0, sizeof m);
-    m.c = 0.4;
-    m.theta = -1.0;
-    power_up(&m);
+    m = servo_at(-1.0, 0.4);
     c.has_phase = true;
     c.phase = (j288_real_t)m.c;
     TEST_ASSERT_EQUAL_INT(J288_OK, j288_joint_init(&joint, &c));
@@ -754,10 +746,7 @@ static void test_encoder_fault(void)
     model_t m;
     int i;
 
-    memset(&m, 0, sizeof m);
-    m.c = 2.5;
-    m.theta = 0.7;
-    power_up(&m);
+    m = servo_at(0.7, 2.5);
     c.init_samples = 3u;
     TEST_ASSERT_EQUAL_INT(J288_OK, j288_joint_init(&joint, &c));
     /* Unknown and faulty: no start, whatever OutPos says. */
@@ -800,12 +789,9 @@ static void test_large_rotor_positions(void)
     int32_t p0;
     int i;
 
-    memset(&m, 0, sizeof m);
     c.pos_min = (j288_real_t)2.0;
     c.pos_max = (j288_real_t)8.0;
-    m.c = 0.1;
-    m.theta = -5.9;
-    power_up(&m);
+    m = servo_at(-5.9, 0.1);
     move_to(&m, 5.9); /* 11.8 rad from power-up: 17.8 million LSB */
     TEST_ASSERT_EQUAL_INT(J288_OK, j288_joint_init(&joint, &c));
     (void)start_joint(&joint, &m);
@@ -936,28 +922,33 @@ static void test_command_round_trip(void)
 
 static void known_joint(j288_joint_config_t *c, model_t *m)
 {
-    memset(m, 0, sizeof *m);
-    m->c = -0.9;
-    m->theta = 0.2;
-    power_up(m);
+    *m = servo_at(0.2, -0.9);
     TEST_ASSERT_EQUAL_INT(J288_OK, j288_joint_init(&joint, c));
     (void)start_joint(&joint, m);
     TEST_ASSERT_TRUE(j288_joint_state(&joint)->known);
 }
 
-static void test_limits_refused(void)
+/* Joint 6 with limits [-0.5, 1.25] rad, 3 rad/s, 10 N*m, refusing or clamping. */
+static j288_joint_config_t limited_cfg(bool clamp)
 {
     j288_joint_config_t c = cfg_for(6u);
+    c.pos_min = (j288_real_t)-0.5;
+    c.pos_max = (j288_real_t)1.25;
+    c.max_speed = (j288_real_t)3.0;
+    c.max_torque = (j288_real_t)10.0;
+    c.clamp = clamp;
+    return c;
+}
+
+static void test_limits_refused(void)
+{
+    j288_joint_config_t c = limited_cfg(false);
     j288_joint_target_t t, good;
     j288_cmd_raw_t cmd, before;
     model_t m;
     unsigned clamped = 55u;
     int i;
 
-    c.pos_min = (j288_real_t)-0.5;
-    c.pos_max = (j288_real_t)1.25;
-    c.max_speed = (j288_real_t)3.0;
-    c.max_torque = (j288_real_t)10.0;
     c.kp = (j288_real_t)20.0;
     c.kd = (j288_real_t)0.5;
     known_joint(&c, &m);
@@ -1012,17 +1003,12 @@ static void test_limits_refused(void)
 
 static void test_limits_clamped(void)
 {
-    j288_joint_config_t c = cfg_for(6u);
+    j288_joint_config_t c = limited_cfg(true);
     j288_joint_target_t t, want;
     j288_cmd_raw_t cmd, ref;
     model_t m;
     unsigned clamped = 0u;
 
-    c.pos_min = (j288_real_t)-0.5;
-    c.pos_max = (j288_real_t)1.25;
-    c.max_speed = (j288_real_t)3.0;
-    c.max_torque = (j288_real_t)10.0;
-    c.clamp = true;
     known_joint(&c, &m);
     j288_joint_target_init(&joint, &t);
     t.pos = (j288_real_t)2.0;
@@ -1202,10 +1188,7 @@ static void test_fit_quality_checks(void)
     model_t m;
     int i;
 
-    memset(&m, 0, sizeof m);
-    m.c = 1.0;
-    m.theta = 0.3;
-    power_up(&m);
+    m = servo_at(0.3, 1.0);
     r = reply_of(&m, 1u);
     TEST_ASSERT_EQUAL_INT(J288_ERR_NULL, j288_cal_init(NULL, &c));
     c.direction = 3;
@@ -1292,12 +1275,9 @@ static void test_fit_across_the_wrap(void)
     int d;
 
     for (d = -1; d <= 1; d += 2) {
-        memset(&m, 0, sizeof m);
         c.direction = (int8_t)d;
         c.zero = (j288_real_t)(-TAU); /* theta = -2 pi (OutPos 0) is joint 0 */
-        m.c = -2.9;
-        m.theta = -TAU + 0.1;
-        power_up(&m);
+        m = servo_at(-TAU + 0.1, -2.9);
         TEST_ASSERT_EQUAL_INT(J288_OK, j288_cal_init(&cal, &c));
         sweep_fit(&cal, &m, -TAU, 0.04, 1000);
         TEST_ASSERT_EQUAL_INT(J288_OK, j288_cal_result(&cal, &rep));
@@ -1356,10 +1336,7 @@ static void bound_setup(j288_joint_config_t *c, model_t *m)
     j288_sched_config_t sc;
     j288_reply_raw_t r;
 
-    memset(m, 0, sizeof *m);
-    m->c = 0.6;
-    m->theta = -0.8;
-    power_up(m);
+    *m = servo_at(-0.8, 0.6);
     *c = cfg_for(JID);
     c->init_samples = 3u;
     c->kp = (j288_real_t)10.0;
