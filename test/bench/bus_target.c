@@ -172,6 +172,56 @@ static uint32_t run_sched_isr(void)
     return ticks_between(t0, t1);
 }
 
+#if J288_CONFIG_SI
+/* ---- the joint layer: a known joint taking replies (tracking, encoder check, limits) and
+ * turning targets into commands; each loop adds a few instructions of its own. */
+static j288_joint_t joint;
+static uint32_t joint_errors;
+
+static uint32_t run_joint_reply(void)
+{
+    j288_joint_config_t jc;
+    j288_reply_raw_t r;
+    uint32_t i, t0, t1;
+    memset(&jc, 0, sizeof jc);
+    memset(&r, 0, sizeof r);
+    jc.id = 3u;
+    r.id = 3u;
+    r.pos = 5000;
+    r.out_pos = 100u;
+    (void)j288_joint_init(&joint, &jc);
+    for (i = 0u; i < J288_JOINT_DEFAULT_INIT_SAMPLES; i++) {
+        (void)j288_joint_take_reply(&joint, &r, NULL);
+    }
+    t0 = systick_now();
+    for (i = 0u; i < ITERATIONS; i++) {
+        unsigned ev;
+        r.pos = 5000 + (int32_t)(i & 7u);
+        joint_errors += (uint32_t)(j288_joint_take_reply(&joint, &r, &ev) != J288_OK);
+    }
+    t1 = systick_now();
+    joint_errors += (uint32_t)!j288_joint_state(&joint)->known;
+    return ticks_between(t0, t1);
+}
+
+static uint32_t run_joint_command(void)
+{
+    j288_joint_target_t t;
+    j288_cmd_raw_t cmd;
+    uint32_t i, t0, t1;
+    j288_joint_target_init(&joint, &t);
+    t.kp = (j288_real_t)20;
+    t.kd = (j288_real_t)0.5;
+    t0 = systick_now();
+    for (i = 0u; i < ITERATIONS; i++) {
+        t.pos = (j288_real_t)(i & 7u) * (j288_real_t)0.01;
+        joint_errors += (uint32_t)(j288_joint_command(&joint, &t, &cmd, NULL) != J288_OK);
+    }
+    t1 = systick_now();
+    return ticks_between(t0, t1);
+}
+#endif
+
 int main(void)
 {
     uint32_t ipt, codec, poll, isr;
@@ -193,6 +243,15 @@ int main(void)
     printf("| codec only (encode, parse, unpack) | %lu |\n", (unsigned long)codec);
     printf("| bus, poll mode | %lu |\n", (unsigned long)poll);
     printf("| scheduler sweeps, advance_in_isr | %lu |\n", (unsigned long)isr);
+#if J288_CONFIG_SI
+    printf("| joint: reply -> state | %lu |\n", (unsigned long)per_txn(run_joint_reply(), ipt));
+    printf("| joint: target -> command | %lu |\n",
+           (unsigned long)per_txn(run_joint_command(), ipt));
+    if (joint_errors != 0u) {
+        printf("bus_target: the joint layer failed (%lu)\n", (unsigned long)joint_errors);
+        return 1;
+    }
+#endif
     if (done_count != 2u * ITERATIONS || sch.slot[14].stats.successes == 0u) {
         printf("bus_target: transactions did not complete (%lu)\n", (unsigned long)done_count);
         return 1;

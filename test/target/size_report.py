@@ -95,6 +95,8 @@ INDIRECT_SITES = [
     (r"^j288_crc32_run", ["crc32"]),
     (r"sched\.c:(next_slot|sched_lock|sched_unlock)", ["lock", "unlock"]),
     (r"sched\.c:emit", ["app"]),
+    (r"sched\.c:sched_done", ["app"]),  # on_reply: the application's hook (or the joint binding)
+    (r"^j288_joint_bus_on_reply|joint\.c:report", ["app"]),  # on_event
     (r"j288_stm32\.c:now_of", ["app"]),
 ]
 
