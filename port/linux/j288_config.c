@@ -138,9 +138,9 @@ int j288_config_write_joint(const char *path, const char *joint, const j288_conf
 
 #else /* J288_CONFIG_HAVE_YAML */
 
-#define PI            3.141592653589793
-#define TWO_PI        (2.0 * PI)
-#define VALUE_LIMIT   1e6 /* largest |zero| or |phase| written back */
+#define PI          3.141592653589793
+#define TWO_PI      (2.0 * PI)
+#define VALUE_LIMIT 1e6 /* largest |zero| or |phase| written back */
 
 bool j288_config_available(void)
 {
@@ -387,7 +387,51 @@ static void set_label(ctx_t *x, const char *kind, const char *name, size_t index
 }
 
 static const char *const bus_keys[] = {"name", "port", "baud", "margin_us", "echo"};
-#define BUS_KEYS_TEXT "name, port, baud, margin_us, echo"
+static const char *const joint_keys[] = {"name", "bus",    "id",        "direction",
+                                         "zero", "limits", "max_speed", "max_torque",
+                                         "kp",   "kd",     "phase",     "clamp"};
+#define JOINT_KEYS_TEXT                                                                            \
+    "name, bus, id, direction, zero, limits, max_speed, max_torque, kp, kd, phase, clamp"
+
+/* What a bus and a joint entry have in common. */
+typedef struct {
+    const char *kind; /* in messages: "bus", "joint" */
+    const char *list; /* the key of their list */
+    const char *const *keys;
+    size_t nkeys;
+    const char *keys_text;
+} entry_kind_t;
+
+static const entry_kind_t k_bus = {"bus", "buses", bus_keys, sizeof bus_keys / sizeof bus_keys[0],
+                                   "name, port, baud, margin_us, echo"};
+static const entry_kind_t k_joint = {"joint", "joints", joint_keys,
+                                     sizeof joint_keys / sizeof joint_keys[0], JOINT_KEYS_TEXT};
+
+/* Entry i of its list: a mapping of known keys with a name, copied into name
+ * (J288_CONFIG_NAME_MAX bytes); messages from here on name it. The name's node, or NULL. */
+static yaml_node_t *entry_name(ctx_t *x, yaml_node_t *m, size_t i, const entry_kind_t *k,
+                               char *name)
+{
+    char what[64];
+    yaml_node_t *v;
+    set_label(x, k->kind, NULL, i);
+    (void)snprintf(what, sizeof what, "a mapping per %s (- name: ...)", k->kind);
+    if (m->type != YAML_MAPPING_NODE) {
+        (void)expected(x, m, k->list, what);
+        return NULL;
+    }
+    set_label(x, k->kind, peek_name(x, m), i);
+    if (check_keys(x, m, k->keys, k->nkeys, k->keys_text) != 0)
+        return NULL;
+    if ((v = value_of(x, m, "name")) == NULL) {
+        (void)fail(x, line_of(m), "'name' is missing");
+        return NULL;
+    }
+    if (get_text(x, v, "name", true, name, J288_CONFIG_NAME_MAX) != 0)
+        return NULL;
+    set_label(x, k->kind, name, i);
+    return v;
+}
 
 static int parse_bus(ctx_t *x, yaml_node_t *m, size_t i)
 {
@@ -397,17 +441,8 @@ static int parse_bus(ctx_t *x, yaml_node_t *m, size_t i)
     size_t j;
     memset(b, 0, sizeof *b);
     b->line = (unsigned)line_of(m);
-    set_label(x, "bus", NULL, i);
-    if (m->type != YAML_MAPPING_NODE)
-        return expected(x, m, "buses", "a mapping per bus (- name: ...)");
-    set_label(x, "bus", peek_name(x, m), i);
-    if (check_keys(x, m, bus_keys, sizeof bus_keys / sizeof bus_keys[0], BUS_KEYS_TEXT) != 0)
+    if ((v = entry_name(x, m, i, &k_bus, b->name)) == NULL)
         return -1;
-    if ((v = value_of(x, m, "name")) == NULL)
-        return fail(x, line_of(m), "'name' is missing");
-    if (get_text(x, v, "name", true, b->name, sizeof b->name) != 0)
-        return -1;
-    set_label(x, "bus", b->name, i);
     for (j = 0; j < i; j++)
         if (strcmp(x->cfg->bus[j].name, b->name) == 0)
             return fail(x, line_of(v), "name: already used by the bus on line %u",
@@ -463,57 +498,39 @@ static int get_limits(ctx_t *x, const yaml_node_t *v, j288_config_joint_t *jt)
     return 0;
 }
 
-/* A number that must be above 0 (strict) or at least 0. */
-static int get_nonneg(ctx_t *x, const yaml_node_t *v, const char *key, bool strict, double *out)
+/* Bounds of a number: none, 0 or more, above 0. */
+typedef enum { ANY_VALUE, AT_LEAST_0, ABOVE_0 } bound_t;
+
+/* key's number in mapping m into *out, when it is there (then *has, if given, is set). */
+static int opt_number(ctx_t *x, const yaml_node_t *m, const char *key, bound_t bound, bool *has,
+                      double *out)
 {
+    yaml_node_t *v = value_of(x, m, key);
+    if (v == NULL)
+        return 0;
     if (get_number(x, v, key, out) != 0)
         return -1;
-    if (strict ? !(*out > 0.0) : !(*out >= 0.0))
+    if ((bound == AT_LEAST_0 && !(*out >= 0.0)) || (bound == ABOVE_0 && !(*out > 0.0)))
         return fail(x, line_of(v), "%s: %s must be %s", key, scalar(v),
-                    strict ? "above 0" : "0 or more");
+                    bound == ABOVE_0 ? "above 0" : "0 or more");
+    if (has != NULL)
+        *has = true;
     return 0;
 }
 
-static const char *const joint_keys[] = {"name", "bus",    "id",        "direction",
-                                         "zero", "limits", "max_speed", "max_torque",
-                                         "kp",   "kd",     "phase",     "clamp"};
-#define JOINT_KEYS_TEXT                                                                            \
-    "name, bus, id, direction, zero, limits, max_speed, max_torque, kp, kd, phase, clamp"
-
-/* Optional numbers of a joint: key, whether it must be above 0 / at least 0 / anything, and
- * where it goes. */
+/* The optional numbers of a joint. */
 static int parse_joint_numbers(ctx_t *x, const yaml_node_t *m, j288_config_joint_t *jt)
 {
     yaml_node_t *v;
-    if ((v = value_of(x, m, "zero")) != NULL && get_number(x, v, "zero", &jt->zero) != 0)
-        return -1;
     if ((v = value_of(x, m, "limits")) != NULL && get_limits(x, v, jt) != 0)
         return -1;
-    if ((v = value_of(x, m, "max_speed")) != NULL) {
-        if (get_nonneg(x, v, "max_speed", true, &jt->max_speed) != 0)
-            return -1;
-        jt->has_max_speed = true;
-    }
-    if ((v = value_of(x, m, "max_torque")) != NULL) {
-        if (get_nonneg(x, v, "max_torque", true, &jt->max_torque) != 0)
-            return -1;
-        jt->has_max_torque = true;
-    }
-    if ((v = value_of(x, m, "kp")) != NULL) {
-        if (get_nonneg(x, v, "kp", false, &jt->kp) != 0)
-            return -1;
-        jt->has_kp = true;
-    }
-    if ((v = value_of(x, m, "kd")) != NULL) {
-        if (get_nonneg(x, v, "kd", false, &jt->kd) != 0)
-            return -1;
-        jt->has_kd = true;
-    }
-    if ((v = value_of(x, m, "phase")) != NULL) {
-        if (get_number(x, v, "phase", &jt->phase) != 0)
-            return -1;
-        jt->has_phase = true;
-    }
+    if (opt_number(x, m, "zero", ANY_VALUE, NULL, &jt->zero) != 0 ||
+        opt_number(x, m, "max_speed", ABOVE_0, &jt->has_max_speed, &jt->max_speed) != 0 ||
+        opt_number(x, m, "max_torque", ABOVE_0, &jt->has_max_torque, &jt->max_torque) != 0 ||
+        opt_number(x, m, "kp", AT_LEAST_0, &jt->has_kp, &jt->kp) != 0 ||
+        opt_number(x, m, "kd", AT_LEAST_0, &jt->has_kd, &jt->kd) != 0 ||
+        opt_number(x, m, "phase", ANY_VALUE, &jt->has_phase, &jt->phase) != 0)
+        return -1;
     return 0;
 }
 
@@ -531,18 +548,8 @@ static int parse_joint(ctx_t *x, yaml_node_t *m, size_t i)
     jt->pos_max = PI;
     x->joint_node[i] = m;
     x->joint_bus[i] = NULL;
-    set_label(x, "joint", NULL, i);
-    if (m->type != YAML_MAPPING_NODE)
-        return expected(x, m, "joints", "a mapping per joint (- name: ...)");
-    set_label(x, "joint", peek_name(x, m), i);
-    if (check_keys(x, m, joint_keys, sizeof joint_keys / sizeof joint_keys[0], JOINT_KEYS_TEXT) !=
-        0)
+    if ((v = entry_name(x, m, i, &k_joint, jt->name)) == NULL)
         return -1;
-    if ((v = value_of(x, m, "name")) == NULL)
-        return fail(x, line_of(m), "'name' is missing");
-    if (get_text(x, v, "name", true, jt->name, sizeof jt->name) != 0)
-        return -1;
-    set_label(x, "joint", jt->name, i);
     for (j = 0; j < i; j++)
         if (strcmp(x->cfg->joint[j].name, jt->name) == 0)
             return fail(x, line_of(v), "name: already used by the joint on line %u",
