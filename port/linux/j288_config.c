@@ -50,20 +50,37 @@ int j288_config_find_bus(const j288_config_t *cfg, const char *name)
     return -1;
 }
 
-/* The whole file into a malloc'ed buffer (NUL-terminated for convenience). */
+/* The whole file into a malloc'ed buffer (NUL-terminated for convenience), growing it as
+ * needed up to J288_CONFIG_FILE_MAX bytes. */
 static int read_file(const char *path, char **text, size_t *len, char *err, size_t errlen)
 {
     FILE *f = fopen(path, "rb");
-    char *buf;
-    size_t n;
+    char *buf = NULL;
+    size_t cap = 0, n = 0;
     if (f == NULL)
         return set_error(err, errlen, "%s: cannot read: %s", path, strerror(errno));
-    buf = malloc(J288_CONFIG_FILE_MAX + 1u);
-    if (buf == NULL) {
-        (void)fclose(f);
-        return set_error(err, errlen, "%s: out of memory", path);
+    for (;;) {
+        if (n == cap) {
+            char *bigger;
+            if (cap > J288_CONFIG_FILE_MAX) {
+                (void)fclose(f);
+                free(buf);
+                return set_error(err, errlen, "%s: larger than %u bytes: not a robot config", path,
+                                 J288_CONFIG_FILE_MAX);
+            }
+            cap = (cap == 0u) ? 4096u : 2u * cap;
+            bigger = realloc(buf, cap + 1u);
+            if (bigger == NULL) {
+                (void)fclose(f);
+                free(buf);
+                return set_error(err, errlen, "%s: out of memory", path);
+            }
+            buf = bigger;
+        }
+        n += fread(buf + n, 1, cap - n, f);
+        if (n < cap)
+            break; /* end of file or an error */
     }
-    n = fread(buf, 1, J288_CONFIG_FILE_MAX + 1u, f);
     if (ferror(f)) {
         (void)fclose(f);
         free(buf);

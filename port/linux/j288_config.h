@@ -41,9 +41,10 @@
  * over it; the file's permission bits are kept; a symlink is followed, not replaced). A
  * joint written as a flow mapping ({name: hip, ...}) can have values replaced, not added.
  *
- * No allocation by callers: structures are caller-allocated with fixed capacities (libyaml
- * allocates internally while a file is read). Not thread-safe per object; functions are
- * reentrant. When the build found no libyaml, every function fails with a message saying so
+ * No allocation by callers: structures are caller-allocated with fixed capacities (the
+ * functions allocate internally for the file's text and libyaml's document, and free it
+ * before they return). Not thread-safe per object; functions are reentrant. When the build
+ * found no libyaml, every function that reads or writes a file fails with a message saying so
  * (j288_config_available() tells beforehand).
  */
 #ifndef J288_CONFIG_H
