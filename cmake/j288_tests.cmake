@@ -149,6 +149,29 @@ if(TARGET j288_sim AND EXISTS "${J288_SRC}/test/linux/test_linux_port.c")
         LIBS j288_unity j288_linux j288::j288)
 endif()
 
+# ---- the robot config reader (mk/linux.mk): libyaml as scripts/libyaml.sh finds it ----------
+if(TARGET j288_linux AND EXISTS "${J288_SRC}/test/linux/test_config.c")
+    set(_yaml_dir "${PROJECT_BINARY_DIR}/libyaml")
+    if(NOT EXISTS "${_yaml_dir}/libyaml.env")
+        execute_process(COMMAND bash "${J288_SRC}/scripts/libyaml.sh" "${_yaml_dir}"
+                                "${CMAKE_C_COMPILER}"
+                        WORKING_DIRECTORY "${J288_SRC}")
+    endif()
+    set(YAML_CFLAGS "")
+    set(YAML_LIBS "")
+    file(STRINGS "${_yaml_dir}/libyaml.env" _yaml_lines)
+    foreach(_line ${_yaml_lines})
+        if(_line MATCHES "^(YAML_[A-Z]+)=(.*)$")
+            separate_arguments(${CMAKE_MATCH_1} UNIX_COMMAND "${CMAKE_MATCH_2}")
+        endif()
+    endforeach()
+    j288_add_test(test_config test/test_config
+        SOURCES "${J288_SRC}/test/linux/test_config.c" "${J288_SRC}/port/linux/j288_config.c"
+        INCLUDES ${J288_TEST_INCLUDES} "${J288_SRC}/port/linux"
+        LIBS j288_unity ${YAML_LIBS})
+    target_compile_options(test_config PRIVATE ${YAML_CFLAGS})
+endif()
+
 # ---- the simulator's servo model (mk/sim.mk) ------------------------------------------------
 if(TARGET j288_sim AND EXISTS "${J288_SRC}/test/sim/test_sim_model.c")
     j288_add_test(test_sim_model test/test_sim_model
