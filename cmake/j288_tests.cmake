@@ -150,7 +150,7 @@ if(TARGET j288_sim AND EXISTS "${J288_SRC}/test/linux/test_linux_port.c")
 endif()
 
 # ---- the robot config reader (mk/linux.mk): libyaml as scripts/libyaml.sh finds it ----------
-if(TARGET j288_linux AND EXISTS "${J288_SRC}/test/linux/test_config.c")
+if(TARGET j288_linux AND EXISTS "${J288_SRC}/test/linux/test_robot_config.c")
     set(_yaml_dir "${PROJECT_BINARY_DIR}/libyaml")
     if(NOT EXISTS "${_yaml_dir}/libyaml.env")
         execute_process(COMMAND bash "${J288_SRC}/scripts/libyaml.sh" "${_yaml_dir}"
@@ -165,11 +165,11 @@ if(TARGET j288_linux AND EXISTS "${J288_SRC}/test/linux/test_config.c")
             separate_arguments(${CMAKE_MATCH_1} UNIX_COMMAND "${CMAKE_MATCH_2}")
         endif()
     endforeach()
-    j288_add_test(test_config test/test_config
-        SOURCES "${J288_SRC}/test/linux/test_config.c" "${J288_SRC}/port/linux/j288_config.c"
+    j288_add_test(test_robot_config test/test_robot_config
+        SOURCES "${J288_SRC}/test/linux/test_robot_config.c" "${J288_SRC}/port/linux/j288_robot_config.c"
         INCLUDES ${J288_TEST_INCLUDES} "${J288_SRC}/port/linux"
         LIBS j288_unity ${YAML_LIBS})
-    target_compile_options(test_config PRIVATE ${YAML_CFLAGS})
+    target_compile_options(test_robot_config PRIVATE ${YAML_CFLAGS})
 endif()
 
 # ---- the simulator's servo model (mk/sim.mk) ------------------------------------------------

@@ -38,32 +38,32 @@ HOST_TESTS += $(LINUX_PORT_TEST)
 TEST_DEPS += $(BIN)/j288-sim
 endif
 
-# The robot config reader (port/linux/j288_config.c, not in the archive: it needs libyaml).
+# The robot config reader (port/linux/j288_robot_config.c, not in the archive: it needs libyaml).
 # scripts/libyaml.sh finds libyaml (the system's, else Debian's package fetched into
 # $(BUILD)/libyaml) and writes the flags into $(YAML_ENV); without it the reader builds as
 # stubs that say so. Users: $(CONFIG_OBJ) and $(call yaml_var,YAML_LIBS) in a recipe.
 YAML_ENV := $(BUILD)/libyaml/libyaml.env
 yaml_var = $$(sed -n 's/^$(1)=//p' $(YAML_ENV))
-CONFIG_OBJ := $(OBJ)/port/linux/j288_config.o
-CONFIG_TEST := $(BUILD)/test/test_config
+CONFIG_OBJ := $(OBJ)/port/linux/j288_robot_config.o
+CONFIG_TEST := $(BUILD)/test/test_robot_config
 
 $(YAML_ENV):
 	bash scripts/libyaml.sh $(BUILD)/libyaml "$(CC)"
 
-$(CONFIG_OBJ): port/linux/j288_config.c port/linux/j288_config.h $(YAML_ENV)
+$(CONFIG_OBJ): port/linux/j288_robot_config.c port/linux/j288_robot_config.h $(YAML_ENV)
 	@mkdir -p $(@D)
 	$(CC) $(LINUX_CPPFLAGS) $(call yaml_var,YAML_CFLAGS) $(CFLAGS_COMMON) -c $< -o $@
 
-$(OBJ)/test/linux/test_config.o: test/linux/test_config.c port/linux/j288_config.h \
+$(OBJ)/test/linux/test_robot_config.o: test/linux/test_robot_config.c port/linux/j288_robot_config.h \
                                  $(UNITY)/unity.c $(YAML_ENV)
 	@mkdir -p $(@D)
 	$(CC) $(TEST_CPPFLAGS) -Iport/linux $(call yaml_var,YAML_CFLAGS) $(CFLAGS_COMMON) -c $< -o $@
 
-$(CONFIG_TEST): $(OBJ)/test/linux/test_config.o $(CONFIG_OBJ) $(UNITY_OBJ)
+$(CONFIG_TEST): $(OBJ)/test/linux/test_robot_config.o $(CONFIG_OBJ) $(UNITY_OBJ)
 	@mkdir -p $(@D)
 	$(CC) $(CFLAGS_COMMON) $^ -o $@ $(LDFLAGS_COMMON) $(call yaml_var,YAML_LIBS) -lm
 
-ifneq ($(wildcard test/linux/test_config.c),)
+ifneq ($(wildcard test/linux/test_robot_config.c),)
 ALL_TARGETS += $(CONFIG_TEST)
 HOST_TESTS += $(CONFIG_TEST)
 endif

@@ -8,7 +8,7 @@ packages=(
     make gcc clang-14 coreutils
     gnuplot-nox                     # make demo / cli_bus.sh plot test (PNG); CI treats it as required
     cmake                           # scripts/ci-cmake.sh
-    libyaml-dev                     # robot config reader (port/linux/j288_config.c, test_config)
+    libyaml-dev                     # robot config reader (port/linux/j288_robot_config.c, test_robot_config)
     qemu-system-arm                 # make test-target, bench-target, bench-bus-target (Cortex-M)
     # hardening (mk/hardening.mk)
     clang-14 libclang-rt-14-dev     # make fuzz / fuzz-ci (libFuzzer, ASan, UBSan)

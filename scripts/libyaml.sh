@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
-# Find libyaml for the robot config reader (port/linux/j288_config.c) and write what the build
+# Find libyaml for the robot config reader (port/linux/j288_robot_config.c) and write what the build
 # needs into DIR/libyaml.env, one VAR=value per line (read by mk/linux.mk and CMake):
 #   YAML_FOUND=1 or 0
-#   YAML_CFLAGS=-DJ288_CONFIG_HAVE_YAML [-I<include dir>]   (empty when not found)
+#   YAML_CFLAGS=-DJ288_HAVE_LIBYAML [-I<include dir>]   (empty when not found)
 #   YAML_LIBS=-lyaml, or <dir>/libyaml.a                     (empty when not found)
 # Order: the system's libyaml (Debian's libyaml-dev; a compile-and-link probe with CC), else
 # Debian's libyaml-dev fetched without root (apt-get download with a private apt state, as
@@ -42,7 +42,7 @@ result() { # FOUND CFLAGS LIBS
 }
 
 if [ $use_system -eq 1 ] && probe "" -lyaml; then
-    result 1 "-DJ288_CONFIG_HAVE_YAML" "-lyaml"
+    result 1 "-DJ288_HAVE_LIBYAML" "-lyaml"
     exit 0
 fi
 
@@ -75,7 +75,7 @@ local_copy() { # sets inc, lib from DIR/root; true when they are there
 }
 if local_copy || { fetch && local_copy; }; then
     if probe "-I$inc" "$lib"; then
-        result 1 "-DJ288_CONFIG_HAVE_YAML -I$inc" "$lib"
+        result 1 "-DJ288_HAVE_LIBYAML -I$inc" "$lib"
         echo "libyaml: using Debian's $(cat "$dir/root/.package" 2>/dev/null || echo libyaml-dev) unpacked in $dir/root"
         exit 0
     fi

@@ -1,7 +1,7 @@
-/* j288_config.c - the robot config file; see j288_config.h. */
+/* j288_robot_config.c - the robot config file; see j288_robot_config.h. */
 #define _XOPEN_SOURCE 700 /* realpath, mkstemp, fchmod, fsync under -std=c99 */
 
-#include "j288_config.h"
+#include "j288_robot_config.h"
 
 #include <errno.h>
 #include <limits.h>
@@ -13,7 +13,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-#ifdef J288_CONFIG_HAVE_YAML
+#ifdef J288_HAVE_LIBYAML
 #include <yaml.h>
 #endif
 
@@ -32,7 +32,7 @@ static int set_error(char *err, size_t errlen, const char *fmt, ...)
     return -1;
 }
 
-const j288_config_joint_t *j288_config_find_joint(const j288_config_t *cfg, const char *name)
+const j288_robot_config_joint_t *j288_robot_config_find_joint(const j288_robot_config_t *cfg, const char *name)
 {
     size_t i;
     for (i = 0; i < cfg->njoints; i++)
@@ -41,7 +41,7 @@ const j288_config_joint_t *j288_config_find_joint(const j288_config_t *cfg, cons
     return NULL;
 }
 
-int j288_config_find_bus(const j288_config_t *cfg, const char *name)
+int j288_robot_config_find_bus(const j288_robot_config_t *cfg, const char *name)
 {
     size_t i;
     for (i = 0; i < cfg->nbuses; i++)
@@ -51,7 +51,7 @@ int j288_config_find_bus(const j288_config_t *cfg, const char *name)
 }
 
 /* The whole file into a malloc'ed buffer (NUL-terminated for convenience), growing it as
- * needed up to J288_CONFIG_FILE_MAX bytes. */
+ * needed up to J288_ROBOT_CONFIG_FILE_MAX bytes. */
 static int read_file(const char *path, char **text, size_t *len, char *err, size_t errlen)
 {
     FILE *f = fopen(path, "rb");
@@ -62,11 +62,11 @@ static int read_file(const char *path, char **text, size_t *len, char *err, size
     for (;;) {
         if (n == cap) {
             char *bigger;
-            if (cap > J288_CONFIG_FILE_MAX) {
+            if (cap > J288_ROBOT_CONFIG_FILE_MAX) {
                 (void)fclose(f);
                 free(buf);
                 return set_error(err, errlen, "%s: larger than %u bytes: not a robot config", path,
-                                 J288_CONFIG_FILE_MAX);
+                                 J288_ROBOT_CONFIG_FILE_MAX);
             }
             cap = (cap == 0u) ? 4096u : 2u * cap;
             bigger = realloc(buf, cap + 1u);
@@ -87,10 +87,10 @@ static int read_file(const char *path, char **text, size_t *len, char *err, size
         return set_error(err, errlen, "%s: cannot read: %s", path, strerror(errno));
     }
     (void)fclose(f);
-    if (n > J288_CONFIG_FILE_MAX) {
+    if (n > J288_ROBOT_CONFIG_FILE_MAX) {
         free(buf);
         return set_error(err, errlen, "%s: larger than %u bytes: not a robot config", path,
-                         J288_CONFIG_FILE_MAX);
+                         J288_ROBOT_CONFIG_FILE_MAX);
     }
     buf[n] = '\0';
     *text = buf;
@@ -98,31 +98,31 @@ static int read_file(const char *path, char **text, size_t *len, char *err, size
     return 0;
 }
 
-int j288_config_load(const char *path, j288_config_t *cfg, char *err, size_t errlen)
+int j288_robot_config_load(const char *path, j288_robot_config_t *cfg, char *err, size_t errlen)
 {
     char *text = NULL;
     size_t len = 0;
     int rc;
-    if (!j288_config_available()) /* say that first, not whether the file exists */
-        return j288_config_parse("", 0, path, cfg, err, errlen);
+    if (!j288_robot_config_available()) /* say that first, not whether the file exists */
+        return j288_robot_config_parse("", 0, path, cfg, err, errlen);
     if (read_file(path, &text, &len, err, errlen) != 0)
         return -1;
-    rc = j288_config_parse(text, len, path, cfg, err, errlen);
+    rc = j288_robot_config_parse(text, len, path, cfg, err, errlen);
     free(text);
     return rc;
 }
 
-#ifndef J288_CONFIG_HAVE_YAML
+#ifndef J288_HAVE_LIBYAML
 
 /* Built without libyaml: every entry point says so. */
 #define NO_YAML "robot config files need libyaml: this build has none (install libyaml-dev)"
 
-bool j288_config_available(void)
+bool j288_robot_config_available(void)
 {
     return false;
 }
 
-int j288_config_parse(const char *text, size_t len, const char *name, j288_config_t *cfg, char *err,
+int j288_robot_config_parse(const char *text, size_t len, const char *name, j288_robot_config_t *cfg, char *err,
                       size_t errlen)
 {
     (void)text;
@@ -131,8 +131,8 @@ int j288_config_parse(const char *text, size_t len, const char *name, j288_confi
     return set_error(err, errlen, "%s: %s", name, NO_YAML);
 }
 
-int j288_config_edit(const char *text, size_t len, const char *name, const char *joint,
-                     const j288_config_update_t *upd, char *out, size_t outcap, size_t *outlen,
+int j288_robot_config_edit(const char *text, size_t len, const char *name, const char *joint,
+                     const j288_robot_config_update_t *upd, char *out, size_t outcap, size_t *outlen,
                      char *err, size_t errlen)
 {
     (void)text;
@@ -145,7 +145,7 @@ int j288_config_edit(const char *text, size_t len, const char *name, const char 
     return set_error(err, errlen, "%s: %s", name, NO_YAML);
 }
 
-int j288_config_write_joint(const char *path, const char *joint, const j288_config_update_t *upd,
+int j288_robot_config_write_joint(const char *path, const char *joint, const j288_robot_config_update_t *upd,
                             char *err, size_t errlen)
 {
     (void)joint;
@@ -153,13 +153,13 @@ int j288_config_write_joint(const char *path, const char *joint, const j288_conf
     return set_error(err, errlen, "%s: %s", path, NO_YAML);
 }
 
-#else /* J288_CONFIG_HAVE_YAML */
+#else /* J288_HAVE_LIBYAML */
 
 #define PI          3.141592653589793
 #define TWO_PI      (2.0 * PI)
 #define VALUE_LIMIT 1e6 /* largest |zero| or |phase| written back */
 
-bool j288_config_available(void)
+bool j288_robot_config_available(void)
 {
     return true;
 }
@@ -173,11 +173,11 @@ typedef struct {
     size_t len;
     yaml_document_t doc;
     bool have_doc;
-    j288_config_t *cfg;
-    yaml_node_t *joint_node[J288_CONFIG_MAX_JOINTS];
-    yaml_node_t *joint_bus[J288_CONFIG_MAX_JOINTS]; /* the value of 'bus:', or NULL */
+    j288_robot_config_t *cfg;
+    yaml_node_t *joint_node[J288_ROBOT_CONFIG_MAX_JOINTS];
+    yaml_node_t *joint_bus[J288_ROBOT_CONFIG_MAX_JOINTS]; /* the value of 'bus:', or NULL */
     size_t joints_line;                             /* the 'joints:' key, 1-based; 0: none */
-    char label[J288_CONFIG_NAME_MAX + 16];          /* "joint 'hip': ", for messages */
+    char label[J288_ROBOT_CONFIG_NAME_MAX + 16];          /* "joint 'hip': ", for messages */
     char *err;
     size_t errlen;
 } ctx_t;
@@ -388,7 +388,7 @@ static const char *peek_name(ctx_t *x, const yaml_node_t *m)
         yaml_node_t *k = node_at(x, p->key);
         yaml_node_t *v = node_at(x, p->value);
         if (k->type == YAML_SCALAR_NODE && strcmp(scalar(k), "name") == 0 &&
-            v->type == YAML_SCALAR_NODE && v->data.scalar.length < J288_CONFIG_NAME_MAX &&
+            v->type == YAML_SCALAR_NODE && v->data.scalar.length < J288_ROBOT_CONFIG_NAME_MAX &&
             strlen(scalar(v)) == v->data.scalar.length)
             return scalar(v);
     }
@@ -425,7 +425,7 @@ static const entry_kind_t k_joint = {"joint", "joints", joint_keys,
                                      sizeof joint_keys / sizeof joint_keys[0], JOINT_KEYS_TEXT};
 
 /* Entry i of its list: a mapping of known keys with a name, copied into name
- * (J288_CONFIG_NAME_MAX bytes); messages from here on name it. The name's node, or NULL. */
+ * (J288_ROBOT_CONFIG_NAME_MAX bytes); messages from here on name it. The name's node, or NULL. */
 static yaml_node_t *entry_name(ctx_t *x, yaml_node_t *m, size_t i, const entry_kind_t *k,
                                char *name)
 {
@@ -444,7 +444,7 @@ static yaml_node_t *entry_name(ctx_t *x, yaml_node_t *m, size_t i, const entry_k
         (void)fail(x, line_of(m), "'name' is missing");
         return NULL;
     }
-    if (get_text(x, v, "name", true, name, J288_CONFIG_NAME_MAX) != 0)
+    if (get_text(x, v, "name", true, name, J288_ROBOT_CONFIG_NAME_MAX) != 0)
         return NULL;
     set_label(x, k->kind, name, i);
     return v;
@@ -452,7 +452,7 @@ static yaml_node_t *entry_name(ctx_t *x, yaml_node_t *m, size_t i, const entry_k
 
 static int parse_bus(ctx_t *x, yaml_node_t *m, size_t i)
 {
-    j288_config_bus_t *b = &x->cfg->bus[i];
+    j288_robot_config_bus_t *b = &x->cfg->bus[i];
     yaml_node_t *v;
     long n;
     size_t j;
@@ -492,7 +492,7 @@ static int parse_bus(ctx_t *x, yaml_node_t *m, size_t i)
     return 0;
 }
 
-static int get_limits(ctx_t *x, const yaml_node_t *v, j288_config_joint_t *jt)
+static int get_limits(ctx_t *x, const yaml_node_t *v, j288_robot_config_joint_t *jt)
 {
     yaml_node_t *lo, *hi;
     if (v->type != YAML_SEQUENCE_NODE ||
@@ -536,7 +536,7 @@ static int opt_number(ctx_t *x, const yaml_node_t *m, const char *key, bound_t b
 }
 
 /* The optional numbers of a joint. */
-static int parse_joint_numbers(ctx_t *x, const yaml_node_t *m, j288_config_joint_t *jt)
+static int parse_joint_numbers(ctx_t *x, const yaml_node_t *m, j288_robot_config_joint_t *jt)
 {
     yaml_node_t *v;
     if ((v = value_of(x, m, "limits")) != NULL && get_limits(x, v, jt) != 0)
@@ -553,13 +553,13 @@ static int parse_joint_numbers(ctx_t *x, const yaml_node_t *m, j288_config_joint
 
 static int parse_joint(ctx_t *x, yaml_node_t *m, size_t i)
 {
-    j288_config_joint_t *jt = &x->cfg->joint[i];
+    j288_robot_config_joint_t *jt = &x->cfg->joint[i];
     yaml_node_t *v;
     long n;
     size_t j;
     memset(jt, 0, sizeof *jt);
     jt->line = (unsigned)line_of(m);
-    jt->bus = J288_CONFIG_NO_BUS;
+    jt->bus = J288_ROBOT_CONFIG_NO_BUS;
     jt->direction = 1;
     jt->pos_min = -PI;
     jt->pos_max = PI;
@@ -596,27 +596,27 @@ static int parse_joint(ctx_t *x, yaml_node_t *m, size_t i)
 /* After every bus and joint is read: each joint's bus, and ids unique per bus. */
 static int resolve_joints(ctx_t *x)
 {
-    j288_config_t *cfg = x->cfg;
+    j288_robot_config_t *cfg = x->cfg;
     size_t i, j;
     for (i = 0; i < cfg->njoints; i++) {
-        j288_config_joint_t *jt = &cfg->joint[i];
+        j288_robot_config_joint_t *jt = &cfg->joint[i];
         yaml_node_t *v = x->joint_bus[i];
-        char name[J288_CONFIG_NAME_MAX];
+        char name[J288_ROBOT_CONFIG_NAME_MAX];
         set_label(x, "joint", jt->name, i);
         if (v == NULL) {
             if (cfg->nbuses > 1u)
                 return fail(x, jt->line, "'bus' is missing (the file has %zu buses)", cfg->nbuses);
-            jt->bus = (cfg->nbuses == 1u) ? 0 : J288_CONFIG_NO_BUS;
+            jt->bus = (cfg->nbuses == 1u) ? 0 : J288_ROBOT_CONFIG_NO_BUS;
         } else {
             if (get_text(x, v, "bus", true, name, sizeof name) != 0)
                 return -1;
-            jt->bus = j288_config_find_bus(cfg, name);
+            jt->bus = j288_robot_config_find_bus(cfg, name);
             if (jt->bus < 0)
                 return fail(x, line_of(v), "bus: no bus is named '%s'%s", name,
                             cfg->nbuses == 0u ? " (the file has no 'buses:')" : "");
         }
         for (j = 0; j < i; j++) {
-            char on_bus[J288_CONFIG_NAME_MAX + 16] = "";
+            char on_bus[J288_ROBOT_CONFIG_NAME_MAX + 16] = "";
             if (cfg->joint[j].bus != jt->bus || cfg->joint[j].id != jt->id)
                 continue;
             if (jt->bus >= 0)
@@ -664,11 +664,11 @@ static int parse_root(ctx_t *x)
         return expected(x, root, "the file", "a mapping with 'buses:' and 'joints:'");
     if (check_keys(x, root, top_keys, 2, "buses, joints") != 0)
         return -1;
-    if (parse_list(x, value_of(x, root, "buses"), "buses", J288_CONFIG_MAX_BUSES, &x->cfg->nbuses,
+    if (parse_list(x, value_of(x, root, "buses"), "buses", J288_ROBOT_CONFIG_MAX_BUSES, &x->cfg->nbuses,
                    parse_bus) != 0)
         return -1;
     x->label[0] = '\0';
-    if (parse_list(x, value_of(x, root, "joints"), "joints", J288_CONFIG_MAX_JOINTS,
+    if (parse_list(x, value_of(x, root, "joints"), "joints", J288_ROBOT_CONFIG_MAX_JOINTS,
                    &x->cfg->njoints, parse_joint) != 0)
         return -1;
     for (p = root->data.mapping.pairs.start; p < root->data.mapping.pairs.top; p++)
@@ -766,7 +766,7 @@ static void ctx_done(ctx_t *x)
 }
 
 /* Parse text into x->cfg, keeping the document for an edit (ctx_done() frees it). */
-static int ctx_parse(ctx_t *x, const char *text, size_t len, const char *name, j288_config_t *cfg,
+static int ctx_parse(ctx_t *x, const char *text, size_t len, const char *name, j288_robot_config_t *cfg,
                      char *err, size_t errlen)
 {
     yaml_parser_t p;
@@ -799,7 +799,7 @@ static int ctx_parse(ctx_t *x, const char *text, size_t len, const char *name, j
     return 0;
 }
 
-int j288_config_parse(const char *text, size_t len, const char *name, j288_config_t *cfg, char *err,
+int j288_robot_config_parse(const char *text, size_t len, const char *name, j288_robot_config_t *cfg, char *err,
                       size_t errlen)
 {
     ctx_t x;
@@ -912,7 +912,7 @@ static int plan_edit(ctx_t *x, yaml_node_t *m, const char *key, const char *valu
     return 0;
 }
 
-static bool same_bus(const j288_config_bus_t *a, const j288_config_bus_t *b)
+static bool same_bus(const j288_robot_config_bus_t *a, const j288_robot_config_bus_t *b)
 {
     return strcmp(a->name, b->name) == 0 && strcmp(a->port, b->port) == 0 &&
            a->has_baud == b->has_baud && a->baud == b->baud &&
@@ -921,7 +921,7 @@ static bool same_bus(const j288_config_bus_t *a, const j288_config_bus_t *b)
 }
 
 /* Equal but for the line and, when skip_zero / skip_phase, those values. */
-static bool same_joint(const j288_config_joint_t *a, const j288_config_joint_t *b, bool skip_zero,
+static bool same_joint(const j288_robot_config_joint_t *a, const j288_robot_config_joint_t *b, bool skip_zero,
                        bool skip_phase)
 {
     return strcmp(a->name, b->name) == 0 && a->bus == b->bus && a->id == b->id &&
@@ -935,10 +935,10 @@ static bool same_joint(const j288_config_joint_t *a, const j288_config_joint_t *
 }
 
 /* The edited text must read as the old one with only the new values changed. */
-static int check_edit(const j288_config_t *before, const j288_config_t *after, size_t ji,
-                      const j288_config_update_t *upd, const char *name, char *err, size_t errlen)
+static int check_edit(const j288_robot_config_t *before, const j288_robot_config_t *after, size_t ji,
+                      const j288_robot_config_update_t *upd, const char *name, char *err, size_t errlen)
 {
-    const j288_config_joint_t *jt = &after->joint[ji];
+    const j288_robot_config_joint_t *jt = &after->joint[ji];
     size_t i;
     bool same = before->nbuses == after->nbuses && before->njoints == after->njoints;
     for (i = 0; same && i < before->nbuses; i++)
@@ -957,7 +957,7 @@ static int check_edit(const j288_config_t *before, const j288_config_t *after, s
     return 0;
 }
 
-static int check_update(const j288_config_update_t *upd, const char *name, char *err, size_t errlen)
+static int check_update(const j288_robot_config_update_t *upd, const char *name, char *err, size_t errlen)
 {
     if (!upd->set_zero && !upd->set_phase)
         return set_error(err, errlen, "%s: nothing to change (neither zero nor phase)", name);
@@ -999,8 +999,8 @@ static int apply_edits(const ctx_t *x, edit_t *ed, size_t n, char *out, size_t o
 
 /* The edit, with the configurations before and after in caller-given (heap) space. */
 static int edit_text(const char *text, size_t len, const char *name, const char *joint,
-                     const j288_config_update_t *upd, char *out, size_t outcap, size_t *outlen,
-                     j288_config_t *before, j288_config_t *after, char *err, size_t errlen)
+                     const j288_robot_config_update_t *upd, char *out, size_t outcap, size_t *outlen,
+                     j288_robot_config_t *before, j288_robot_config_t *after, char *err, size_t errlen)
 {
     ctx_t x;
     edit_t ed[2];
@@ -1035,16 +1035,16 @@ static int edit_text(const char *text, size_t len, const char *name, const char 
             *outlen += bom;
     }
     ctx_done(&x);
-    if (rc == 0 && j288_config_parse(out, *outlen, name, after, err, errlen) != 0)
+    if (rc == 0 && j288_robot_config_parse(out, *outlen, name, after, err, errlen) != 0)
         return -1;
     return (rc == 0) ? check_edit(before, after, ji, upd, name, err, errlen) : -1;
 }
 
-int j288_config_edit(const char *text, size_t len, const char *name, const char *joint,
-                     const j288_config_update_t *upd, char *out, size_t outcap, size_t *outlen,
+int j288_robot_config_edit(const char *text, size_t len, const char *name, const char *joint,
+                     const j288_robot_config_update_t *upd, char *out, size_t outcap, size_t *outlen,
                      char *err, size_t errlen)
 {
-    j288_config_t *cfg = malloc(2u * sizeof *cfg);
+    j288_robot_config_t *cfg = malloc(2u * sizeof *cfg);
     int rc;
     if (cfg == NULL)
         return set_error(err, errlen, "%s: out of memory", name);
@@ -1095,7 +1095,7 @@ fail:
     return -1;
 }
 
-int j288_config_write_joint(const char *path, const char *joint, const j288_config_update_t *upd,
+int j288_robot_config_write_joint(const char *path, const char *joint, const j288_robot_config_update_t *upd,
                             char *err, size_t errlen)
 {
     char real[PATH_MAX];
@@ -1115,7 +1115,7 @@ int j288_config_write_joint(const char *path, const char *joint, const j288_conf
         free(text);
         return set_error(err, errlen, "%s: out of memory", path);
     }
-    rc = j288_config_edit(text, len, path, joint, upd, out, outcap, &outlen, err, errlen);
+    rc = j288_robot_config_edit(text, len, path, joint, upd, out, outcap, &outlen, err, errlen);
     if (rc == 0)
         rc = replace_file(real, path, out, outlen, st.st_mode, err, errlen);
     free(out);
@@ -1123,4 +1123,4 @@ int j288_config_write_joint(const char *path, const char *joint, const j288_conf
     return rc;
 }
 
-#endif /* J288_CONFIG_HAVE_YAML */
+#endif /* J288_HAVE_LIBYAML */

@@ -1,4 +1,4 @@
-/* Unit tests of the robot config reader and writer (port/linux/j288_config.c). */
+/* Unit tests of the robot config reader and writer (port/linux/j288_robot_config.c). */
 #define _XOPEN_SOURCE 700 /* mkdtemp, symlink, readlink under -std=c99 */
 
 #include "unity.h"
@@ -11,12 +11,12 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-#include "j288_config.h"
+#include "j288_robot_config.h"
 
 #define NAME "robot.yaml"
 
-static j288_config_t g_cfg;
-static char g_err[J288_CONFIG_ERROR_MAX];
+static j288_robot_config_t g_cfg;
+static char g_err[J288_ROBOT_CONFIG_ERROR_MAX];
 static char g_out[8192];
 static size_t g_outlen;
 
@@ -28,11 +28,11 @@ void setUp(void)
 
 void tearDown(void) {}
 
-#ifdef J288_CONFIG_HAVE_YAML
+#ifdef J288_HAVE_LIBYAML
 
 static int parse(const char *text)
 {
-    return j288_config_parse(text, strlen(text), NAME, &g_cfg, g_err, sizeof g_err);
+    return j288_robot_config_parse(text, strlen(text), NAME, &g_cfg, g_err, sizeof g_err);
 }
 
 /* text must fail with "robot.yaml:LINE: " and a message holding part. */
@@ -84,7 +84,7 @@ static const char *const k_full = "# A robot with two legs.\n"
 
 static void test_full_file(void)
 {
-    const j288_config_joint_t *j;
+    const j288_robot_config_joint_t *j;
     TEST_ASSERT_EQUAL_INT_MESSAGE(0, parse(k_full), g_err);
     TEST_ASSERT_EQUAL_UINT(2, g_cfg.nbuses);
     TEST_ASSERT_EQUAL_STRING("left", g_cfg.bus[0].name);
@@ -97,7 +97,7 @@ static void test_full_file(void)
     TEST_ASSERT_EQUAL_STRING("right", g_cfg.bus[1].name);
     TEST_ASSERT_FALSE(g_cfg.bus[1].has_baud || g_cfg.bus[1].has_margin_us || g_cfg.bus[1].has_echo);
     TEST_ASSERT_EQUAL_UINT(3, g_cfg.njoints);
-    j = j288_config_find_joint(&g_cfg, "hip");
+    j = j288_robot_config_find_joint(&g_cfg, "hip");
     TEST_ASSERT_NOT_NULL(j);
     TEST_ASSERT_EQUAL_INT(0, j->bus);
     TEST_ASSERT_EQUAL_UINT8(1, j->id);
@@ -115,26 +115,26 @@ static void test_full_file(void)
     TEST_ASSERT_EQUAL_DOUBLE(2.1, j->phase);
     TEST_ASSERT_TRUE(j->clamp);
     TEST_ASSERT_EQUAL_UINT(11, j->line);
-    j = j288_config_find_joint(&g_cfg, "knee");
+    j = j288_robot_config_find_joint(&g_cfg, "knee");
     TEST_ASSERT_NOT_NULL(j);
     TEST_ASSERT_EQUAL_DOUBLE(0.0, j->pos_min);
     TEST_ASSERT_EQUAL_DOUBLE(2.5, j->pos_max);
     TEST_ASSERT_FALSE(j->has_phase || j->clamp || j->has_kp);
-    j = j288_config_find_joint(&g_cfg, "hip_r");
+    j = j288_robot_config_find_joint(&g_cfg, "hip_r");
     TEST_ASSERT_NOT_NULL(j);
     TEST_ASSERT_EQUAL_INT(1, j->bus); /* the same id on another bus is fine */
-    TEST_ASSERT_NULL(j288_config_find_joint(&g_cfg, "ankle"));
-    TEST_ASSERT_EQUAL_INT(1, j288_config_find_bus(&g_cfg, "right"));
-    TEST_ASSERT_EQUAL_INT(-1, j288_config_find_bus(&g_cfg, "middle"));
+    TEST_ASSERT_NULL(j288_robot_config_find_joint(&g_cfg, "ankle"));
+    TEST_ASSERT_EQUAL_INT(1, j288_robot_config_find_bus(&g_cfg, "right"));
+    TEST_ASSERT_EQUAL_INT(-1, j288_robot_config_find_bus(&g_cfg, "middle"));
 }
 
 static void test_defaults(void)
 {
-    const j288_config_joint_t *j;
+    const j288_robot_config_joint_t *j;
     TEST_ASSERT_EQUAL_INT_MESSAGE(0, parse("joints:\n  - name: a\n    id: 0\n"), g_err);
     TEST_ASSERT_EQUAL_UINT(0, g_cfg.nbuses);
     j = &g_cfg.joint[0];
-    TEST_ASSERT_EQUAL_INT(J288_CONFIG_NO_BUS, j->bus);
+    TEST_ASSERT_EQUAL_INT(J288_ROBOT_CONFIG_NO_BUS, j->bus);
     TEST_ASSERT_EQUAL_INT(1, j->direction);
     TEST_ASSERT_EQUAL_DOUBLE(0.0, j->zero);
     TEST_ASSERT_FALSE(j->has_limits || j->has_max_speed || j->has_max_torque || j->has_kp ||
@@ -278,30 +278,30 @@ static void test_errors_capacity(void)
     static char text[8192];
     size_t n, i;
     n = (size_t)snprintf(text, sizeof text, "joints:\n");
-    for (i = 0; i < J288_CONFIG_MAX_JOINTS + 1u; i++)
+    for (i = 0; i < J288_ROBOT_CONFIG_MAX_JOINTS + 1u; i++)
         n += (size_t)snprintf(text + n, sizeof text - n, "  - {name: j%zu, id: %zu, bus: b%zu}\n",
                               i, i % 15u, i / 15u);
     n += (size_t)snprintf(text + n, sizeof text - n, "buses:\n");
     for (i = 0; i < 5u; i++)
         n += (size_t)snprintf(text + n, sizeof text - n, "  - {name: b%zu, port: /dev/p%zu}\n", i,
                               i);
-    check_error(text, 2u + J288_CONFIG_MAX_JOINTS, "joints: more than 64");
+    check_error(text, 2u + J288_ROBOT_CONFIG_MAX_JOINTS, "joints: more than 64");
     n = (size_t)snprintf(text, sizeof text, "buses:\n");
-    for (i = 0; i < J288_CONFIG_MAX_BUSES + 1u; i++)
+    for (i = 0; i < J288_ROBOT_CONFIG_MAX_BUSES + 1u; i++)
         n += (size_t)snprintf(text + n, sizeof text - n, "  - {name: b%zu, port: /dev/p%zu}\n", i,
                               i);
-    check_error(text, 2u + J288_CONFIG_MAX_BUSES, "buses: more than 16");
+    check_error(text, 2u + J288_ROBOT_CONFIG_MAX_BUSES, "buses: more than 16");
     /* Exactly the capacity is fine. */
     n = (size_t)snprintf(text, sizeof text, "buses:\n");
     for (i = 0; i < 5u; i++)
         n += (size_t)snprintf(text + n, sizeof text - n, "  - {name: b%zu, port: /dev/p%zu}\n", i,
                               i);
     n += (size_t)snprintf(text + n, sizeof text - n, "joints:\n");
-    for (i = 0; i < J288_CONFIG_MAX_JOINTS; i++)
+    for (i = 0; i < J288_ROBOT_CONFIG_MAX_JOINTS; i++)
         n += (size_t)snprintf(text + n, sizeof text - n, "  - {name: j%zu, id: %zu, bus: b%zu}\n",
                               i, i % 15u, i / 15u);
     TEST_ASSERT_EQUAL_INT_MESSAGE(0, parse(text), g_err);
-    TEST_ASSERT_EQUAL_UINT(J288_CONFIG_MAX_JOINTS, g_cfg.njoints);
+    TEST_ASSERT_EQUAL_UINT(J288_ROBOT_CONFIG_MAX_JOINTS, g_cfg.njoints);
 }
 
 static void test_errors_malformed(void)
@@ -328,24 +328,24 @@ static void test_errors_malformed(void)
 
 /* ---- write-back ------------------------------------------------------------------------- */
 
-static int edit(const char *text, const char *joint, const j288_config_update_t *upd)
+static int edit(const char *text, const char *joint, const j288_robot_config_update_t *upd)
 {
-    return j288_config_edit(text, strlen(text), NAME, joint, upd, g_out, sizeof g_out - 1u,
+    return j288_robot_config_edit(text, strlen(text), NAME, joint, upd, g_out, sizeof g_out - 1u,
                             &g_outlen, g_err, sizeof g_err);
 }
 
-static j288_config_update_t zero_upd(double z)
+static j288_robot_config_update_t zero_upd(double z)
 {
-    j288_config_update_t u;
+    j288_robot_config_update_t u;
     memset(&u, 0, sizeof u);
     u.set_zero = true;
     u.zero = z;
     return u;
 }
 
-static j288_config_update_t phase_upd(double c)
+static j288_robot_config_update_t phase_upd(double c)
 {
-    j288_config_update_t u;
+    j288_robot_config_update_t u;
     memset(&u, 0, sizeof u);
     u.set_phase = true;
     u.phase = c;
@@ -362,7 +362,7 @@ static void check_output(const char *expected)
 
 static void test_edit_replaces_in_place(void)
 {
-    j288_config_update_t u = zero_upd(0.125);
+    j288_robot_config_update_t u = zero_upd(0.125);
     TEST_ASSERT_EQUAL_INT_MESSAGE(0, edit(k_full, "hip", &u), g_err);
     {
         /* k_full with "zero: 0.25" -> "zero: 0.125" and nothing else. */
@@ -381,7 +381,7 @@ static void test_edit_replaces_in_place(void)
 
 static void test_edit_adds_missing_key(void)
 {
-    j288_config_update_t u = phase_upd(2.718281828459);
+    j288_robot_config_update_t u = phase_upd(2.718281828459);
     char expected[2048];
     const char *at;
     /* knee ends with a block list and a comment: the new line goes after the list's last
@@ -411,7 +411,7 @@ static void test_edit_adds_missing_key(void)
 
 static void test_edit_line_endings_and_unicode(void)
 {
-    j288_config_update_t u = phase_upd(1.0);
+    j288_robot_config_update_t u = phase_upd(1.0);
     /* CRLF: the new line ends as the others do. */
     TEST_ASSERT_EQUAL_INT_MESSAGE(0, edit("joints:\r\n  - name: a\r\n    id: 1\r\n", "a", &u),
                                   g_err);
@@ -448,7 +448,7 @@ static void test_edit_value_format(void)
                  {3.14159265358979, "3.141592654"}};
     size_t i;
     for (i = 0; i < sizeof cases / sizeof cases[0]; i++) {
-        j288_config_update_t u = zero_upd(cases[i].v);
+        j288_robot_config_update_t u = zero_upd(cases[i].v);
         char expected[128];
         TEST_ASSERT_EQUAL_INT_MESSAGE(0, edit("joints: [{name: a, id: 1, zero: 9}]\n", "a", &u),
                                       g_err);
@@ -460,7 +460,7 @@ static void test_edit_value_format(void)
 
 static void test_edit_refusals(void)
 {
-    j288_config_update_t u = phase_upd(1.0);
+    j288_robot_config_update_t u = phase_upd(1.0);
     /* A flow mapping can have values replaced (above), not added. */
     TEST_ASSERT_EQUAL_INT(-1, edit("joints:\n  - {name: a, id: 1}\n", "a", &u));
     TEST_ASSERT_EQUAL_STRING_LEN(NAME ":2: joint 'a': is written as a flow mapping", g_err,
@@ -481,7 +481,7 @@ static void test_edit_refusals(void)
     TEST_ASSERT_NOT_NULL(strstr(g_err, "nothing to change"));
     /* Too small an output buffer is an error, not an overflow. */
     u = zero_upd(1.0);
-    TEST_ASSERT_EQUAL_INT(-1, j288_config_edit("joints:\n  - name: a\n    id: 1\n", 30u, NAME, "a",
+    TEST_ASSERT_EQUAL_INT(-1, j288_robot_config_edit("joints:\n  - name: a\n    id: 1\n", 30u, NAME, "a",
                                                &u, g_out, 30u, &g_outlen, g_err, sizeof g_err));
     TEST_ASSERT_NOT_NULL(strstr(g_err, "output buffer too small"));
 }
@@ -526,20 +526,20 @@ static size_t files_in_dir(void)
 static void test_file_round_trip(void)
 {
     char path[128], link[128], target[128];
-    j288_config_update_t u = phase_upd(0.333);
+    j288_robot_config_update_t u = phase_upd(0.333);
     struct stat st;
     ssize_t n;
     (void)snprintf(path, sizeof path, "%s/robot.yaml", g_dir);
     (void)snprintf(link, sizeof link, "%s/link.yaml", g_dir);
     write_text(path, k_full);
     TEST_ASSERT_EQUAL_INT(0, chmod(path, 0640));
-    TEST_ASSERT_EQUAL_INT_MESSAGE(0, j288_config_write_joint(path, "knee", &u, g_err, sizeof g_err),
+    TEST_ASSERT_EQUAL_INT_MESSAGE(0, j288_robot_config_write_joint(path, "knee", &u, g_err, sizeof g_err),
                                   g_err);
     TEST_ASSERT_EQUAL_INT(0, stat(path, &st));
     TEST_ASSERT_EQUAL_UINT(0640, st.st_mode & 07777);
-    TEST_ASSERT_EQUAL_INT_MESSAGE(0, j288_config_load(path, &g_cfg, g_err, sizeof g_err), g_err);
-    TEST_ASSERT_EQUAL_DOUBLE(0.333, j288_config_find_joint(&g_cfg, "knee")->phase);
-    TEST_ASSERT_EQUAL_DOUBLE(2.1, j288_config_find_joint(&g_cfg, "hip")->phase);
+    TEST_ASSERT_EQUAL_INT_MESSAGE(0, j288_robot_config_load(path, &g_cfg, g_err, sizeof g_err), g_err);
+    TEST_ASSERT_EQUAL_DOUBLE(0.333, j288_robot_config_find_joint(&g_cfg, "knee")->phase);
+    TEST_ASSERT_EQUAL_DOUBLE(2.1, j288_robot_config_find_joint(&g_cfg, "hip")->phase);
     TEST_ASSERT_EQUAL_UINT(1, files_in_dir()); /* no temporary file left */
     /* Writing the same value again changes nothing; through a symlink, the target changes
      * and the link stays a link. */
@@ -548,11 +548,11 @@ static void test_file_round_trip(void)
         (void)snprintf(before, sizeof before, "%s", read_text(path));
         TEST_ASSERT_EQUAL_INT(0, symlink("robot.yaml", link));
         TEST_ASSERT_EQUAL_INT_MESSAGE(
-            0, j288_config_write_joint(link, "knee", &u, g_err, sizeof g_err), g_err);
+            0, j288_robot_config_write_joint(link, "knee", &u, g_err, sizeof g_err), g_err);
         TEST_ASSERT_EQUAL_STRING(before, read_text(path));
         u.phase = 0.5;
         TEST_ASSERT_EQUAL_INT_MESSAGE(
-            0, j288_config_write_joint(link, "knee", &u, g_err, sizeof g_err), g_err);
+            0, j288_robot_config_write_joint(link, "knee", &u, g_err, sizeof g_err), g_err);
         n = readlink(link, target, sizeof target - 1u);
         TEST_ASSERT_EQUAL_INT(10, n);
         TEST_ASSERT_NOT_NULL(strstr(read_text(path), "    phase: 0.5\n"));
@@ -561,14 +561,14 @@ static void test_file_round_trip(void)
     {
         char before[8192];
         (void)snprintf(before, sizeof before, "%s", read_text(path));
-        TEST_ASSERT_EQUAL_INT(-1, j288_config_write_joint(path, "hip_x", &u, g_err, sizeof g_err));
+        TEST_ASSERT_EQUAL_INT(-1, j288_robot_config_write_joint(path, "hip_x", &u, g_err, sizeof g_err));
         TEST_ASSERT_EQUAL_STRING(before, read_text(path));
     }
     TEST_ASSERT_EQUAL_INT(0, unlink(link));
     TEST_ASSERT_EQUAL_INT(0, unlink(path));
-    TEST_ASSERT_EQUAL_INT(-1, j288_config_write_joint(path, "a", &u, g_err, sizeof g_err));
+    TEST_ASSERT_EQUAL_INT(-1, j288_robot_config_write_joint(path, "a", &u, g_err, sizeof g_err));
     TEST_ASSERT_NOT_NULL(strstr(g_err, "No such file"));
-    TEST_ASSERT_EQUAL_INT(-1, j288_config_load(path, &g_cfg, g_err, sizeof g_err));
+    TEST_ASSERT_EQUAL_INT(-1, j288_robot_config_load(path, &g_cfg, g_err, sizeof g_err));
     TEST_ASSERT_NOT_NULL(strstr(g_err, "robot.yaml: cannot read: No such file"));
 }
 
@@ -580,10 +580,10 @@ static void test_file_too_large(void)
     (void)snprintf(path, sizeof path, "%s/big.yaml", g_dir);
     f = fopen(path, "wb");
     TEST_ASSERT_NOT_NULL(f);
-    for (i = 0; i <= J288_CONFIG_FILE_MAX / 16u; i++)
+    for (i = 0; i <= J288_ROBOT_CONFIG_FILE_MAX / 16u; i++)
         (void)fputs("# padding......\n", f);
     (void)fclose(f);
-    TEST_ASSERT_EQUAL_INT(-1, j288_config_load(path, &g_cfg, g_err, sizeof g_err));
+    TEST_ASSERT_EQUAL_INT(-1, j288_robot_config_load(path, &g_cfg, g_err, sizeof g_err));
     TEST_ASSERT_NOT_NULL(strstr(g_err, "larger than 1048576 bytes"));
     TEST_ASSERT_EQUAL_INT(0, unlink(path));
 }
@@ -623,8 +623,8 @@ int main(void)
 static void test_without_libyaml(void)
 {
     const char *ci = getenv("CI");
-    TEST_ASSERT_FALSE(j288_config_available());
-    TEST_ASSERT_EQUAL_INT(-1, j288_config_load("robot.yaml", &g_cfg, g_err, sizeof g_err));
+    TEST_ASSERT_FALSE(j288_robot_config_available());
+    TEST_ASSERT_EQUAL_INT(-1, j288_robot_config_load("robot.yaml", &g_cfg, g_err, sizeof g_err));
     TEST_ASSERT_NOT_NULL(strstr(g_err, "robot.yaml: robot config files need libyaml"));
     if (ci != NULL && strcmp(ci, "true") == 0)
         TEST_FAIL_MESSAGE("built without libyaml under CI=true: install libyaml-dev");
