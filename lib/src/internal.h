@@ -137,6 +137,12 @@ static inline void j288_bus_unlock(const j288_bus_t *bus)
 
 /* ---- parser */
 
+/* j288_parser_reset() for the bus, which owns its parser: drop a partial frame. */
+static inline void j288_parser_drop(j288_parser_t *p)
+{
+    p->len = 0u;
+}
+
 /*
  * j288_parser_feed() without the copy: on J288_PARSE_FRAME, *frame points at the good frame,
  * which is inside data when it arrived whole while the parser was hunting (checked where it

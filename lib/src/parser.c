@@ -237,6 +237,6 @@ int j288_parser_flush(j288_parser_t *p)
 void j288_parser_reset(j288_parser_t *p)
 {
     if (p != NULL) {
-        p->len = 0u;
+        j288_parser_drop(p);
     }
 }
