@@ -5,7 +5,7 @@
 
 /* T0[i] = i * x^32 mod P (poly 0x04C11DB7, MSB first): the CRC register's top byte i shifted
  * out through 8 bits. Generated once and checked against the bitwise backend by the tests. */
-static const uint32_t crc_table256[256] = {
+const uint32_t j288_crc_table256[256] = {
     0x00000000u, 0x04C11DB7u, 0x09823B6Eu, 0x0D4326D9u,
     0x130476DCu, 0x17C56B6Bu, 0x1A864DB2u, 0x1E475005u,
     0x2608EDB8u, 0x22C9F00Fu, 0x2F8AD6D6u, 0x2B4BCB61u,
@@ -76,7 +76,7 @@ static const uint32_t crc_table256[256] = {
  * word costs four independent lookups instead of four dependent steps. Three arrays rather
  * than one [3][256], so that each lookup is one indexed load from its own base. Generated
  * once, checked by the tests against the bitwise backend. */
-static const uint32_t crc_slice1[256] = {
+const uint32_t j288_crc_slice1[256] = {
     0x00000000u, 0xD219C1DCu, 0xA0F29E0Fu, 0x72EB5FD3u,
     0x452421A9u, 0x973DE075u, 0xE5D6BFA6u, 0x37CF7E7Au,
     0x8A484352u, 0x5851828Eu, 0x2ABADD5Du, 0xF8A31C81u,
@@ -143,7 +143,7 @@ static const uint32_t crc_slice1[256] = {
     0x3C547B1Au, 0xEE4DBAC6u, 0x9CA6E515u, 0x4EBF24C9u,
 };
 
-static const uint32_t crc_slice2[256] = {
+const uint32_t j288_crc_slice2[256] = {
     0x00000000u, 0x01D8AC87u, 0x03B1590Eu, 0x0269F589u,
     0x0762B21Cu, 0x06BA1E9Bu, 0x04D3EB12u, 0x050B4795u,
     0x0EC56438u, 0x0F1DC8BFu, 0x0D743D36u, 0x0CAC91B1u,
@@ -210,7 +210,7 @@ static const uint32_t crc_slice2[256] = {
     0xB545ECF4u, 0xB49D4073u, 0xB6F4B5FAu, 0xB72C197Du,
 };
 
-static const uint32_t crc_slice3[256] = {
+const uint32_t j288_crc_slice3[256] = {
     0x00000000u, 0xDC6D9AB7u, 0xBC1A28D9u, 0x6077B26Eu,
     0x7CF54C05u, 0xA098D6B2u, 0xC0EF64DCu, 0x1C82FE6Bu,
     0xF9EA980Au, 0x258702BDu, 0x45F0B0D3u, 0x999D2A64u,
@@ -284,28 +284,12 @@ static const uint32_t crc_slice3[256] = {
  * assembled with shifts, which the compiler turns into a single load where the core allows
  * unaligned loads.
  */
-static inline uint32_t table_word(uint32_t crc, const uint8_t *p)
-{
-    uint32_t c = crc ^ j288_get_u32le(p);
-    c = (c << 8) ^ crc_table256[c >> 24];
-    c = (c << 8) ^ crc_table256[c >> 24];
-    c = (c << 8) ^ crc_table256[c >> 24];
-    return (c << 8) ^ crc_table256[c >> 24];
-}
-
-static inline uint32_t slice4_word(uint32_t crc, const uint8_t *p)
-{
-    uint32_t c = crc ^ j288_get_u32le(p);
-    return crc_slice3[c >> 24] ^ crc_slice2[(c >> 16) & 0xFFu] ^ crc_slice1[(c >> 8) & 0xFFu] ^
-           crc_table256[c & 0xFFu];
-}
-
 uint32_t j288_crc32_update_table(uint32_t crc, const uint8_t *data, size_t nwords)
 {
     uint32_t c = crc;
     size_t w;
     for (w = 0; w < nwords; w++) {
-        c = table_word(c, &data[4u * w]);
+        c = j288_crc_table_word(c, &data[4u * w]);
     }
     return c;
 }
@@ -315,7 +299,7 @@ uint32_t j288_crc32_update_slice4(uint32_t crc, const uint8_t *data, size_t nwor
     uint32_t c = crc;
     size_t w;
     for (w = 0; w < nwords; w++) {
-        c = slice4_word(c, &data[4u * w]);
+        c = j288_crc_slice4_word(c, &data[4u * w]);
     }
     return c;
 }
@@ -359,44 +343,17 @@ uint32_t j288_crc32(const uint8_t *data, size_t nwords)
     return j288_crc_default(data, nwords);
 }
 
-/* Frames are checked at the wire's rate, so the table backends' loop is unrolled for a frame's
- * four or five words: a loop would cost a fifth of a word's work per word here. */
-#if (J288_CONFIG_CRC_BACKEND == J288_CRC_BACKEND_TABLE) ||                                   \
-    (J288_CONFIG_CRC_BACKEND == J288_CRC_BACKEND_SLICE4)
-#if J288_CONFIG_CRC_BACKEND == J288_CRC_BACKEND_TABLE
-#define FRAME_WORD table_word
-#else
-#define FRAME_WORD slice4_word
-#endif
 uint32_t j288_crc_frame_default(const uint8_t *data, size_t nwords)
 {
-    uint32_t c = FRAME_WORD(J288_CRC32_INIT, data);
-    size_t w;
-    c = FRAME_WORD(c, &data[4]);
-    c = FRAME_WORD(c, &data[8]);
-    c = FRAME_WORD(c, &data[12]);
-    if (nwords == 4u) {
-        return c;
-    }
-    c = FRAME_WORD(c, &data[16]);
-    for (w = 5u; w < nwords; w++) {
-        c = FRAME_WORD(c, &data[4u * w]);
-    }
-    return c;
+    return j288_crc_frame_unrolled(data, nwords);
 }
-#else
-uint32_t j288_crc_frame_default(const uint8_t *data, size_t nwords)
-{
-    return j288_crc_default(data, nwords);
-}
-#endif
 
 uint32_t j288_crc32_mpeg2_bytes(const uint8_t *data, size_t len)
 {
     uint32_t crc = J288_CRC32_INIT;
     size_t i;
     for (i = 0; i < len; i++) {
-        crc = (crc << 8) ^ crc_table256[(crc >> 24) ^ data[i]];
+        crc = (crc << 8) ^ j288_crc_table256[(crc >> 24) ^ data[i]];
     }
     return crc;
 }

@@ -76,7 +76,7 @@ int j288_cmd_encode(const j288_cmd_raw_t *cmd, uint8_t out[J288_CMD_LEN], const 
     j288_store_le32(&out[CMD_TAU], pair16(cmd->tau, cmd->speed));
     j288_store_le32(&out[CMD_POS], from_i32(cmd->pos));
     j288_store_le32(&out[CMD_KP], pair16(cmd->kp, cmd->kd));
-    j288_store_le32(&out[CMD_CRC], j288_crc_frame(crc, out, CMD_CRC_WORDS));
+    j288_store_le32(&out[CMD_CRC], j288_crc_frame_hot(crc, out, CMD_CRC_WORDS));
     return J288_OK;
 }
 

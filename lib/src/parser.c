@@ -31,9 +31,9 @@ int j288_parser_init(j288_parser_t *p, j288_parse_kind_t kind, const j288_crc_t 
 }
 
 /* The CRC of a whole frame at f against its field, the frame's last four bytes. */
-static bool frame_crc_ok(const j288_parser_t *p, const uint8_t *f)
+static inline bool frame_crc_ok(const j288_parser_t *p, const uint8_t *f)
 {
-    return j288_crc_frame(p->crc, &f[p->crc_first], p->crc_words) ==
+    return j288_crc_frame_hot(p->crc, &f[p->crc_first], p->crc_words) ==
            j288_get_u32le(&f[p->frame_len - 4u]);
 }
 
@@ -167,8 +167,8 @@ static size_t take_first(j288_parser_t *p, const uint8_t *data, size_t len, bool
     return p->frame_len;
 }
 
-int j288_parser_scan(j288_parser_t *p, const uint8_t *data, size_t len, size_t *consumed,
-                     const uint8_t **frame)
+static inline int scan(j288_parser_t *p, const uint8_t *data, size_t len, size_t *consumed,
+                       const uint8_t **frame)
 {
     bool good;
     size_t from = take_first(p, data, len, &good);
@@ -180,11 +180,15 @@ int j288_parser_scan(j288_parser_t *p, const uint8_t *data, size_t len, size_t *
     return scan_from(p, data, len, from, consumed, frame);
 }
 
+int j288_parser_scan(j288_parser_t *p, const uint8_t *data, size_t len, size_t *consumed,
+                     const uint8_t **frame)
+{
+    return scan(p, data, len, consumed, frame);
+}
+
 int j288_parser_feed(j288_parser_t *p, const uint8_t *data, size_t len, size_t *consumed)
 {
     const uint8_t *f = NULL;
-    bool good;
-    size_t from;
     int rc;
 
     if (consumed != NULL) {
@@ -193,14 +197,7 @@ int j288_parser_feed(j288_parser_t *p, const uint8_t *data, size_t len, size_t *
     if ((p == NULL) || (consumed == NULL) || ((data == NULL) && (len != 0u))) {
         return J288_ERR_NULL;
     }
-    from = take_first(p, data, len, &good);
-    if (good) {
-        f = data;
-        rc = J288_PARSE_FRAME;
-        *consumed = from;
-    } else {
-        rc = scan_from(p, data, len, from, consumed, &f);
-    }
+    rc = scan(p, data, len, consumed, &f);
     if ((rc == J288_PARSE_FRAME) && (f != p->buf)) {
         /* Checked in the caller's data: the parser keeps its own copy (constant lengths, so
          * that the compiler copies words). */
