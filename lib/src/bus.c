@@ -425,20 +425,23 @@ static uint32_t take_reply_bytes(j288_bus_t *bus, const uint8_t *p, uint32_t n, 
     return (uint32_t)used;
 }
 
-/* Echo window: compare with what we sent. */
+/* Echo window: compare with what we sent, up to the first byte that differs (what follows
+ * it is stale, however the bytes were chunked). */
 static uint32_t take_echo_bytes(j288_bus_t *bus, const uint8_t *p, uint32_t n)
 {
     uint32_t want = J288_CMD_LEN - (uint32_t)bus->echo_pos;
     uint32_t k = (n < want) ? n : want;
-    uint32_t i;
+    uint32_t i = 0u;
 
-    for (i = 0u; i < k; i++) {
-        if (p[i] != bus->tx_buf[bus->echo_pos + i]) {
+    while (i < k) {
+        i++;
+        if (p[i - 1u] != bus->tx_buf[bus->echo_pos + i - 1u]) {
             bus->collided = true;
+            break;
         }
     }
-    bus->echo_pos = (uint8_t)(bus->echo_pos + k);
-    return k;
+    bus->echo_pos = (uint8_t)(bus->echo_pos + i);
+    return i;
 }
 
 /* Bytes at ring index pos: stale, echo or reply, by state. Returns bytes consumed. */
@@ -660,12 +663,10 @@ int j288_bus_submit(j288_bus_t *bus, const j288_cmd_raw_t *cmd, uint32_t now_us,
     begin_txn(bus, cmd->id, done, user);
     bus->stats.transactions++;
     bus->queued = true;
+    /* From a completion callback (inside an advance) the bus is in the guard that finish()
+     * has just begun: the guard's timer, or the next poll, starts the transmit. */
     if (!bus->in_advance) {
         advance(bus, now_us);
-    } else if ((st == J288_BUS_IDLE) || time_reached(now_us, bus->guard_end)) {
-        bus->again = true; /* from a callback: the running advance starts it */
-    } else {
-        /* From a callback, inside a guard: the guard's timer (or the next poll) starts it. */
     }
     j288_bus_unlock(bus);
     return J288_OK;

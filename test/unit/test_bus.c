@@ -1374,6 +1374,41 @@ static void test_bytes_after_broadcast_in_same_poll(void)
     TEST_ASSERT_EQUAL_UINT32(J288_REPLY_LEN, j288_bus_stats(&bus)->stale_bytes);
 }
 
+/* An echo that differs at byte 5: the attempt is a collision, and the 14 bytes after the
+ * difference are stale whether the echo comes in one piece or byte by byte (they were once
+ * compared and dropped uncounted when they came in the same piece). */
+static void test_echo_mismatch_same_in_any_chunking(void)
+{
+    j288_bus_config_t cfg;
+    j288_cmd_raw_t cmd = lock_cmd(4u);
+    uint8_t echo[J288_CMD_LEN];
+    int pass;
+    for (pass = 0; pass < 2; pass++) {
+        size_t i;
+        memset(&cfg, 0, sizeof cfg);
+        cfg.echo = true;
+        setup_cfg(&cfg);
+        fp.poll_fn = NULL;
+        fp.txdone = FAKE_TXDONE_MANUAL;
+        submit_ok(&cmd);
+        memcpy(echo, fake_port_frame(&fp, 0u)->data, sizeof echo);
+        echo[5] ^= 0x20u;
+        if (pass == 0) {
+            j288_bus_on_rx(&bus, echo, sizeof echo);
+        } else {
+            for (i = 0u; i < sizeof echo; i++) {
+                j288_bus_on_rx(&bus, &echo[i], 1u);
+                j288_bus_poll(&bus, 20u);
+            }
+        }
+        j288_bus_on_tx_done(&bus);
+        j288_bus_poll(&bus, 34u);
+        TEST_ASSERT_EQUAL_INT(1, cb.calls);
+        TEST_ASSERT_EQUAL_INT(J288_ERR_COLLISION, cb.txn.result);
+        TEST_ASSERT_EQUAL_UINT32(14u, j288_bus_stats(&bus)->stale_bytes);
+    }
+}
+
 /* ---- pauses inside a reply: the line goes idle, the frame goes on */
 
 /* WORKED_REPLY3 in two parts with an idle line between them (split: bytes in the first part);
@@ -1823,6 +1858,7 @@ int main(void)
     RUN_TEST(test_failure_ranking);
     RUN_TEST(test_noise_while_idle_is_not_echo);
     RUN_TEST(test_bytes_after_broadcast_in_same_poll);
+    RUN_TEST(test_echo_mismatch_same_in_any_chunking);
     RUN_TEST(test_pause_inside_head_keeps_frame);
     RUN_TEST(test_pause_inside_payload_keeps_frame);
     RUN_TEST(test_pause_before_reply);
