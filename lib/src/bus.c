@@ -37,8 +37,7 @@ static bool time_reached(uint32_t now, uint32_t t)
 /* TX, ECHO or WAIT_REPLY: an attempt is on the wire (the states are numbered in that order). */
 static bool is_active(uint8_t state)
 {
-    return (uint8_t)(state - (uint8_t)J288_BUS_TX) <=
-           (uint8_t)(J288_BUS_WAIT_REPLY - J288_BUS_TX);
+    return (state >= (uint8_t)J288_BUS_TX) && (state <= (uint8_t)J288_BUS_WAIT_REPLY);
 }
 
 static void arm_at(j288_bus_t *bus, uint32_t t)
@@ -59,7 +58,8 @@ static void note_fail(j288_bus_t *bus, int err)
 /* n / d and n % d for n below 2^24, by shift and subtract. */
 static uint32_t div_small(uint32_t n, uint32_t d, uint32_t *rem)
 {
-    uint32_t q = 0u, r = 0u;
+    uint32_t q = 0u;
+    uint32_t r = 0u;
     int bit;
     for (bit = 23; bit >= 0; bit--) {
         r = (r << 1) | ((n >> (unsigned)bit) & 1u); /* r < 2^24: no overflow */
@@ -93,7 +93,8 @@ uint32_t j288_wire_time_us(uint32_t baud, uint32_t nbytes)
     const uint32_t b = (baud == 0u) ? J288_DEFAULT_BAUD : baud;
     uint32_t unit_r;
     const uint32_t unit_q = div_small(10000000u, b, &unit_r); /* 10^7 = unit_q * b + unit_r */
-    uint32_t q = 0u, r = 0u;
+    uint32_t q = 0u;
+    uint32_t r = 0u;
     int bit;
     for (bit = 31; bit >= 0; bit--) {
         q = (q << 1) + add_mod(&r, r, b);
@@ -717,9 +718,10 @@ void j288_bus_on_rx(j288_bus_t *bus, const uint8_t *data, size_t len)
         advance_from_event(bus);
         return;
     }
-    n = (len < J288_CONFIG_RX_RING_SIZE) ? len : J288_CONFIG_RX_RING_SIZE;
-    if (n < len) {
-        bus->stats.rx_overflows += (uint32_t)(len - n);
+    n = len;
+    if (n > J288_CONFIG_RX_RING_SIZE) {
+        bus->stats.rx_overflows += (uint32_t)(n - J288_CONFIG_RX_RING_SIZE);
+        n = J288_CONFIG_RX_RING_SIZE;
     }
     bus->direct = data;
     bus->direct_pos = head;

@@ -31,7 +31,9 @@ static bool mode_timeout(uint8_t mode) { return (mode & 0x80u) != 0u; }
  * (flipping the sign bit and subtracting its weight; compilers emit one sign extension). */
 static int16_t as_i16(uint16_t u)
 {
-    return (int16_t)((int32_t)(u ^ 0x8000u) - 0x8000);
+    uint32_t flipped = (uint32_t)u ^ 0x8000u;
+    int32_t v = (int32_t)flipped;
+    return (int16_t)(v - 0x8000);
 }
 
 static int32_t as_i32(uint32_t u)
@@ -55,8 +57,8 @@ static uint32_t pair16(int16_t lo, int16_t hi)
 }
 
 /* The head's two bytes as one little-endian halfword, for a single compare. */
-#define CMD_HEAD16 ((uint16_t)(J288_CMD_HEAD0 | (J288_CMD_HEAD1 << 8)))
-#define RPL_HEAD16 ((uint16_t)(J288_REPLY_HEAD0 | (J288_REPLY_HEAD1 << 8)))
+#define CMD_HEAD16 (J288_CMD_HEAD0 | ((uint32_t)J288_CMD_HEAD1 << 8u))
+#define RPL_HEAD16 (J288_REPLY_HEAD0 | ((uint32_t)J288_REPLY_HEAD1 << 8u))
 
 int j288_cmd_encode(const j288_cmd_raw_t *cmd, uint8_t out[J288_CMD_LEN], const j288_crc_t *crc)
 {
@@ -71,7 +73,7 @@ int j288_cmd_encode(const j288_cmd_raw_t *cmd, uint8_t out[J288_CMD_LEN], const 
     }
     /* Every check is done: out is written only now, as the four words the frame is made of
      * (head, mode and reserved byte; tau and speed; pos; kp and kd), then its CRC. */
-    j288_store_le32(&out[0], (uint32_t)CMD_HEAD16 |
+    j288_store_le32(&out[0], CMD_HEAD16 |
                                  ((uint32_t)mode_pack(cmd->id, cmd->status, cmd->watchdog) << 16));
     j288_store_le32(&out[CMD_TAU], pair16(cmd->tau, cmd->speed));
     j288_store_le32(&out[CMD_POS], from_i32(cmd->pos));

@@ -119,10 +119,11 @@ static bool take_whole(j288_parser_t *p, const uint8_t *f)
 /* The general case, from data[i]: a byte that does not start a head while hunting is
  * garbage, a head with a whole frame behind it goes to take_whole(), everything else through
  * take_byte(), which also resynchronises inside a dropped frame. */
-J288_NOINLINE static int scan_from(j288_parser_t *p, const uint8_t *data, size_t len, size_t i,
-                     size_t *consumed, const uint8_t **frame)
+J288_NOINLINE static int scan_from(j288_parser_t *p, const uint8_t *data, size_t len,
+                                   size_t from, size_t *consumed, const uint8_t **frame)
 {
     const uint16_t head = head16(p);
+    size_t i = from;
 
     while (i < len) {
         const uint8_t *f = &data[i];
@@ -160,7 +161,9 @@ J288_NOINLINE static int scan_from(j288_parser_t *p, const uint8_t *data, size_t
 static size_t take_first(j288_parser_t *p, const uint8_t *data, size_t len, bool *good)
 {
     *good = false;
-    if ((p->len != 0u) || (len < p->frame_len) || (j288_get_u16le(data) != head16(p))) {
+    /* (A frame is at least a command long: data holds two bytes to read.) */
+    if ((p->len != 0u) || (len < J288_CMD_LEN) || (len < p->frame_len) ||
+        (j288_get_u16le(data) != head16(p))) {
         return 0u;
     }
     *good = take_whole(p, data);
