@@ -26,6 +26,14 @@
 #define J288_NOINLINE
 #endif
 
+/* A small function on a hot path that has more than one caller: inlined in each (the
+ * compiler would otherwise keep one out-of-line copy and a call). Only a hint. */
+#if defined(__GNUC__)
+#define J288_INLINE_HOT inline __attribute__((always_inline))
+#else
+#define J288_INLINE_HOT inline
+#endif
+
 /* ---- bytes */
 
 /* Store v little-endian at p, any alignment. Where the core stores unaligned words and is

@@ -66,6 +66,19 @@ static void drop_frame(j288_parser_t *p)
     resync(p);
 }
 
+/* The byte path has collected a whole frame in buf: count it, or drop it and resync. Out of
+ * line, so that the byte path's per-byte work stays short. */
+J288_NOINLINE static bool collected(j288_parser_t *p)
+{
+    if (frame_crc_ok(p, p->buf)) {
+        p->stats.frames++;
+        p->len = 0u;
+        return true;
+    }
+    drop_frame(p);
+    return false;
+}
+
 /* One byte in; true when a good frame completes. Both heads end in 0xEE. */
 static bool take_byte(j288_parser_t *p, uint8_t b)
 {
@@ -89,16 +102,7 @@ static bool take_byte(j288_parser_t *p, uint8_t b)
     }
     p->buf[p->len] = b;
     p->len++;
-    if (p->len < p->frame_len) {
-        return false;
-    }
-    if (frame_crc_ok(p, p->buf)) {
-        p->stats.frames++;
-        p->len = 0u;
-        return true;
-    }
-    drop_frame(p);
-    return false;
+    return (p->len == p->frame_len) && collected(p);
 }
 
 /* While hunting, a head with a whole frame behind it in the caller's data: checked where it
@@ -116,20 +120,20 @@ static bool take_whole(j288_parser_t *p, const uint8_t *f)
     return false;
 }
 
-/* The general case, from data[i]: a byte that does not start a head while hunting is
- * garbage, a head with a whole frame behind it goes to take_whole(), everything else through
- * take_byte(), which also resynchronises inside a dropped frame. */
-J288_NOINLINE static int scan_from(j288_parser_t *p, const uint8_t *data, size_t len,
-                                   size_t from, size_t *consumed, const uint8_t **frame)
+/* The general case: a byte that does not start a head while hunting is garbage, a head with a
+ * whole frame behind it goes to take_whole(), everything else through take_byte(), which
+ * also resynchronises inside a dropped frame. Returns the bytes consumed; *frame is set when
+ * a good frame completed (and left alone otherwise). */
+J288_NOINLINE static size_t scan_bytes(j288_parser_t *p, const uint8_t *data, size_t len,
+                                       const uint8_t **frame)
 {
-    const uint16_t head = head16(p);
-    size_t i = from;
+    size_t i = 0u;
 
     while (i < len) {
         const uint8_t *f = &data[i];
         size_t left = len - i;
         if ((p->len == 0u) && (left >= 2u)) {
-            if (j288_get_u16le(f) != head) {
+            if (j288_get_u16le(f) != head16(p)) {
                 p->stats.garbage_bytes++;
                 i++;
                 continue;
@@ -137,22 +141,19 @@ J288_NOINLINE static int scan_from(j288_parser_t *p, const uint8_t *data, size_t
             if (left >= p->frame_len) {
                 i += p->frame_len;
                 if (take_whole(p, f)) {
-                    *consumed = i;
                     *frame = f;
-                    return J288_PARSE_FRAME;
+                    return i;
                 }
                 continue;
             }
         }
         i++;
         if (take_byte(p, *f)) {
-            *consumed = i;
             *frame = p->buf;
-            return J288_PARSE_FRAME;
+            return i;
         }
     }
-    *consumed = len;
-    return J288_PARSE_NONE;
+    return len;
 }
 
 /* The common case: nothing held and data starting with a whole frame, as a frame received in
@@ -170,9 +171,10 @@ static size_t take_first(j288_parser_t *p, const uint8_t *data, size_t len, bool
     return p->frame_len;
 }
 
-static inline int scan(j288_parser_t *p, const uint8_t *data, size_t len, size_t *consumed,
-                       const uint8_t **frame)
+static J288_INLINE_HOT int scan(j288_parser_t *p, const uint8_t *data, size_t len,
+                                size_t *consumed, const uint8_t **frame)
 {
+    const uint8_t *f = NULL;
     bool good;
     size_t from = take_first(p, data, len, &good);
     if (good) {
@@ -180,7 +182,23 @@ static inline int scan(j288_parser_t *p, const uint8_t *data, size_t len, size_t
         *frame = data;
         return J288_PARSE_FRAME;
     }
-    return scan_from(p, data, len, from, consumed, frame);
+    /* A frame in progress takes the bytes that follow one by one, here (the common case when a
+     * port hands over a byte at a time); the hunt for heads goes on in scan_bytes(). */
+    while ((p->len != 0u) && (from < len)) {
+        from++;
+        if (take_byte(p, data[from - 1u])) {
+            *consumed = from;
+            *frame = p->buf;
+            return J288_PARSE_FRAME;
+        }
+    }
+    if (from == len) {
+        *consumed = len;
+        return J288_PARSE_NONE;
+    }
+    *consumed = from + scan_bytes(p, &data[from], len - from, &f);
+    *frame = f;
+    return (f != NULL) ? J288_PARSE_FRAME : J288_PARSE_NONE;
 }
 
 int j288_parser_scan(j288_parser_t *p, const uint8_t *data, size_t len, size_t *consumed,
