@@ -23,7 +23,7 @@ OBJ := $(BUILD)/obj
 LIB_SRC := $(sort $(wildcard lib/src/*.c))
 LIB_OBJ := $(LIB_SRC:%.c=$(OBJ)/%.o)
 LIB_A := $(BUILD)/lib/libj288.a
-LIB_HDR := $(wildcard lib/include/j288/*.h)
+LIB_HDR := $(wildcard lib/include/j288/*.h lib/src/*.h)
 
 # Unity (fetched, never committed; see scripts/fetch-unity.sh).
 UNITY := $(BUILD)/unity

@@ -93,7 +93,8 @@ endif()
 # ---- the codec tests with each compile-time CRC backend (mk/codec.mk) ----------------------
 # A library variant per backend; its flags reach the tests and test/support too, as Make's
 # EXTRA_CFLAGS do in the crc-<variant> sub-build.
-set(J288_CRC_VARIANTS nibble bitwise hw)
+set(J288_CRC_VARIANTS slice4 nibble bitwise hw)
+set(J288_CRC_DEFS_slice4 J288_CONFIG_CRC_BACKEND=J288_CRC_BACKEND_SLICE4)
 set(J288_CRC_DEFS_nibble J288_CONFIG_CRC_BACKEND=J288_CRC_BACKEND_NIBBLE)
 set(J288_CRC_DEFS_bitwise J288_CONFIG_CRC_BACKEND=J288_CRC_BACKEND_BITWISE)
 set(J288_CRC_DEFS_hw J288_CONFIG_CRC_BACKEND=J288_CRC_BACKEND_HW

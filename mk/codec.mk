@@ -39,10 +39,11 @@ bench-codec: $(CODEC_BENCH)
 	    t=$$(ir $$m); echo "  $$m: $$(( (t - base) / $(CODEC_BENCH_N) ))"; \
 	done
 
-# The codec tests again with each compile-time CRC backend (J288_CONFIG_CRC_BACKEND): nibble,
-# bitwise, and HW through J288_CONFIG_CRC_HW_FUNCTION (a stand-in from test/support). Each
+# The codec tests again with each compile-time CRC backend (J288_CONFIG_CRC_BACKEND): slice4,
+# nibble, bitwise, and HW through J288_CONFIG_CRC_HW_FUNCTION (a stand-in from test/support). Each
 # variant is a sub-build in $(BUILD)/crc-<variant>; its binaries run in `make test`.
-CODEC_CRC_VARIANTS := nibble bitwise hw
+CODEC_CRC_VARIANTS := slice4 nibble bitwise hw
+CODEC_CRC_FLAGS_slice4 := -DJ288_CONFIG_CRC_BACKEND=J288_CRC_BACKEND_SLICE4
 CODEC_CRC_FLAGS_nibble := -DJ288_CONFIG_CRC_BACKEND=J288_CRC_BACKEND_NIBBLE
 CODEC_CRC_FLAGS_bitwise := -DJ288_CONFIG_CRC_BACKEND=J288_CRC_BACKEND_BITWISE
 CODEC_CRC_FLAGS_hw := -DJ288_CONFIG_CRC_BACKEND=J288_CRC_BACKEND_HW \

@@ -46,11 +46,16 @@ ENGINE_TGT_m4 := -mcpu=cortex-m4 -mthumb -mfloat-abi=hard -mfpu=fpv4-sp-d16 -DJ2
 ENGINE_TGT_m0 := -mcpu=cortex-m0 -mthumb -mfloat-abi=soft
 ENGINE_TGT_QEMU_m4 := -M mps2-an386 -cpu cortex-m4
 ENGINE_TGT_QEMU_m0 := -M mps2-an385 -cpu cortex-m3
-ENGINE_TGT_ELFS := $(foreach c,m0 m4,$(foreach o,O2 Os,$(ENGINE_TGT_DIR)/bus_target_$(c)_$(o).elf))
+# Images per core and optimisation: the default CRC backend (table), and slicing-by-4 (s4).
+ENGINE_TGT_CRC_table :=
+ENGINE_TGT_CRC_s4 := -DJ288_CONFIG_CRC_BACKEND=J288_CRC_BACKEND_SLICE4
+ENGINE_TGT_ELFS := $(foreach c,m0 m4,$(foreach o,O2 Os,$(foreach v,table s4,\
+                     $(ENGINE_TGT_DIR)/bus_target_$(c)_$(o)_$(v).elf)))
 
 $(ENGINE_TGT_DIR)/bus_target_%.elf: test/bench/bus_target.c test/target/startup.c $(LIB_SRC) $(LIB_HDR)
 	@mkdir -p $(@D)
 	arm-none-eabi-gcc $(ENGINE_TGT_$(word 1,$(subst _, ,$*))) -$(word 2,$(subst _, ,$*)) -g \
+	    $(ENGINE_TGT_CRC_$(word 3,$(subst _, ,$*))) \
 	    $(CSTD) $(WARN) -ffunction-sections -fdata-sections $(CPPFLAGS_LIB) \
 	    test/bench/bus_target.c test/target/startup.c $(LIB_SRC) \
 	    -nostartfiles --specs=nano.specs --specs=rdimon.specs -Wl,--gc-sections -Ltest/target \
@@ -64,10 +69,10 @@ bench-bus-target:
 	    echo "bench-bus-target: skipped; install gcc-arm-none-eabi libnewlib-arm-none-eabi qemu-system-arm"; \
 	    exit 0; fi; \
 	 $(MAKE) --no-print-directory BUILD=$(BUILD) $(ENGINE_TGT_ELFS) >/dev/null && \
-	 for c in m0 m4; do for o in O2 Os; do \
+	 for c in m0 m4; do for o in O2 Os; do for v in table s4; do \
 	    echo "Cortex-$$c -$$o (QEMU -icount shift=0), instructions per transaction:"; \
 	    if [ $$c = m4 ]; then q="$(ENGINE_TGT_QEMU_m4)"; else q="$(ENGINE_TGT_QEMU_m0)"; fi; \
 	    timeout 120 qemu-system-arm $$q -icount shift=0 -nographic -monitor none -serial none \
 	        -semihosting-config enable=on,target=native \
-	        -kernel $(ENGINE_TGT_DIR)/bus_target_$${c}_$$o.elf || exit 1; \
-	 done; done
+	        -kernel $(ENGINE_TGT_DIR)/bus_target_$${c}_$${o}_$$v.elf || exit 1; \
+	 done; done; done

@@ -34,7 +34,7 @@ enum {
     /* Frame errors: bytes that are not a valid frame. */
     J288_ERR_BAD_HEADER = -20, /* first two bytes are not the expected head */
     J288_ERR_CRC = -21,        /* CRC mismatch */
-    J288_ERR_TRUNCATED = -22,  /* the line went idle inside a frame */
+    J288_ERR_TRUNCATED = -22,  /* a frame still incomplete at the deadline (or a flush) */
 
     /* Bus results. */
     J288_ERR_BUSY = -30,       /* a transaction is already in progress */
