@@ -32,7 +32,7 @@ REQUIRE = $(NEED) $(1) $(2) || { [ $$? -eq 1 ] && exit 0; exit 1; }
 LIB_SRC := $(sort $(wildcard lib/src/*.c))
 LIB_OBJ := $(LIB_SRC:%.c=$(OBJ)/%.o)
 LIB_A := $(BUILD)/lib/libj288.a
-LIB_HDR := $(wildcard lib/include/j288/*.h)
+LIB_HDR := $(wildcard lib/include/j288/*.h lib/src/*.h)
 
 # What the fragments build and use (named here so that any fragment can depend on them).
 LINUX_A := $(BUILD)/lib/libj288_linux.a

@@ -70,16 +70,22 @@ bench-target:
 	    $(call QEMU_BENCH,m4f,$(BUILD)/bench-target/codec_m4f_$$o.elf) || exit 1; echo; \
 	 done
 
-# The bus engine and the scheduler, port operations empty.
+# The bus engine and the scheduler, port operations empty, with the default CRC backend (table)
+# and with slicing-by-4 (s4).
 BENCH_BUS_CPUS := m0 m4f
-$(foreach c,$(BENCH_BUS_CPUS),$(foreach o,$(BENCH_OPTS),$(eval $(call BENCH_IMAGE,bus_$(c),$(c),\
-    test/bench/bus_target.c $(call TC,$(c),STARTUP) $(LIB_SRC),,$(o)))))
+BENCH_BUS_CRCS := table s4
+BENCH_BUS_CRC_table :=
+BENCH_BUS_CRC_s4 := -DJ288_CONFIG_CRC_BACKEND=J288_CRC_BACKEND_SLICE4
+BENCH_BUS_ELFS := $(foreach c,$(BENCH_BUS_CPUS),$(foreach v,$(BENCH_BUS_CRCS),\
+    $(BENCH_OPTS:%=$(BUILD)/bench-target/bus_$(c)_$(v)_%.elf)))
+$(foreach c,$(BENCH_BUS_CPUS),$(foreach v,$(BENCH_BUS_CRCS),$(foreach o,$(BENCH_OPTS),$(eval \
+    $(call BENCH_IMAGE,bus_$(c)_$(v),$(c),test/bench/bus_target.c $(call TC,$(c),STARTUP) $(LIB_SRC),\
+    $(BENCH_BUS_CRC_$(v)),$(o))))))
 
 bench-bus-target:
 	@$(call REQUIRE_TC,$(BENCH_BUS_CPUS),QEMU); \
-	 $(MAKE) --no-print-directory $(foreach c,$(BENCH_BUS_CPUS),$(BENCH_OPTS:%=$(BUILD)/bench-target/bus_$(c)_%.elf)) \
-	     >/dev/null && \
-	 $(foreach c,$(BENCH_BUS_CPUS),for o in $(BENCH_OPTS); do \
-	    echo "Cortex-$(c) -$$o ($(CPU_$(c)_QEMU), QEMU -icount shift=0), instructions per transaction:"; \
-	    $(call QEMU_BENCH,$(c),$(BUILD)/bench-target/bus_$(c)_$$o.elf) || exit 1; \
-	 done;)
+	 $(MAKE) --no-print-directory $(BENCH_BUS_ELFS) >/dev/null && \
+	 $(foreach c,$(BENCH_BUS_CPUS),for o in $(BENCH_OPTS); do for v in $(BENCH_BUS_CRCS); do \
+	    echo "Cortex-$(c) -$$o, CRC $$v ($(CPU_$(c)_QEMU), QEMU -icount shift=0), instructions per transaction:"; \
+	    $(call QEMU_BENCH,$(c),$(BUILD)/bench-target/bus_$(c)_$${v}_$$o.elf) || exit 1; \
+	 done; done;)

@@ -157,8 +157,9 @@ test-target: $(UNITY)/unity.c
 
 # ---- make size: flash/RAM per module and stack per public call, M0 and M4F at -Os -------------
 SIZE_CPUS := m0 m4f
-SIZE_BACKENDS := table nibble hw
+SIZE_BACKENDS := table slice4 nibble hw
 SIZE_table_DEFS := -DJ288_CONFIG_CRC_BACKEND=J288_CRC_BACKEND_TABLE -DJ288_STM32_HW_CRC=0
+SIZE_slice4_DEFS := -DJ288_CONFIG_CRC_BACKEND=J288_CRC_BACKEND_SLICE4 -DJ288_STM32_HW_CRC=0
 SIZE_nibble_DEFS := -DJ288_CONFIG_CRC_BACKEND=J288_CRC_BACKEND_NIBBLE -DJ288_STM32_HW_CRC=0
 SIZE_hw_DEFS := -DJ288_CONFIG_CRC_BACKEND=J288_CRC_BACKEND_HW \
                 -DJ288_CONFIG_CRC_HW_FUNCTION=j288_stm32_crc32_default

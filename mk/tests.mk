@@ -3,7 +3,7 @@
 # them all, and the sanitizer and valgrind runs (mk/hardening.mk) run the same lists.
 #   test/cli/          the j288 tool's helpers, linked with the helper objects (not main())
 #   test/sim/          the simulator's servo model
-#   test/linux/        the Linux port over a real pty served by j288-sim
+#   test/linux/        the Linux port over a real pty served by j288-sim, the robot config reader
 #   test/stm32/        the STM32 port against a fake HAL, with the real engine
 #   crc-<backend>/     the codec tests again with each compile-time CRC backend
 #   test/fuzz/         every fuzz target replaying its committed corpus
@@ -22,9 +22,11 @@ $(CLI_TEST): $(OBJ)/test/cli/test_cli_helpers.o \
 	$(CC) $(CFLAGS_COMMON) $^ -o $@ $(LDFLAGS_COMMON) -lm
 
 # ---- the codec tests with each CRC backend (J288_CONFIG_CRC_BACKEND) -------------------------
-# nibble, bitwise, and HW through J288_CONFIG_CRC_HW_FUNCTION (a stand-in in test/support).
-# Each is a sub-build in $(BUILD)/crc-<backend>, one sub-make building all its binaries.
-CODEC_CRC_VARIANTS := nibble bitwise hw
+# slice4, nibble, bitwise, and HW through J288_CONFIG_CRC_HW_FUNCTION (a stand-in in
+# test/support). Each is a sub-build in $(BUILD)/crc-<backend>, one sub-make building all its
+# binaries.
+CODEC_CRC_VARIANTS := slice4 nibble bitwise hw
+CODEC_CRC_FLAGS_slice4 := -DJ288_CONFIG_CRC_BACKEND=J288_CRC_BACKEND_SLICE4
 CODEC_CRC_FLAGS_nibble := -DJ288_CONFIG_CRC_BACKEND=J288_CRC_BACKEND_NIBBLE
 CODEC_CRC_FLAGS_bitwise := -DJ288_CONFIG_CRC_BACKEND=J288_CRC_BACKEND_BITWISE
 CODEC_CRC_FLAGS_hw := -DJ288_CONFIG_CRC_BACKEND=J288_CRC_BACKEND_HW \
@@ -69,6 +71,16 @@ $(LINUX_PORT_TEST): $(OBJ)/test/linux/test_linux_port.o $(UNITY_OBJ) $(LINUX_A) 
 	@mkdir -p $(@D)
 	$(CC) $(CFLAGS_COMMON) $^ -o $@ $(LDFLAGS_COMMON) -lm
 
+CONFIG_TEST := $(BUILD)/test/test_robot_config
+$(OBJ)/test/linux/test_robot_config.o: test/linux/test_robot_config.c port/linux/j288_robot_config.h \
+    $(TEST_HDR) $(UNITY)/unity.c $(YAML_ENV)
+	@mkdir -p $(@D)
+	$(CC) $(TEST_CPPFLAGS) -Iport/linux $(call yaml_var,YAML_CFLAGS) $(CFLAGS_COMMON) -c $< -o $@
+
+$(CONFIG_TEST): $(OBJ)/test/linux/test_robot_config.o $(CONFIG_OBJ) $(UNITY_OBJ)
+	@mkdir -p $(@D)
+	$(CC) $(CFLAGS_COMMON) $^ -o $@ $(LDFLAGS_COMMON) $(call yaml_var,YAML_LIBS) -lm
+
 SIM_MODEL_TEST := $(BUILD)/test/test_sim_model
 $(OBJ)/test/sim/%.o: test/sim/%.c tools/j288-sim/servo_model.h $(TEST_HDR) $(UNITY)/unity.c
 	@mkdir -p $(@D)
@@ -95,11 +107,12 @@ $(STM32_TEST): $(STM32_TEST_SRC:%.c=$(OBJ)/stm32host/%.o) $(UNITY_OBJ) $(LIB_A)
 
 # ---- the lists -------------------------------------------------------------------------------
 HOST_TESTS += $(CLI_TEST) $(foreach v,$(CODEC_CRC_VARIANTS),$(CODEC_CRC_TEST_NAMES:%=$(BUILD)/crc-$(v)/test/%)) \
-    $(FUZZ_REPLAY_TESTS) $(LINUX_PORT_TEST) $(SIM_MODEL_TEST) $(STM32_TEST)
+    $(FUZZ_REPLAY_TESTS) $(LINUX_PORT_TEST) $(CONFIG_TEST) $(SIM_MODEL_TEST) $(STM32_TEST)
 TEST_SCRIPTS += test/e2e/cli_offline.sh test/e2e/cli_bus.sh tools/vectors/check-drift.sh \
     test/e2e/sim_cli.sh test/e2e/example_linux.sh test/abi/check-abi.sh
 TEST_DEPS += $(J288_BIN) $(SIM_BIN) $(EXAMPLE_LINUX) $(LIB_A)
-ALL_TARGETS += $(CLI_TEST) $(FUZZ_REPLAY_TESTS) $(LINUX_PORT_TEST) $(SIM_MODEL_TEST) $(STM32_TEST)
+ALL_TARGETS += $(CLI_TEST) $(FUZZ_REPLAY_TESTS) $(LINUX_PORT_TEST) $(CONFIG_TEST) $(SIM_MODEL_TEST) \
+    $(STM32_TEST)
 
 .PHONY: check-abi vectors-check
 check-abi: $(LIB_A)

@@ -1,5 +1,6 @@
 # The Linux port and the programs built on it:
 #   $(LINUX_A)     libj288_linux.a, port/linux (termios2): -Iport/linux, link it before $(LIB_A)
+#   $(CONFIG_OBJ)  the robot config reader (port/linux, libyaml)
 #   $(J288_BIN)    tools/j288: offline frame calculator and bus commands over the Linux port
 #   $(SIM_BIN)     tools/j288-sim: simulated servos on a pseudo-terminal
 #   $(BIN)/linux-status   examples/linux: the library's smallest Linux program
@@ -38,6 +39,21 @@ $(OBJ)/tools/j288-sim/%.o: tools/j288-sim/%.c tools/j288-sim/servo_model.h $(LIB
 $(SIM_BIN): $(SIM_MODEL_OBJ) $(OBJ)/tools/j288-sim/sim_main.o $(LIB_A)
 	@mkdir -p $(@D)
 	$(CC) $(CFLAGS_COMMON) $^ -o $@ $(LDFLAGS_COMMON) -lm
+
+# The robot config reader (port/linux/j288_robot_config.c, not in the archive: it needs
+# libyaml). scripts/libyaml.sh finds libyaml (the system's, else Debian's package fetched into
+# $(BUILD)/libyaml) and writes the flags into $(YAML_ENV); without it the reader builds as
+# stubs that say so. Users: $(CONFIG_OBJ), and $(call yaml_var,YAML_LIBS) in a recipe.
+YAML_ENV := $(BUILD)/libyaml/libyaml.env
+yaml_var = $$(sed -n 's/^$(1)=//p' $(YAML_ENV))
+CONFIG_OBJ := $(OBJ)/port/linux/j288_robot_config.o
+
+$(YAML_ENV):
+	bash scripts/libyaml.sh $(BUILD)/libyaml "$(CC)"
+
+$(CONFIG_OBJ): port/linux/j288_robot_config.c port/linux/j288_robot_config.h $(YAML_ENV)
+	@mkdir -p $(@D)
+	$(CC) $(LINUX_CPPFLAGS) $(call yaml_var,YAML_CFLAGS) $(CFLAGS_COMMON) -c $< -o $@
 
 EXAMPLE_LINUX := $(BIN)/linux-status
 $(OBJ)/examples/linux/%.o: examples/linux/%.c port/linux/j288_linux.h $(LIB_HDR)

@@ -1,9 +1,11 @@
 /* CRC32 as the STM32 CRC unit computes it; see j288/crc32.h for the contract. */
 #include "j288/crc32.h"
 
-/* Tables are T[i] = i * x^32 mod P for i shifted to the top of the register; generated once
- * (poly 0x04C11DB7, MSB first) and checked against the bitwise backend by the tests. */
-static const uint32_t crc_table256[256] = {
+#include "internal.h"
+
+/* T0[i] = i * x^32 mod P (poly 0x04C11DB7, MSB first): the CRC register's top byte i shifted
+ * out through 8 bits. Generated once and checked against the bitwise backend by the tests. */
+const uint32_t j288_crc_table256[256] = {
     0x00000000u, 0x04C11DB7u, 0x09823B6Eu, 0x0D4326D9u,
     0x130476DCu, 0x17C56B6Bu, 0x1A864DB2u, 0x1E475005u,
     0x2608EDB8u, 0x22C9F00Fu, 0x2F8AD6D6u, 0x2B4BCB61u,
@@ -70,17 +72,234 @@ static const uint32_t crc_table256[256] = {
     0xBCB4666Du, 0xB8757BDAu, 0xB5365D03u, 0xB1F740B4u,
 };
 
-/* The wire's words are little-endian, and the CRC eats a word MSB first: byte 3 first. */
+/* Slicing by 4: Tk[i] = i * x^(32 + 8k) mod P for k = 1..3 (T0 is crc_table256), so that a
+ * word costs four independent lookups instead of four dependent steps. Three arrays rather
+ * than one [3][256], so that each lookup is one indexed load from its own base. Generated
+ * once, checked by the tests against the bitwise backend. */
+const uint32_t j288_crc_slice1[256] = {
+    0x00000000u, 0xD219C1DCu, 0xA0F29E0Fu, 0x72EB5FD3u,
+    0x452421A9u, 0x973DE075u, 0xE5D6BFA6u, 0x37CF7E7Au,
+    0x8A484352u, 0x5851828Eu, 0x2ABADD5Du, 0xF8A31C81u,
+    0xCF6C62FBu, 0x1D75A327u, 0x6F9EFCF4u, 0xBD873D28u,
+    0x10519B13u, 0xC2485ACFu, 0xB0A3051Cu, 0x62BAC4C0u,
+    0x5575BABAu, 0x876C7B66u, 0xF58724B5u, 0x279EE569u,
+    0x9A19D841u, 0x4800199Du, 0x3AEB464Eu, 0xE8F28792u,
+    0xDF3DF9E8u, 0x0D243834u, 0x7FCF67E7u, 0xADD6A63Bu,
+    0x20A33626u, 0xF2BAF7FAu, 0x8051A829u, 0x524869F5u,
+    0x6587178Fu, 0xB79ED653u, 0xC5758980u, 0x176C485Cu,
+    0xAAEB7574u, 0x78F2B4A8u, 0x0A19EB7Bu, 0xD8002AA7u,
+    0xEFCF54DDu, 0x3DD69501u, 0x4F3DCAD2u, 0x9D240B0Eu,
+    0x30F2AD35u, 0xE2EB6CE9u, 0x9000333Au, 0x4219F2E6u,
+    0x75D68C9Cu, 0xA7CF4D40u, 0xD5241293u, 0x073DD34Fu,
+    0xBABAEE67u, 0x68A32FBBu, 0x1A487068u, 0xC851B1B4u,
+    0xFF9ECFCEu, 0x2D870E12u, 0x5F6C51C1u, 0x8D75901Du,
+    0x41466C4Cu, 0x935FAD90u, 0xE1B4F243u, 0x33AD339Fu,
+    0x04624DE5u, 0xD67B8C39u, 0xA490D3EAu, 0x76891236u,
+    0xCB0E2F1Eu, 0x1917EEC2u, 0x6BFCB111u, 0xB9E570CDu,
+    0x8E2A0EB7u, 0x5C33CF6Bu, 0x2ED890B8u, 0xFCC15164u,
+    0x5117F75Fu, 0x830E3683u, 0xF1E56950u, 0x23FCA88Cu,
+    0x1433D6F6u, 0xC62A172Au, 0xB4C148F9u, 0x66D88925u,
+    0xDB5FB40Du, 0x094675D1u, 0x7BAD2A02u, 0xA9B4EBDEu,
+    0x9E7B95A4u, 0x4C625478u, 0x3E890BABu, 0xEC90CA77u,
+    0x61E55A6Au, 0xB3FC9BB6u, 0xC117C465u, 0x130E05B9u,
+    0x24C17BC3u, 0xF6D8BA1Fu, 0x8433E5CCu, 0x562A2410u,
+    0xEBAD1938u, 0x39B4D8E4u, 0x4B5F8737u, 0x994646EBu,
+    0xAE893891u, 0x7C90F94Du, 0x0E7BA69Eu, 0xDC626742u,
+    0x71B4C179u, 0xA3AD00A5u, 0xD1465F76u, 0x035F9EAAu,
+    0x3490E0D0u, 0xE689210Cu, 0x94627EDFu, 0x467BBF03u,
+    0xFBFC822Bu, 0x29E543F7u, 0x5B0E1C24u, 0x8917DDF8u,
+    0xBED8A382u, 0x6CC1625Eu, 0x1E2A3D8Du, 0xCC33FC51u,
+    0x828CD898u, 0x50951944u, 0x227E4697u, 0xF067874Bu,
+    0xC7A8F931u, 0x15B138EDu, 0x675A673Eu, 0xB543A6E2u,
+    0x08C49BCAu, 0xDADD5A16u, 0xA83605C5u, 0x7A2FC419u,
+    0x4DE0BA63u, 0x9FF97BBFu, 0xED12246Cu, 0x3F0BE5B0u,
+    0x92DD438Bu, 0x40C48257u, 0x322FDD84u, 0xE0361C58u,
+    0xD7F96222u, 0x05E0A3FEu, 0x770BFC2Du, 0xA5123DF1u,
+    0x189500D9u, 0xCA8CC105u, 0xB8679ED6u, 0x6A7E5F0Au,
+    0x5DB12170u, 0x8FA8E0ACu, 0xFD43BF7Fu, 0x2F5A7EA3u,
+    0xA22FEEBEu, 0x70362F62u, 0x02DD70B1u, 0xD0C4B16Du,
+    0xE70BCF17u, 0x35120ECBu, 0x47F95118u, 0x95E090C4u,
+    0x2867ADECu, 0xFA7E6C30u, 0x889533E3u, 0x5A8CF23Fu,
+    0x6D438C45u, 0xBF5A4D99u, 0xCDB1124Au, 0x1FA8D396u,
+    0xB27E75ADu, 0x6067B471u, 0x128CEBA2u, 0xC0952A7Eu,
+    0xF75A5404u, 0x254395D8u, 0x57A8CA0Bu, 0x85B10BD7u,
+    0x383636FFu, 0xEA2FF723u, 0x98C4A8F0u, 0x4ADD692Cu,
+    0x7D121756u, 0xAF0BD68Au, 0xDDE08959u, 0x0FF94885u,
+    0xC3CAB4D4u, 0x11D37508u, 0x63382ADBu, 0xB121EB07u,
+    0x86EE957Du, 0x54F754A1u, 0x261C0B72u, 0xF405CAAEu,
+    0x4982F786u, 0x9B9B365Au, 0xE9706989u, 0x3B69A855u,
+    0x0CA6D62Fu, 0xDEBF17F3u, 0xAC544820u, 0x7E4D89FCu,
+    0xD39B2FC7u, 0x0182EE1Bu, 0x7369B1C8u, 0xA1707014u,
+    0x96BF0E6Eu, 0x44A6CFB2u, 0x364D9061u, 0xE45451BDu,
+    0x59D36C95u, 0x8BCAAD49u, 0xF921F29Au, 0x2B383346u,
+    0x1CF74D3Cu, 0xCEEE8CE0u, 0xBC05D333u, 0x6E1C12EFu,
+    0xE36982F2u, 0x3170432Eu, 0x439B1CFDu, 0x9182DD21u,
+    0xA64DA35Bu, 0x74546287u, 0x06BF3D54u, 0xD4A6FC88u,
+    0x6921C1A0u, 0xBB38007Cu, 0xC9D35FAFu, 0x1BCA9E73u,
+    0x2C05E009u, 0xFE1C21D5u, 0x8CF77E06u, 0x5EEEBFDAu,
+    0xF33819E1u, 0x2121D83Du, 0x53CA87EEu, 0x81D34632u,
+    0xB61C3848u, 0x6405F994u, 0x16EEA647u, 0xC4F7679Bu,
+    0x79705AB3u, 0xAB699B6Fu, 0xD982C4BCu, 0x0B9B0560u,
+    0x3C547B1Au, 0xEE4DBAC6u, 0x9CA6E515u, 0x4EBF24C9u,
+};
+
+const uint32_t j288_crc_slice2[256] = {
+    0x00000000u, 0x01D8AC87u, 0x03B1590Eu, 0x0269F589u,
+    0x0762B21Cu, 0x06BA1E9Bu, 0x04D3EB12u, 0x050B4795u,
+    0x0EC56438u, 0x0F1DC8BFu, 0x0D743D36u, 0x0CAC91B1u,
+    0x09A7D624u, 0x087F7AA3u, 0x0A168F2Au, 0x0BCE23ADu,
+    0x1D8AC870u, 0x1C5264F7u, 0x1E3B917Eu, 0x1FE33DF9u,
+    0x1AE87A6Cu, 0x1B30D6EBu, 0x19592362u, 0x18818FE5u,
+    0x134FAC48u, 0x129700CFu, 0x10FEF546u, 0x112659C1u,
+    0x142D1E54u, 0x15F5B2D3u, 0x179C475Au, 0x1644EBDDu,
+    0x3B1590E0u, 0x3ACD3C67u, 0x38A4C9EEu, 0x397C6569u,
+    0x3C7722FCu, 0x3DAF8E7Bu, 0x3FC67BF2u, 0x3E1ED775u,
+    0x35D0F4D8u, 0x3408585Fu, 0x3661ADD6u, 0x37B90151u,
+    0x32B246C4u, 0x336AEA43u, 0x31031FCAu, 0x30DBB34Du,
+    0x269F5890u, 0x2747F417u, 0x252E019Eu, 0x24F6AD19u,
+    0x21FDEA8Cu, 0x2025460Bu, 0x224CB382u, 0x23941F05u,
+    0x285A3CA8u, 0x2982902Fu, 0x2BEB65A6u, 0x2A33C921u,
+    0x2F388EB4u, 0x2EE02233u, 0x2C89D7BAu, 0x2D517B3Du,
+    0x762B21C0u, 0x77F38D47u, 0x759A78CEu, 0x7442D449u,
+    0x714993DCu, 0x70913F5Bu, 0x72F8CAD2u, 0x73206655u,
+    0x78EE45F8u, 0x7936E97Fu, 0x7B5F1CF6u, 0x7A87B071u,
+    0x7F8CF7E4u, 0x7E545B63u, 0x7C3DAEEAu, 0x7DE5026Du,
+    0x6BA1E9B0u, 0x6A794537u, 0x6810B0BEu, 0x69C81C39u,
+    0x6CC35BACu, 0x6D1BF72Bu, 0x6F7202A2u, 0x6EAAAE25u,
+    0x65648D88u, 0x64BC210Fu, 0x66D5D486u, 0x670D7801u,
+    0x62063F94u, 0x63DE9313u, 0x61B7669Au, 0x606FCA1Du,
+    0x4D3EB120u, 0x4CE61DA7u, 0x4E8FE82Eu, 0x4F5744A9u,
+    0x4A5C033Cu, 0x4B84AFBBu, 0x49ED5A32u, 0x4835F6B5u,
+    0x43FBD518u, 0x4223799Fu, 0x404A8C16u, 0x41922091u,
+    0x44996704u, 0x4541CB83u, 0x47283E0Au, 0x46F0928Du,
+    0x50B47950u, 0x516CD5D7u, 0x5305205Eu, 0x52DD8CD9u,
+    0x57D6CB4Cu, 0x560E67CBu, 0x54679242u, 0x55BF3EC5u,
+    0x5E711D68u, 0x5FA9B1EFu, 0x5DC04466u, 0x5C18E8E1u,
+    0x5913AF74u, 0x58CB03F3u, 0x5AA2F67Au, 0x5B7A5AFDu,
+    0xEC564380u, 0xED8EEF07u, 0xEFE71A8Eu, 0xEE3FB609u,
+    0xEB34F19Cu, 0xEAEC5D1Bu, 0xE885A892u, 0xE95D0415u,
+    0xE29327B8u, 0xE34B8B3Fu, 0xE1227EB6u, 0xE0FAD231u,
+    0xE5F195A4u, 0xE4293923u, 0xE640CCAAu, 0xE798602Du,
+    0xF1DC8BF0u, 0xF0042777u, 0xF26DD2FEu, 0xF3B57E79u,
+    0xF6BE39ECu, 0xF766956Bu, 0xF50F60E2u, 0xF4D7CC65u,
+    0xFF19EFC8u, 0xFEC1434Fu, 0xFCA8B6C6u, 0xFD701A41u,
+    0xF87B5DD4u, 0xF9A3F153u, 0xFBCA04DAu, 0xFA12A85Du,
+    0xD743D360u, 0xD69B7FE7u, 0xD4F28A6Eu, 0xD52A26E9u,
+    0xD021617Cu, 0xD1F9CDFBu, 0xD3903872u, 0xD24894F5u,
+    0xD986B758u, 0xD85E1BDFu, 0xDA37EE56u, 0xDBEF42D1u,
+    0xDEE40544u, 0xDF3CA9C3u, 0xDD555C4Au, 0xDC8DF0CDu,
+    0xCAC91B10u, 0xCB11B797u, 0xC978421Eu, 0xC8A0EE99u,
+    0xCDABA90Cu, 0xCC73058Bu, 0xCE1AF002u, 0xCFC25C85u,
+    0xC40C7F28u, 0xC5D4D3AFu, 0xC7BD2626u, 0xC6658AA1u,
+    0xC36ECD34u, 0xC2B661B3u, 0xC0DF943Au, 0xC10738BDu,
+    0x9A7D6240u, 0x9BA5CEC7u, 0x99CC3B4Eu, 0x981497C9u,
+    0x9D1FD05Cu, 0x9CC77CDBu, 0x9EAE8952u, 0x9F7625D5u,
+    0x94B80678u, 0x9560AAFFu, 0x97095F76u, 0x96D1F3F1u,
+    0x93DAB464u, 0x920218E3u, 0x906BED6Au, 0x91B341EDu,
+    0x87F7AA30u, 0x862F06B7u, 0x8446F33Eu, 0x859E5FB9u,
+    0x8095182Cu, 0x814DB4ABu, 0x83244122u, 0x82FCEDA5u,
+    0x8932CE08u, 0x88EA628Fu, 0x8A839706u, 0x8B5B3B81u,
+    0x8E507C14u, 0x8F88D093u, 0x8DE1251Au, 0x8C39899Du,
+    0xA168F2A0u, 0xA0B05E27u, 0xA2D9ABAEu, 0xA3010729u,
+    0xA60A40BCu, 0xA7D2EC3Bu, 0xA5BB19B2u, 0xA463B535u,
+    0xAFAD9698u, 0xAE753A1Fu, 0xAC1CCF96u, 0xADC46311u,
+    0xA8CF2484u, 0xA9178803u, 0xAB7E7D8Au, 0xAAA6D10Du,
+    0xBCE23AD0u, 0xBD3A9657u, 0xBF5363DEu, 0xBE8BCF59u,
+    0xBB8088CCu, 0xBA58244Bu, 0xB831D1C2u, 0xB9E97D45u,
+    0xB2275EE8u, 0xB3FFF26Fu, 0xB19607E6u, 0xB04EAB61u,
+    0xB545ECF4u, 0xB49D4073u, 0xB6F4B5FAu, 0xB72C197Du,
+};
+
+const uint32_t j288_crc_slice3[256] = {
+    0x00000000u, 0xDC6D9AB7u, 0xBC1A28D9u, 0x6077B26Eu,
+    0x7CF54C05u, 0xA098D6B2u, 0xC0EF64DCu, 0x1C82FE6Bu,
+    0xF9EA980Au, 0x258702BDu, 0x45F0B0D3u, 0x999D2A64u,
+    0x851FD40Fu, 0x59724EB8u, 0x3905FCD6u, 0xE5686661u,
+    0xF7142DA3u, 0x2B79B714u, 0x4B0E057Au, 0x97639FCDu,
+    0x8BE161A6u, 0x578CFB11u, 0x37FB497Fu, 0xEB96D3C8u,
+    0x0EFEB5A9u, 0xD2932F1Eu, 0xB2E49D70u, 0x6E8907C7u,
+    0x720BF9ACu, 0xAE66631Bu, 0xCE11D175u, 0x127C4BC2u,
+    0xEAE946F1u, 0x3684DC46u, 0x56F36E28u, 0x8A9EF49Fu,
+    0x961C0AF4u, 0x4A719043u, 0x2A06222Du, 0xF66BB89Au,
+    0x1303DEFBu, 0xCF6E444Cu, 0xAF19F622u, 0x73746C95u,
+    0x6FF692FEu, 0xB39B0849u, 0xD3ECBA27u, 0x0F812090u,
+    0x1DFD6B52u, 0xC190F1E5u, 0xA1E7438Bu, 0x7D8AD93Cu,
+    0x61082757u, 0xBD65BDE0u, 0xDD120F8Eu, 0x017F9539u,
+    0xE417F358u, 0x387A69EFu, 0x580DDB81u, 0x84604136u,
+    0x98E2BF5Du, 0x448F25EAu, 0x24F89784u, 0xF8950D33u,
+    0xD1139055u, 0x0D7E0AE2u, 0x6D09B88Cu, 0xB164223Bu,
+    0xADE6DC50u, 0x718B46E7u, 0x11FCF489u, 0xCD916E3Eu,
+    0x28F9085Fu, 0xF49492E8u, 0x94E32086u, 0x488EBA31u,
+    0x540C445Au, 0x8861DEEDu, 0xE8166C83u, 0x347BF634u,
+    0x2607BDF6u, 0xFA6A2741u, 0x9A1D952Fu, 0x46700F98u,
+    0x5AF2F1F3u, 0x869F6B44u, 0xE6E8D92Au, 0x3A85439Du,
+    0xDFED25FCu, 0x0380BF4Bu, 0x63F70D25u, 0xBF9A9792u,
+    0xA31869F9u, 0x7F75F34Eu, 0x1F024120u, 0xC36FDB97u,
+    0x3BFAD6A4u, 0xE7974C13u, 0x87E0FE7Du, 0x5B8D64CAu,
+    0x470F9AA1u, 0x9B620016u, 0xFB15B278u, 0x277828CFu,
+    0xC2104EAEu, 0x1E7DD419u, 0x7E0A6677u, 0xA267FCC0u,
+    0xBEE502ABu, 0x6288981Cu, 0x02FF2A72u, 0xDE92B0C5u,
+    0xCCEEFB07u, 0x108361B0u, 0x70F4D3DEu, 0xAC994969u,
+    0xB01BB702u, 0x6C762DB5u, 0x0C019FDBu, 0xD06C056Cu,
+    0x3504630Du, 0xE969F9BAu, 0x891E4BD4u, 0x5573D163u,
+    0x49F12F08u, 0x959CB5BFu, 0xF5EB07D1u, 0x29869D66u,
+    0xA6E63D1Du, 0x7A8BA7AAu, 0x1AFC15C4u, 0xC6918F73u,
+    0xDA137118u, 0x067EEBAFu, 0x660959C1u, 0xBA64C376u,
+    0x5F0CA517u, 0x83613FA0u, 0xE3168DCEu, 0x3F7B1779u,
+    0x23F9E912u, 0xFF9473A5u, 0x9FE3C1CBu, 0x438E5B7Cu,
+    0x51F210BEu, 0x8D9F8A09u, 0xEDE83867u, 0x3185A2D0u,
+    0x2D075CBBu, 0xF16AC60Cu, 0x911D7462u, 0x4D70EED5u,
+    0xA81888B4u, 0x74751203u, 0x1402A06Du, 0xC86F3ADAu,
+    0xD4EDC4B1u, 0x08805E06u, 0x68F7EC68u, 0xB49A76DFu,
+    0x4C0F7BECu, 0x9062E15Bu, 0xF0155335u, 0x2C78C982u,
+    0x30FA37E9u, 0xEC97AD5Eu, 0x8CE01F30u, 0x508D8587u,
+    0xB5E5E3E6u, 0x69887951u, 0x09FFCB3Fu, 0xD5925188u,
+    0xC910AFE3u, 0x157D3554u, 0x750A873Au, 0xA9671D8Du,
+    0xBB1B564Fu, 0x6776CCF8u, 0x07017E96u, 0xDB6CE421u,
+    0xC7EE1A4Au, 0x1B8380FDu, 0x7BF43293u, 0xA799A824u,
+    0x42F1CE45u, 0x9E9C54F2u, 0xFEEBE69Cu, 0x22867C2Bu,
+    0x3E048240u, 0xE26918F7u, 0x821EAA99u, 0x5E73302Eu,
+    0x77F5AD48u, 0xAB9837FFu, 0xCBEF8591u, 0x17821F26u,
+    0x0B00E14Du, 0xD76D7BFAu, 0xB71AC994u, 0x6B775323u,
+    0x8E1F3542u, 0x5272AFF5u, 0x32051D9Bu, 0xEE68872Cu,
+    0xF2EA7947u, 0x2E87E3F0u, 0x4EF0519Eu, 0x929DCB29u,
+    0x80E180EBu, 0x5C8C1A5Cu, 0x3CFBA832u, 0xE0963285u,
+    0xFC14CCEEu, 0x20795659u, 0x400EE437u, 0x9C637E80u,
+    0x790B18E1u, 0xA5668256u, 0xC5113038u, 0x197CAA8Fu,
+    0x05FE54E4u, 0xD993CE53u, 0xB9E47C3Du, 0x6589E68Au,
+    0x9D1CEBB9u, 0x4171710Eu, 0x2106C360u, 0xFD6B59D7u,
+    0xE1E9A7BCu, 0x3D843D0Bu, 0x5DF38F65u, 0x819E15D2u,
+    0x64F673B3u, 0xB89BE904u, 0xD8EC5B6Au, 0x0481C1DDu,
+    0x18033FB6u, 0xC46EA501u, 0xA419176Fu, 0x78748DD8u,
+    0x6A08C61Au, 0xB6655CADu, 0xD612EEC3u, 0x0A7F7474u,
+    0x16FD8A1Fu, 0xCA9010A8u, 0xAAE7A2C6u, 0x768A3871u,
+    0x93E25E10u, 0x4F8FC4A7u, 0x2FF876C9u, 0xF395EC7Eu,
+    0xEF171215u, 0x337A88A2u, 0x530D3ACCu, 0x8F60A07Bu,
+};
+
+/*
+ * Every backend folds one word at a time: the wire's word is little-endian and the CRC eats it
+ * MSB first, which is the same as XOR-ing the word into the register and then shifting the
+ * register's 32 bits out (8, 4 or 1 at a time, or through four tables at once). Words are
+ * assembled with shifts, which the compiler turns into a single load where the core allows
+ * unaligned loads.
+ */
 uint32_t j288_crc32_update_table(uint32_t crc, const uint8_t *data, size_t nwords)
 {
     uint32_t c = crc;
     size_t w;
     for (w = 0; w < nwords; w++) {
-        const uint8_t *p = &data[4u * w];
-        unsigned k;
-        for (k = 0u; k < 4u; k++) {
-            c = (c << 8) ^ crc_table256[(c >> 24) ^ p[3u - k]];
-        }
+        c = j288_crc_table_word(c, &data[4u * w]);
+    }
+    return c;
+}
+
+uint32_t j288_crc32_update_slice4(uint32_t crc, const uint8_t *data, size_t nwords)
+{
+    uint32_t c = crc;
+    size_t w;
+    for (w = 0; w < nwords; w++) {
+        c = j288_crc_slice4_word(c, &data[4u * w]);
     }
     return c;
 }
@@ -96,12 +315,10 @@ uint32_t j288_crc32_update_nibble(uint32_t crc, const uint8_t *data, size_t nwor
     uint32_t c = crc;
     size_t w;
     for (w = 0; w < nwords; w++) {
-        const uint8_t *p = &data[4u * w];
         unsigned k;
-        for (k = 0u; k < 4u; k++) {
-            uint32_t b = p[3u - k];
-            c = (c << 4) ^ crc_table16[(c >> 28) ^ (b >> 4)];
-            c = (c << 4) ^ crc_table16[(c >> 28) ^ (b & 0x0Fu)];
+        c ^= j288_get_u32le(&data[4u * w]);
+        for (k = 0u; k < 8u; k++) {
+            c = (c << 4) ^ crc_table16[c >> 28];
         }
     }
     return c;
@@ -112,10 +329,8 @@ uint32_t j288_crc32_update_bitwise(uint32_t crc, const uint8_t *data, size_t nwo
     uint32_t c = crc;
     size_t w;
     for (w = 0; w < nwords; w++) {
-        const uint8_t *p = &data[4u * w];
         unsigned bit;
-        c ^= ((uint32_t)p[0]) | ((uint32_t)p[1] << 8) | ((uint32_t)p[2] << 16) |
-             ((uint32_t)p[3] << 24);
+        c ^= j288_get_u32le(&data[4u * w]);
         for (bit = 0; bit < 32u; bit++) {
             c = ((c & 0x80000000u) != 0u) ? ((c << 1) ^ J288_CRC32_POLY) : (c << 1);
         }
@@ -123,21 +338,14 @@ uint32_t j288_crc32_update_bitwise(uint32_t crc, const uint8_t *data, size_t nwo
     return c;
 }
 
-#if J288_CONFIG_CRC_BACKEND == J288_CRC_BACKEND_HW
-extern uint32_t J288_CONFIG_CRC_HW_FUNCTION(const uint8_t *data, size_t nwords);
-#endif
-
 uint32_t j288_crc32(const uint8_t *data, size_t nwords)
 {
-#if J288_CONFIG_CRC_BACKEND == J288_CRC_BACKEND_TABLE
-    return j288_crc32_update_table(J288_CRC32_INIT, data, nwords);
-#elif J288_CONFIG_CRC_BACKEND == J288_CRC_BACKEND_NIBBLE
-    return j288_crc32_update_nibble(J288_CRC32_INIT, data, nwords);
-#elif J288_CONFIG_CRC_BACKEND == J288_CRC_BACKEND_BITWISE
-    return j288_crc32_update_bitwise(J288_CRC32_INIT, data, nwords);
-#else
-    return J288_CONFIG_CRC_HW_FUNCTION(data, nwords);
-#endif
+    return j288_crc_default(data, nwords);
+}
+
+uint32_t j288_crc_frame_default(const uint8_t *data, size_t nwords)
+{
+    return j288_crc_frame_unrolled(data, nwords);
 }
 
 uint32_t j288_crc32_mpeg2_bytes(const uint8_t *data, size_t len)
@@ -145,7 +353,7 @@ uint32_t j288_crc32_mpeg2_bytes(const uint8_t *data, size_t len)
     uint32_t crc = J288_CRC32_INIT;
     size_t i;
     for (i = 0; i < len; i++) {
-        crc = (crc << 8) ^ crc_table256[(crc >> 24) ^ data[i]];
+        crc = (crc << 8) ^ j288_crc_table256[(crc >> 24) ^ data[i]];
     }
     return crc;
 }
@@ -155,5 +363,5 @@ uint32_t j288_crc32_run(const j288_crc_t *crc, const uint8_t *data, size_t nword
     if ((crc != NULL) && (crc->fn != NULL)) {
         return crc->fn(crc->ctx, data, nwords);
     }
-    return j288_crc32(data, nwords);
+    return j288_crc_default(data, nwords);
 }

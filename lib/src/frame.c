@@ -1,7 +1,9 @@
-/* Command and reply frames, byte by byte; see j288/frame.h for the contract. */
+/* Command and reply frames; see j288/frame.h for the contract. */
 #include "j288/frame.h"
 
 #include <string.h>
+
+#include "internal.h"
 
 /* Byte offsets on the wire (spec tables). */
 enum {
@@ -25,14 +27,13 @@ static uint8_t mode_id(uint8_t mode) { return (uint8_t)(mode & 0x0Fu); }
 static uint8_t mode_status(uint8_t mode) { return (uint8_t)((mode >> 4) & 0x07u); }
 static bool mode_timeout(uint8_t mode) { return (mode & 0x80u) != 0u; }
 
-/* Two's complement from the unsigned wire pattern, without implementation-defined casts. */
+/* Two's complement from the unsigned wire pattern, without implementation-defined casts
+ * (flipping the sign bit and subtracting its weight; compilers emit one sign extension). */
 static int16_t as_i16(uint16_t u)
 {
-    int32_t v = (int32_t)u;
-    if (v >= 0x8000) {
-        v -= 0x10000;
-    }
-    return (int16_t)v;
+    uint32_t flipped = (uint32_t)u ^ 0x8000u;
+    int32_t v = (int32_t)flipped;
+    return (int16_t)(v - 0x8000);
 }
 
 static int32_t as_i32(uint32_t u)
@@ -49,45 +50,35 @@ static int32_t as_i32(uint32_t u)
 static uint16_t from_i16(int16_t v) { return (uint16_t)v; }
 static uint32_t from_i32(int32_t v) { return (uint32_t)v; }
 
-static int cmd_check(const j288_cmd_raw_t *cmd)
+/* Two 16-bit fields as the little-endian word they make on the wire. */
+static uint32_t pair16(int16_t lo, int16_t hi)
 {
-    if (cmd->id > J288_BROADCAST_ID) {
-        return J288_ERR_BAD_ID;
-    }
-    if (cmd->status > J288_MODE_FOC) {
-        return J288_ERR_BAD_STATUS;
-    }
-    if ((cmd->kp < 0) || (cmd->kd < 0)) {
-        return J288_ERR_NEG_GAIN;
-    }
-    return J288_OK;
+    return (uint32_t)from_i16(lo) | ((uint32_t)from_i16(hi) << 16);
 }
+
+/* The head's two bytes as one little-endian halfword, for a single compare. */
+#define CMD_HEAD16 (J288_CMD_HEAD0 | ((uint32_t)J288_CMD_HEAD1 << 8u))
+#define RPL_HEAD16 (J288_REPLY_HEAD0 | ((uint32_t)J288_REPLY_HEAD1 << 8u))
 
 int j288_cmd_encode(const j288_cmd_raw_t *cmd, uint8_t out[J288_CMD_LEN], const j288_crc_t *crc)
 {
-    uint8_t f[J288_CMD_LEN];
     int err;
 
     if ((cmd == NULL) || (out == NULL)) {
         return J288_ERR_NULL;
     }
-    err = cmd_check(cmd);
+    err = j288_cmd_check(cmd);
     if (err != J288_OK) {
         return err;
     }
-    /* Built in a local frame and copied at the end, so out is untouched on any error and
-     * never holds a half-built frame that a DMA could pick up. */
-    f[0] = J288_CMD_HEAD0;
-    f[1] = J288_CMD_HEAD1;
-    f[CMD_MODE] = mode_pack(cmd->id, cmd->status, cmd->watchdog);
-    f[CMD_RES] = 0u;
-    j288_put_u16le(&f[CMD_TAU], from_i16(cmd->tau));
-    j288_put_u16le(&f[CMD_SPEED], from_i16(cmd->speed));
-    j288_put_u32le(&f[CMD_POS], from_i32(cmd->pos));
-    j288_put_u16le(&f[CMD_KP], from_i16(cmd->kp));
-    j288_put_u16le(&f[CMD_KD], from_i16(cmd->kd));
-    j288_put_u32le(&f[CMD_CRC], j288_crc32_run(crc, f, CMD_CRC_WORDS));
-    (void)memcpy(out, f, sizeof f);
+    /* Every check is done: out is written only now, as the four words the frame is made of
+     * (head, mode and reserved byte; tau and speed; pos; kp and kd), then its CRC. */
+    j288_store_le32(&out[0], CMD_HEAD16 |
+                                 ((uint32_t)mode_pack(cmd->id, cmd->status, cmd->watchdog) << 16));
+    j288_store_le32(&out[CMD_TAU], pair16(cmd->tau, cmd->speed));
+    j288_store_le32(&out[CMD_POS], from_i32(cmd->pos));
+    j288_store_le32(&out[CMD_KP], pair16(cmd->kp, cmd->kd));
+    j288_store_le32(&out[CMD_CRC], j288_crc_frame_hot(crc, out, CMD_CRC_WORDS));
     return J288_OK;
 }
 
@@ -107,7 +98,7 @@ void j288_cmd_unpack(const uint8_t in[J288_CMD_LEN], j288_cmd_raw_t *cmd)
 
 uint32_t j288_cmd_crc_expected(const uint8_t in[J288_CMD_LEN], const j288_crc_t *crc)
 {
-    return j288_crc32_run(crc, in, CMD_CRC_WORDS);
+    return j288_crc_frame(crc, in, CMD_CRC_WORDS);
 }
 
 uint32_t j288_frame_crc_field(const uint8_t *frame, size_t len)
@@ -124,7 +115,7 @@ int j288_cmd_decode(const uint8_t in[J288_CMD_LEN], j288_cmd_raw_t *cmd, const j
     if ((in == NULL) || (cmd == NULL)) {
         return J288_ERR_NULL;
     }
-    if ((in[0] != J288_CMD_HEAD0) || (in[1] != J288_CMD_HEAD1)) {
+    if (j288_get_u16le(in) != CMD_HEAD16) {
         return J288_ERR_BAD_HEADER;
     }
     if (j288_cmd_crc_expected(in, crc) != j288_get_u32le(&in[CMD_CRC])) {
@@ -164,7 +155,7 @@ int j288_reply_encode(const j288_reply_raw_t *reply, uint8_t out[J288_REPLY_LEN]
     j288_put_u16le(&f[RPL_OUT],
                    (uint16_t)(reply->out_pos | ((unsigned)reply->warnings << EXFLAG_SHIFT)));
     j288_put_u16le(&f[RPL_RES], reply->reserved);
-    j288_put_u32le(&f[RPL_CRC], j288_crc32_run(crc, &f[RPL_CRC_FIRST], RPL_CRC_WORDS));
+    j288_put_u32le(&f[RPL_CRC], j288_crc_frame(crc, &f[RPL_CRC_FIRST], RPL_CRC_WORDS));
     (void)memcpy(out, f, sizeof f);
     return J288_OK;
 }
@@ -191,7 +182,7 @@ void j288_reply_unpack(const uint8_t in[J288_REPLY_LEN], j288_reply_raw_t *reply
 
 uint32_t j288_reply_crc_expected(const uint8_t in[J288_REPLY_LEN], const j288_crc_t *crc)
 {
-    return j288_crc32_run(crc, &in[RPL_CRC_FIRST], RPL_CRC_WORDS);
+    return j288_crc_frame(crc, &in[RPL_CRC_FIRST], RPL_CRC_WORDS);
 }
 
 int j288_reply_decode(const uint8_t in[J288_REPLY_LEN], j288_reply_raw_t *reply,
@@ -200,7 +191,7 @@ int j288_reply_decode(const uint8_t in[J288_REPLY_LEN], j288_reply_raw_t *reply,
     if ((in == NULL) || (reply == NULL)) {
         return J288_ERR_NULL;
     }
-    if ((in[0] != J288_REPLY_HEAD0) || (in[1] != J288_REPLY_HEAD1)) {
+    if (j288_get_u16le(in) != RPL_HEAD16) {
         return J288_ERR_BAD_HEADER;
     }
     if (j288_reply_crc_expected(in, crc) != j288_get_u32le(&in[RPL_CRC])) {

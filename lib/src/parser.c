@@ -3,6 +3,8 @@
 
 #include <string.h>
 
+#include "internal.h"
+
 int j288_parser_init(j288_parser_t *p, j288_parse_kind_t kind, const j288_crc_t *crc)
 {
     if (p == NULL) {
@@ -14,16 +16,31 @@ int j288_parser_init(j288_parser_t *p, j288_parse_kind_t kind, const j288_crc_t 
     (void)memset(p, 0, sizeof *p);
     p->kind = kind;
     p->crc = crc;
-    p->head0 = (kind == J288_PARSE_REPLY) ? J288_REPLY_HEAD0 : J288_CMD_HEAD0;
-    p->frame_len = (uint8_t)((kind == J288_PARSE_REPLY) ? J288_REPLY_LEN : J288_CMD_LEN);
+    if (kind == J288_PARSE_REPLY) {
+        p->head0 = J288_REPLY_HEAD0;
+        p->frame_len = (uint8_t)J288_REPLY_LEN;
+        p->crc_first = 2u; /* bytes 2-21 */
+        p->crc_words = 5u;
+    } else {
+        p->head0 = J288_CMD_HEAD0;
+        p->frame_len = (uint8_t)J288_CMD_LEN;
+        p->crc_first = 0u; /* bytes 0-15 */
+        p->crc_words = 4u;
+    }
     return J288_OK;
 }
 
-static bool frame_crc_ok(const j288_parser_t *p)
+/* The CRC of a whole frame at f against its field, the frame's last four bytes. */
+static inline bool frame_crc_ok(const j288_parser_t *p, const uint8_t *f)
 {
-    uint32_t want = (p->kind == J288_PARSE_REPLY) ? j288_reply_crc_expected(p->buf, p->crc)
-                                                  : j288_cmd_crc_expected(p->buf, p->crc);
-    return want == j288_frame_crc_field(p->buf, p->frame_len);
+    return j288_crc_frame_hot(p->crc, &f[p->crc_first], p->crc_words) ==
+           j288_get_u32le(&f[p->frame_len - 4u]);
+}
+
+/* The head's two bytes as one little-endian halfword. */
+static uint16_t head16(const j288_parser_t *p)
+{
+    return (uint16_t)(p->head0 | ((unsigned)J288_REPLY_HEAD1 << 8));
 }
 
 /* After a bad frame: keep from the next position that could still start a frame. A head
@@ -40,6 +57,26 @@ static void resync(j288_parser_t *p)
     p->stats.dropped_bytes += i;
     p->len = (uint8_t)(p->len - i);
     (void)memmove(p->buf, &p->buf[i], p->len);
+}
+
+/* A whole frame held in buf failed its CRC: count it and resynchronise inside it. */
+static void drop_frame(j288_parser_t *p)
+{
+    p->stats.crc_errors++;
+    resync(p);
+}
+
+/* The byte path has collected a whole frame in buf: count it, or drop it and resync. Out of
+ * line, so that the byte path's per-byte work stays short. */
+J288_NOINLINE static bool collected(j288_parser_t *p)
+{
+    if (frame_crc_ok(p, p->buf)) {
+        p->stats.frames++;
+        p->len = 0u;
+        return true;
+    }
+    drop_frame(p);
+    return false;
 }
 
 /* One byte in; true when a good frame completes. Both heads end in 0xEE. */
@@ -65,36 +102,133 @@ static bool take_byte(j288_parser_t *p, uint8_t b)
     }
     p->buf[p->len] = b;
     p->len++;
-    if (p->len < p->frame_len) {
-        return false;
-    }
-    if (frame_crc_ok(p)) {
+    return (p->len == p->frame_len) && collected(p);
+}
+
+/* While hunting, a head with a whole frame behind it in the caller's data: checked where it
+ * lies. True when good (counted); a bad one is copied into buf and dropped exactly as the byte
+ * path drops it once collected. */
+static bool take_whole(j288_parser_t *p, const uint8_t *f)
+{
+    if (frame_crc_ok(p, f)) {
         p->stats.frames++;
-        p->len = 0u;
         return true;
     }
-    p->stats.crc_errors++;
-    resync(p);
+    (void)memcpy(p->buf, f, p->frame_len);
+    p->len = p->frame_len;
+    drop_frame(p);
     return false;
+}
+
+/* The general case: a byte that does not start a head while hunting is garbage, a head with a
+ * whole frame behind it goes to take_whole(), everything else through take_byte(), which
+ * also resynchronises inside a dropped frame. Returns the bytes consumed; *frame is set when
+ * a good frame completed (and left alone otherwise). */
+J288_NOINLINE static size_t scan_bytes(j288_parser_t *p, const uint8_t *data, size_t len,
+                                       const uint8_t **frame)
+{
+    size_t i = 0u;
+
+    while (i < len) {
+        const uint8_t *f = &data[i];
+        size_t left = len - i;
+        if ((p->len == 0u) && (left >= 2u)) {
+            if (j288_get_u16le(f) != head16(p)) {
+                p->stats.garbage_bytes++;
+                i++;
+                continue;
+            }
+            if (left >= p->frame_len) {
+                i += p->frame_len;
+                if (take_whole(p, f)) {
+                    *frame = f;
+                    return i;
+                }
+                continue;
+            }
+        }
+        i++;
+        if (take_byte(p, *f)) {
+            *frame = p->buf;
+            return i;
+        }
+    }
+    return len;
+}
+
+/* The common case: nothing held and data starting with a whole frame, as a frame received in
+ * one piece arrives. Returns the bytes taken (the frame, good or dropped; *good tells), or 0
+ * when data does not start that way. */
+static size_t take_first(j288_parser_t *p, const uint8_t *data, size_t len, bool *good)
+{
+    *good = false;
+    /* (A frame is at least a command long: data holds two bytes to read.) */
+    if ((p->len != 0u) || (len < J288_CMD_LEN) || (len < p->frame_len) ||
+        (j288_get_u16le(data) != head16(p))) {
+        return 0u;
+    }
+    *good = take_whole(p, data);
+    return p->frame_len;
+}
+
+static J288_INLINE_HOT int scan(j288_parser_t *p, const uint8_t *data, size_t len,
+                                size_t *consumed, const uint8_t **frame)
+{
+    const uint8_t *f = NULL;
+    bool good;
+    size_t from = take_first(p, data, len, &good);
+    if (good) {
+        *consumed = from;
+        *frame = data;
+        return J288_PARSE_FRAME;
+    }
+    /* A frame in progress takes the bytes that follow one by one, here (the common case when a
+     * port hands over a byte at a time); the hunt for heads goes on in scan_bytes(). */
+    while ((p->len != 0u) && (from < len)) {
+        from++;
+        if (take_byte(p, data[from - 1u])) {
+            *consumed = from;
+            *frame = p->buf;
+            return J288_PARSE_FRAME;
+        }
+    }
+    if (from == len) {
+        *consumed = len;
+        return J288_PARSE_NONE;
+    }
+    *consumed = from + scan_bytes(p, &data[from], len - from, &f);
+    *frame = f;
+    return (f != NULL) ? J288_PARSE_FRAME : J288_PARSE_NONE;
+}
+
+int j288_parser_scan(j288_parser_t *p, const uint8_t *data, size_t len, size_t *consumed,
+                     const uint8_t **frame)
+{
+    return scan(p, data, len, consumed, frame);
 }
 
 int j288_parser_feed(j288_parser_t *p, const uint8_t *data, size_t len, size_t *consumed)
 {
-    size_t i;
+    const uint8_t *f = NULL;
+    int rc;
+
     if (consumed != NULL) {
         *consumed = 0u;
     }
     if ((p == NULL) || (consumed == NULL) || ((data == NULL) && (len != 0u))) {
         return J288_ERR_NULL;
     }
-    for (i = 0u; i < len; i++) {
-        if (take_byte(p, data[i])) {
-            *consumed = i + 1u;
-            return J288_PARSE_FRAME;
+    rc = scan(p, data, len, consumed, &f);
+    if ((rc == J288_PARSE_FRAME) && (f != p->buf)) {
+        /* Checked in the caller's data: the parser keeps its own copy (constant lengths, so
+         * that the compiler copies words). */
+        if (p->kind == J288_PARSE_REPLY) {
+            (void)memcpy(p->buf, f, J288_REPLY_LEN);
+        } else {
+            (void)memcpy(p->buf, f, J288_CMD_LEN);
         }
     }
-    *consumed = len;
-    return J288_PARSE_NONE;
+    return rc;
 }
 
 const uint8_t *j288_parser_frame(const j288_parser_t *p)
@@ -121,6 +255,6 @@ int j288_parser_flush(j288_parser_t *p)
 void j288_parser_reset(j288_parser_t *p)
 {
     if (p != NULL) {
-        p->len = 0u;
+        j288_parser_drop(p);
     }
 }

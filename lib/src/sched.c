@@ -3,30 +3,7 @@
 
 #include <string.h>
 
-/* Thread-side changes to state that the bus ISR reads (advance_in_isr only). */
-static void sched_lock(const j288_sched_t *s)
-{
-    const j288_bus_t *b = s->bus;
-    if (b->cfg.advance_in_isr && !b->in_advance && (b->port->lock != NULL)) {
-        b->port->lock(b->port_ctx);
-    }
-}
-
-static void sched_unlock(const j288_sched_t *s)
-{
-    const j288_bus_t *b = s->bus;
-    if (b->cfg.advance_in_isr && !b->in_advance && (b->port->unlock != NULL)) {
-        b->port->unlock(b->port_ctx);
-    }
-}
-
-static void lock_cmd(j288_cmd_raw_t *c, uint8_t id, bool watchdog)
-{
-    (void)memset(c, 0, sizeof *c);
-    c->id = id;
-    c->status = J288_MODE_LOCK;
-    c->watchdog = watchdog;
-}
+#include "internal.h"
 
 int j288_sched_init(j288_sched_t *s, j288_bus_t *bus, const j288_sched_config_t *cfg)
 {
@@ -44,7 +21,7 @@ int j288_sched_init(j288_sched_t *s, j288_bus_t *bus, const j288_sched_config_t 
         s->cfg.offline_after = (uint8_t)J288_DEFAULT_OFFLINE_AFTER;
     }
     for (i = 0u; i < J288_MAX_SERVOS; i++) {
-        lock_cmd(&s->slot[i].cmd, i, true);
+        j288_cmd_lock(&s->slot[i].cmd, i, true);
         s->slot[i].last_result = J288_OK;
     }
     return J288_OK;
@@ -64,23 +41,23 @@ int j288_sched_enable(j288_sched_t *s, uint8_t id, bool enabled)
 
 int j288_sched_set_cmd(j288_sched_t *s, const j288_cmd_raw_t *cmd)
 {
+    int err;
+
     if ((s == NULL) || (cmd == NULL)) {
         return J288_ERR_NULL;
     }
-    /* The encoder's checks, in its order, so that a slot never holds a command the bus
-     * would refuse mid-sweep. */
+    /* The encoder's checks, so that a slot never holds a command the bus would refuse
+     * mid-sweep; 15 (broadcast) is not a slot. */
     if (cmd->id > J288_MAX_ID) {
         return J288_ERR_BAD_ID;
     }
-    if (cmd->status > J288_MODE_FOC) {
-        return J288_ERR_BAD_STATUS;
+    err = j288_cmd_check(cmd);
+    if (err != J288_OK) {
+        return err;
     }
-    if ((cmd->kp < 0) || (cmd->kd < 0)) {
-        return J288_ERR_NEG_GAIN;
-    }
-    sched_lock(s);
+    j288_bus_lock(s->bus);
     s->slot[cmd->id].cmd = *cmd;
-    sched_unlock(s);
+    j288_bus_unlock(s->bus);
     return J288_OK;
 }
 
@@ -206,19 +183,20 @@ static int next_slot(j288_sched_t *s, uint32_t now)
         while (s->cursor < J288_MAX_SERVOS) {
             uint8_t id = s->cursor++;
             j288_slot_t *slot = &s->slot[id];
-            j288_cmd_raw_t cmd;
+            const j288_cmd_raw_t *cmd = &slot->cmd; /* its id is the slot's (set_cmd, init) */
+            j288_cmd_raw_t cleared;
             int rc;
             if (!slot->enabled) {
                 continue;
             }
-            cmd = slot->cmd;
-            cmd.id = id;
             s->wd_clear_in_flight = slot->clear_watchdog;
             if (slot->clear_watchdog) {
-                cmd.watchdog = false;
+                cleared = *cmd;
+                cleared.watchdog = false;
+                cmd = &cleared;
             }
             s->sent++;
-            rc = j288_bus_submit(s->bus, &cmd, now, sched_done, s);
+            rc = j288_bus_submit(s->bus, cmd, now, sched_done, s);
             if (rc == J288_OK) {
                 return J288_OK; /* sched_done continues the sweep */
             }
@@ -307,9 +285,9 @@ int j288_sched_clear_watchdog(j288_sched_t *s, uint8_t id)
     if (id > J288_MAX_ID) {
         return J288_ERR_BAD_ID;
     }
-    sched_lock(s);
+    j288_bus_lock(s->bus);
     s->slot[id].clear_watchdog = true;
-    sched_unlock(s);
+    j288_bus_unlock(s->bus);
     return J288_OK;
 }
 
@@ -320,13 +298,13 @@ int j288_sched_estop(j288_sched_t *s, uint32_t now_us)
     if (s == NULL) {
         return J288_ERR_NULL;
     }
-    sched_lock(s);
+    j288_bus_lock(s->bus);
     s->sweeping = false;
     s->stopped = true;
     for (i = 0u; i < J288_MAX_SERVOS; i++) {
-        lock_cmd(&s->slot[i].cmd, i, s->slot[i].cmd.watchdog);
+        j288_cmd_lock(&s->slot[i].cmd, i, s->slot[i].cmd.watchdog);
     }
-    sched_unlock(s);
+    j288_bus_unlock(s->bus);
     return j288_bus_estop(s->bus, now_us);
 }
 

@@ -39,6 +39,12 @@ const char *j288_strerror(int err)
         {J288_ERR_ABORTED, "aborted by emergency stop"},
         {J288_ERR_OVERFLOW, "receive overflow"},
         {J288_ERR_OFFLINE, "device gone"},
+        {J288_ERR_ANGLE_UNKNOWN, "joint angle not known (starting, or lost)"},
+        {J288_ERR_CAL_MISMATCH, "calibrated phase disagrees with the output encoder"},
+        {J288_ERR_LIMIT_POS, "target position outside the joint's limits"},
+        {J288_ERR_LIMIT_SPEED, "target speed beyond the joint's limit"},
+        {J288_ERR_LIMIT_TORQUE, "target torque beyond the joint's limit"},
+        {J288_ERR_CAL_DATA, "calibration data fail a quality check"},
     };
     size_t i;
     for (i = 0; i < (sizeof(err_texts) / sizeof(err_texts[0])); i++) {

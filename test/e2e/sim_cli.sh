@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # j288-sim as a program: --help, argument errors, the pty path line, --link, --log, exit on
-# SIGINT/SIGTERM and --exit-after with the statistics line, nothing left behind, and the
-# fault switch (SIGUSR1 off, SIGUSR2 on) seen through the j288 tool's status command.
+# SIGINT/SIGTERM and --exit-after with the statistics line, nothing left behind, the
+# fault switch (SIGUSR1 off, SIGUSR2 on) seen through the j288 tool's status command, and
+# the joint: --phase/--start-angle, the --truth file (start, SIGWINCH, power cycles, exit)
+# against what the j288 tool reads, power cycles (SIGPWR, --power-cycle-after).
 # Run from the repo root with BIN set (make test does); J288_SIM and J288 may name other
 # binaries (make test-valgrind points them at test/e2e/valgrind-wrap.sh).
 # No check depends on the machine's speed: waits poll for what they expect, bounded (10-30 s),
@@ -47,7 +49,13 @@ wait_exit() {
     return 124
 }
 
-t_help() { "$SIM" --help | grep -q -- '--ids' && "$SIM" --help | grep -q -- '--exit-after'; }
+t_help() {
+    local opt
+    for opt in --ids --exit-after --phase --start-angle --backlash --truth --power-cycle-after \
+        --power-off-ms SIGPWR SIGWINCH; do
+        "$SIM" --help | grep -q -- "$opt" || { echo "--help does not mention $opt"; return 1; }
+    done
+}
 t_bad_option() {
     "$SIM" --bogus >/dev/null 2>"$tmp/e"; local rc=$?
     [ $rc -eq 2 ] && [ "$(wc -l <"$tmp/e")" -eq 1 ] && grep -q "unknown option '--bogus'" "$tmp/e"
@@ -144,6 +152,109 @@ t_fault_switch_late_in_flight() {
     kill -s TERM "$SIM_PID"; wait_exit "$SIM_PID" || return 1
     grep -q '^j288-sim: stats: .* commands 3 .* replies 3 dropped 0 corrupted 0 late 1 ' "$tmp/err"
 }
+
+# ---- the joint and the truth file ---------------------------------------------------------
+# truth_val FILE ID KEY: the value of KEY on servo ID's line of a --truth file.
+truth_val() {
+    awk -v id="$2" -v key="$3" '$1 == "id=" id {
+        for (i = 2; i <= NF; i++) { n = index($i, "="); if (substr($i, 1, n - 1) == key) print substr($i, n + 1) } }' "$1"
+}
+# json_int NAME: the integer field NAME of the status JSON in $tmp/json.
+json_int() { grep -o "\"$1\": -\?[0-9]*" "$tmp/json" | head -n1 | sed 's/.*: //'; }
+# status_json ID: one status exchange as JSON into $tmp/json (250 ms margin).
+status_json() {
+    timeout 30 "$J288" --port "$SIM_PTY" status --id "$1" --retries 0 --margin-us 250000 --json \
+        >"$tmp/json" 2>"$tmp/st"
+}
+# The count a 13-bit encoder gives for output angle $1, and the reply's raw position for $1 rad.
+out_pos_of() { awk -v t="$1" 'BEGIN { pi = atan2(0, -1); f = t / (2 * pi); f -= int(f); if (f < 0) f += 1; print int(f * 8192) }'; }
+pos_raw_of() { awk -v p="$1" 'BEGIN { pi = atan2(0, -1); v = p * 32768 / (2 * pi); print (v < 0) ? -int(-v + 0.5) : int(v + 0.5) }'; }
+
+# --phase and --start-angle give the truth at start (written before the path line); the tool
+# reads the OutPos and rotor position it implies; SIGWINCH and the exit rewrite the file.
+t_truth_start() {
+    [ -x "$J288" ] || { echo "$J288 not built"; return 1; }
+    local f=$tmp/truth
+    rm -f "$f"
+    start_sim --ids 1,2 --phase 1:2.5 --start-angle 1:-1.25 --truth "$f" --quiet --exit-after 120 || return 1
+    [ "$(head -n1 "$f")" = "# j288-sim truth seq=1 t=0.000000 reason=start" ] || { echo "header: $(head -n1 "$f")"; return 1; }
+    [ "$(grep -c '^id=' "$f")" -eq 2 ] || return 1
+    [ "$(truth_val "$f" 1 c)" = 2.500000000 ] && [ "$(truth_val "$f" 1 theta)" = -1.250000000 ] || return 1
+    [ "$(truth_val "$f" 1 out_pos)" = "$(out_pos_of -1.25)" ] || { echo "out_pos $(truth_val "$f" 1 out_pos)"; return 1; }
+    awk -v p="$(truth_val "$f" 1 p)" 'BEGIN { exit !(p >= 0 && p < 2 * atan2(0, -1)) }' || return 1
+    status_json 1 || { echo "status failed: $(cat "$tmp/st")"; return 1; }
+    [ "$(json_int out_pos_raw)" = "$(truth_val "$f" 1 out_pos)" ] || { echo "out_pos_raw $(json_int out_pos_raw)"; return 1; }
+    [ "$(json_int pos_raw)" = "$(pos_raw_of "$(truth_val "$f" 1 p)")" ] || { echo "pos_raw $(json_int pos_raw)"; return 1; }
+    kill -s WINCH "$SIM_PID"
+    wait_file "$f" '^# j288-sim truth seq=2 t=[0-9.]+ reason=request$' || { echo "no request truth"; return 1; }
+    [ "$(truth_val "$f" 1 c)" = 2.500000000 ] || return 1
+    kill -s TERM "$SIM_PID"; wait_exit "$SIM_PID" || return 1
+    grep -Eq '^# j288-sim truth seq=3 t=[0-9.]+ reason=exit$' "$f" && [ ! -e "$f.tmp" ] &&
+        grep -q ' power-cycles 0$' "$tmp/err"
+}
+# Same seed, same servos; another seed, others.
+t_truth_deterministic() {
+    local s
+    for s in 5 5 6; do
+        "$SIM" --ids 1,2,3 --seed $s --truth "$tmp/t$s" --exit-after 0.01 --quiet >/dev/null 2>&1 || return 1
+        grep '^id=' "$tmp/t$s" >>"$tmp/all$s"
+    done
+    [ "$(grep -c '^id=' "$tmp/all5")" -eq 6 ] && [ "$(sed -n 1,3p "$tmp/all5")" = "$(sed -n 4,6p "$tmp/all5")" ] &&
+        ! cmp -s <(sed -n 1,3p "$tmp/all5") "$tmp/all6"
+}
+# SIGPWR: every servo off for --power-off-ms, the truth written when they go off and when they
+# are back; the turn count is lost: a servo moved several rotor turns reports p inside
+# [0, 2 pi) again, with the same OutPos, and k took the turns.
+t_power_cycle_signal() {
+    [ -x "$J288" ] || { echo "$J288 not built"; return 1; }
+    local f=$tmp/truth k0
+    rm -f "$f"
+    start_sim --ids 1,2 --truth "$f" --power-off-ms 200 --exit-after 120 || return 1
+    k0=$(truth_val "$f" 1 k)
+    timeout 30 "$J288" --port "$SIM_PTY" move --id 1 --pos 20 --side rotor --speed 50 --duration 1.5 \
+        --retries 1 --margin-us 250000 >/dev/null 2>"$tmp/st" || { echo "move failed: $(cat "$tmp/st")"; return 1; }
+    status_json 1 || return 1
+    [ "$(json_int pos_raw)" -gt 32768 ] || { echo "the move did not turn the rotor: $(json_int pos_raw)"; return 1; }
+    kill -s PWR "$SIM_PID"
+    wait_err '^j288-sim: power cycle: servos 1 2 off for 200 ms$' || { echo "no power cycle message"; return 1; }
+    wait_file "$f" 'reason=power-on$' || { echo "no power-on truth"; return 1; }
+    [ "$(truth_val "$f" 1 powered)" = 1 ] && [ "$(truth_val "$f" 1 cycles)" = 1 ] &&
+        [ "$(truth_val "$f" 2 cycles)" = 1 ] || { cat "$f"; return 1; }
+    [ "$(truth_val "$f" 1 k)" -gt $((k0 + 1)) ] || { echo "k $k0 -> $(truth_val "$f" 1 k)"; return 1; }
+    status_json 1 || { echo "status failed after the power cycle: $(cat "$tmp/st")"; return 1; }
+    [ "$(json_int pos_raw)" -ge 0 ] && [ "$(json_int pos_raw)" -lt 32768 ] || { echo "pos_raw $(json_int pos_raw)"; return 1; }
+    [ "$(json_int pos_raw)" = "$(pos_raw_of "$(truth_val "$f" 1 p)")" ] &&
+        [ "$(json_int out_pos_raw)" = "$(truth_val "$f" 1 out_pos)" ] || { cat "$tmp/json" "$f"; return 1; }
+    grep -q '"mode_name": "lock"' "$tmp/json" && grep -q '"watchdog": 0' "$tmp/json" || return 1
+    kill -s TERM "$SIM_PID"; wait_exit "$SIM_PID" || return 1
+    grep -q ' power-cycles 2$' "$tmp/err"
+}
+# --power-cycle-after 0:1 with a minute off: servo 1 is silent, servo 2 answers.
+t_power_cycle_option() {
+    [ -x "$J288" ] || { echo "$J288 not built"; return 1; }
+    local f=$tmp/truth
+    rm -f "$f"
+    start_sim --ids 1,2 --truth "$f" --power-cycle-after 0:1 --power-off-ms 60000 --quiet --exit-after 120 || return 1
+    wait_file "$f" 'reason=power-off$' || { echo "no power-off truth"; return 1; }
+    [ "$(truth_val "$f" 1 powered)" = 0 ] && [ "$(truth_val "$f" 2 powered)" = 1 ] || { cat "$f"; return 1; }
+    status_fails || { echo "servo 1 answered while off"; return 1; }
+    status_json 2 || { echo "servo 2 did not answer: $(cat "$tmp/st")"; return 1; }
+    kill -s TERM "$SIM_PID"; wait_exit "$SIM_PID" || return 1
+    grep -q ' power-cycles 1$' "$tmp/err"
+}
+t_joint_bad_values() {
+    local args
+    for args in "--phase 3:1|--phase names an id" "--phase 1|--phase: expected ID:RAD" \
+        "--start-angle 1:x|--start-angle: 'x' is not a number" "--backlash 2|--backlash" \
+        "--power-cycle-after 1:4|--power-cycle-after names an id" \
+        "--power-cycle-after -1|--power-cycle-after" "--power-off-ms 70000|--power-off-ms" \
+        "--truth $tmp/no/such/dir/t|--truth $tmp/no/such/dir/t.tmp: No such file"; do
+        # shellcheck disable=SC2086
+        "$SIM" --ids 1 ${args%%|*} --exit-after 1 >/dev/null 2>"$tmp/e"; local rc=$?
+        [ $rc -eq 2 ] && grep -qF -- "${args#*|}" "$tmp/e" || { echo "${args%%|*}: rc $rc: $(cat "$tmp/e")"; return 1; }
+    done
+}
+
 t_link_refuses_file() {
     echo keep >"$tmp/file"
     "$SIM" --link "$tmp/file" --exit-after 1 >/dev/null 2>"$tmp/e"; local rc=$?
@@ -159,6 +270,11 @@ check log_frames t_log_frames
 check link_refuses_file t_link_refuses_file
 check fault_switch t_fault_switch
 check fault_switch_late_in_flight t_fault_switch_late_in_flight
+check joint_bad_values t_joint_bad_values
+check truth_start t_truth_start
+check truth_deterministic t_truth_deterministic
+check power_cycle_signal t_power_cycle_signal
+check power_cycle_option t_power_cycle_option
 
 echo "$tests Tests $failures Failures 0 Ignored"
 [ $failures -eq 0 ]

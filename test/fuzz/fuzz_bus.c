@@ -30,7 +30,18 @@
  *   those of them that failed), timeouts and collisions those the callbacks report plus at
  *   most the stop frames';
  * - a stop frame that fails is sent again (whatever the retries) before anything else, at
- *   most J288_ESTOP_ATTEMPTS times, and a stop given up had exactly that many transmits.
+ *   most J288_ESTOP_ATTEMPTS times, and a stop given up had exactly that many transmits;
+ * - the same input with every byte handed to on_rx on its own (so that the parser never sees a
+ *   whole frame at once and, with advance_in_isr, the bus takes each byte as it comes) gives
+ *   the same callbacks (id, result, each attempt's result, reply, times) and the same bus and
+ *   parser statistics: the whole-frame fast paths and the byte paths agree. With the bus
+ *   advanced in the event calls this is not compared after an estop, or when bytes came
+ *   while a deadline or guard end had passed unseen (no arm_timeout): the machine then
+ *   changes state in the middle of a delivery for a reason other than its bytes (the first
+ *   advance notices the time; a stop frame goes out inside the advance that ended the
+ *   attempt before it), so bytes that came in one piece were all taken before the change
+ *   while the same bytes one by one fall on both sides of it: two different timelines, both
+ *   handled right.
  */
 #include "fuzz_common.h"
 
@@ -41,6 +52,29 @@
 
 #define MAX_SERIALS 2048u
 #define MAX_OPS 3000u
+#define MAX_LOG 4096u
+
+/* What a run leaves behind, compared between the chunked and the byte-by-byte runs. */
+typedef struct {
+    uint8_t id;
+    uint8_t attempts;
+    int result;
+    int attempt_result[J288_CONFIG_MAX_RETRIES + 1u];
+    int32_t reply_pos;
+    uint32_t start_us;
+    uint32_t latency_us;
+} done_log_t;
+
+typedef struct {
+    done_log_t log[MAX_LOG];
+    uint32_t nlog;
+    j288_bus_stats_t bus;
+    j288_parser_stats_t parser;
+    bool incomparable; /* the comparison does not apply (see above) */
+} outcome_t;
+
+static bool bytewise;     /* hand on_rx one byte at a time */
+static outcome_t *record; /* where the callbacks are logged */
 
 typedef struct {
     /* port state */
@@ -75,6 +109,7 @@ typedef struct {
     uint8_t serial_id[MAX_SERIALS];
     bool serial_credited[MAX_SERIALS];
     uint8_t retries;
+    bool overdue_delivery; /* bytes came while the bus had a deadline or guard end unseen */
 } world_t;
 
 static world_t w;
@@ -202,9 +237,27 @@ static bool is_bus_result(int r)
            r == J288_ERR_OFFLINE || r == J288_ERR_OVERFLOW;
 }
 
+static void log_done(const j288_txn_t *t)
+{
+    done_log_t *l;
+    if (record->nlog >= MAX_LOG) {
+        return;
+    }
+    l = &record->log[record->nlog++];
+    memset(l, 0, sizeof *l);
+    l->id = t->id;
+    l->attempts = t->attempts;
+    l->result = t->result;
+    memcpy(l->attempt_result, t->attempt_result, sizeof l->attempt_result);
+    l->reply_pos = t->reply.pos;
+    l->start_us = t->start_us;
+    l->latency_us = t->latency_us;
+}
+
 static void on_done(void *user, const j288_txn_t *t)
 {
     unsigned k;
+    log_done(t);
     FUZZ_CHECK(user == &w);
     FUZZ_CHECK(w.fifo_n > 0u); /* exactly once per accepted submit */
     FUZZ_CHECK(t->id == w.fifo_id[0]);
@@ -286,7 +339,11 @@ static void advance_time(uint32_t dt)
 static void deliver(const uint8_t *d, size_t n, uint8_t chunk)
 {
     size_t off = 0;
-    size_t step = (chunk == 0u) ? n : chunk;
+    size_t step = bytewise ? 1u : ((chunk == 0u) ? n : chunk);
+    if (bus.cfg.advance_in_isr && !j288_bus_is_idle(&bus) &&
+        ((int32_t)(w.now - bus.timer_at) >= 0)) {
+        w.overdue_delivery = true; /* see the comparison of the two runs, above */
+    }
     while (off < n) {
         size_t k = (n - off < step) ? n - off : step;
         j288_bus_on_rx(&bus, &d[off], k);
@@ -423,7 +480,34 @@ static void do_op(fuzz_in_t *in)
     }
 }
 
+static void run(const uint8_t *data, size_t size);
+
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
+{
+    static outcome_t chunked, bytes;
+    if (size < 3u) {
+        return 0;
+    }
+    bytewise = false;
+    memset(&chunked, 0, sizeof chunked);
+    record = &chunked;
+    run(data, size);
+    bytewise = true;
+    memset(&bytes, 0, sizeof bytes);
+    record = &bytes;
+    run(data, size);
+    if (chunked.incomparable) {
+        return 0;
+    }
+    FUZZ_CHECK(chunked.nlog == bytes.nlog);
+    FUZZ_CHECK(memcmp(chunked.log, bytes.log, chunked.nlog * sizeof chunked.log[0]) == 0);
+    FUZZ_CHECK(memcmp(&chunked.bus, &bytes.bus, sizeof chunked.bus) == 0);
+    FUZZ_CHECK(memcmp(&chunked.parser, &bytes.parser, sizeof chunked.parser) == 0);
+    return 0;
+}
+
+/* One run of the input with every invariant checked; its outcome goes to *record. */
+static void run(const uint8_t *data, size_t size)
 {
     static const uint32_t bauds[4] = {0u, 115200u, 1000000u, 9600u};
     j288_bus_config_t cfg;
@@ -433,9 +517,6 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     const j288_bus_stats_t *st;
     bool drain_tx;
 
-    if (size < 3u) {
-        return 0;
-    }
     memset(&w, 0, sizeof w);
     c0 = data[0];
     c1 = data[1];
@@ -512,5 +593,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     FUZZ_CHECK(st->estop_failures <= st->estops);
     FUZZ_CHECK(w.stop_frames <= st->estops * J288_ESTOP_ATTEMPTS);
     FUZZ_CHECK(w.stop_frames >= st->estops + st->estop_failures * (J288_ESTOP_ATTEMPTS - 1u));
-    return 0;
+    record->bus = *st;
+    record->parser = *j288_bus_parser_stats(&bus);
+    record->incomparable = cfg.advance_in_isr && ((w.estops != 0u) || w.overdue_delivery);
 }

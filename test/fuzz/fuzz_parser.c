@@ -14,7 +14,11 @@
  *   and is exactly the reference's next frame: chunking never changes what is accepted;
  * - feed never consumes more than it was given, and consumes the frame's last byte exactly;
  * - the statistics add up: garbage + dropped + 26 * frames + pending = bytes fed; CRC
- *   errors and truncations match the reference.
+ *   errors and truncations match the reference;
+ * - the same stream fed one byte per call (so that the parser never sees a whole frame in one
+ *   piece and only its byte state machine runs), flushed at the same places, gives the same
+ *   frames at the same positions and exactly the same statistics: the whole-frame fast path
+ *   and the byte path agree.
  */
 #include "fuzz_common.h"
 
@@ -24,6 +28,7 @@
 #include <string.h>
 
 #define MAX_FRAMES 4096u
+#define MAX_FLUSHES 8192u
 
 typedef struct {
     size_t flen;
@@ -84,6 +89,49 @@ static uint32_t crc_fn_bitwise(void *ctx, const uint8_t *d, size_t n)
     return j288_crc32_update_bitwise(J288_CRC32_INIT, d, n);
 }
 
+/* The stream again, one byte per feed, with the flushes at the recorded stream positions (in
+ * order, before the byte at that position); frames, statistics and pending bytes must equal
+ * those of the chunked run. */
+static void check_bytewise(const j288_parser_t *chunked, j288_parse_kind_t kind,
+                           const j288_crc_t *crc, const uint8_t *st, size_t n,
+                           const size_t *flush_pos, size_t nflush, const size_t *got_pos,
+                           size_t got)
+{
+    static size_t pos2[MAX_FRAMES];
+    j288_parser_t p;
+    size_t i, f = 0u, got2 = 0u;
+    size_t flen = (kind == J288_PARSE_REPLY) ? J288_REPLY_LEN : J288_CMD_LEN;
+    FUZZ_CHECK(j288_parser_init(&p, kind, crc) == J288_OK);
+    for (i = 0u; i <= n; i++) {
+        size_t used = 0u;
+        while ((f < nflush) && (flush_pos[f] == i)) {
+            (void)j288_parser_flush(&p);
+            f++;
+        }
+        if (i == n) {
+            break;
+        }
+        if (j288_parser_feed(&p, &st[i], 1u, &used) == J288_PARSE_FRAME) {
+            FUZZ_CHECK(i + 1u >= flen);
+            if (got2 < MAX_FRAMES) {
+                pos2[got2] = i + 1u - flen;
+            }
+            got2++;
+        }
+        FUZZ_CHECK(used == 1u);
+    }
+    FUZZ_CHECK(got2 == got);
+    for (i = 0u; (i < got) && (i < MAX_FRAMES); i++) {
+        FUZZ_CHECK(pos2[i] == got_pos[i]);
+    }
+    FUZZ_CHECK(p.stats.frames == chunked->stats.frames);
+    FUZZ_CHECK(p.stats.garbage_bytes == chunked->stats.garbage_bytes);
+    FUZZ_CHECK(p.stats.crc_errors == chunked->stats.crc_errors);
+    FUZZ_CHECK(p.stats.truncated == chunked->stats.truncated);
+    FUZZ_CHECK(p.stats.dropped_bytes == chunked->stats.dropped_bytes);
+    FUZZ_CHECK(j288_parser_pending(&p) == j288_parser_pending(chunked));
+}
+
 /* End of a segment: the parser's pending bytes and frames so far match the reference. */
 static void check_segment(ref_t *ref, const j288_parser_t *parser, const uint8_t *st,
                           size_t seg_start, size_t seg_end, const size_t *got_pos, size_t got)
@@ -101,6 +149,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
     static ref_t ref;
     static size_t got_pos[MAX_FRAMES];
+    static size_t flush_pos[MAX_FLUSHES];
+    size_t nflush = 0u;
     j288_parser_t parser;
     j288_crc_t engine = {NULL, NULL};
     const j288_crc_t *crc = &engine;
@@ -186,6 +236,10 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         pos += take;
         if ((c & 0x80u) != 0u) {
             size_t pending = j288_parser_pending(&parser);
+            if (nflush < MAX_FLUSHES) {
+                flush_pos[nflush] = pos;
+            }
+            nflush++;
             check_segment(&ref, &parser, st, seg_start, pos, got_pos, got);
             FUZZ_CHECK(j288_parser_flush(&parser) ==
                        ((pending > 0u) ? J288_ERR_TRUNCATED : J288_OK));
@@ -204,5 +258,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     FUZZ_CHECK((size_t)stv->garbage_bytes + stv->dropped_bytes + ref.flen * (size_t)stv->frames +
                    j288_parser_pending(&parser) ==
                pos);
+    if (nflush <= MAX_FLUSHES) {
+        check_bytewise(&parser, kind, crc, st, pos, flush_pos, nflush, got_pos, got);
+    }
     return 0;
 }

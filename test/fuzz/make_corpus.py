@@ -75,6 +75,20 @@ def main():
     # a false head inside a payload, followed by the real frame
     f = rpl_frames[0][1]
     write("parser", "seed_false_head", [0, 1, 9] + list(b"\xfc\xee" + f[:4] + f))
+    # large chunks, so that whole frames are checked where they lie (the target compares with
+    # the byte path): doubled and false heads, a corrupt frame then a good one, a frame that
+    # starts inside a corrupt one, frames across chunk ends
+    g = rpl_frames[1][1]
+    bad = bytearray(g)
+    bad[7] ^= 0x04
+    stream = (b"\xfc\xfc\xee" + f + b"\xfc" + bytes(bad) + g + b"\xfc\xee" + f[2:] + f +
+              bytes(bad[:9]) + g + f[:11])
+    write("parser", "seed_fast_path_reply", [0, 2, 63, 0x80 | 40] + list(stream))
+    c = cmd_frames[0][1]
+    bad = bytearray(c)
+    bad[5] ^= 0x10
+    stream = b"\xfe\xfe\xee" + c + bytes(bad) + c + c[:9] + c + c[:3]
+    write("parser", "seed_fast_path_cmd", [1 | (1 << 1), 1, 63] + list(stream))
 
     # codec: byte 0 = case (low 3 bits) | crc engine (bits 3-4) | fix head 0x40 | fix crc 0x80.
     for i, (name, f) in enumerate(rpl_pick):

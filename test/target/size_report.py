@@ -88,14 +88,20 @@ INDIRECT_SITES = [
     (r"bus\.c:finish", ["sched_done"]),
     (r"bus\.c:port_lock", ["lock"]),
     (r"bus\.c:port_unlock", ["unlock"]),
+    (r"(bus|sched)\.c:j288_bus_lock", ["lock"]),
+    (r"(bus|sched)\.c:j288_bus_unlock", ["unlock"]),
     (r"bus\.c:start_attempt", ["set_dir", "start_tx", "start_rx", "now_us"]),
     (r"bus\.c:advance_from_event", ["now_us"]),
     (r"^j288_bus_on_tx_done", ["set_dir", "start_rx"]),
+    (r"^j288_bus_on_rx", ["now_us"]),
     (r"^j288_bus_transfer_blocking", ["wait", "now_us", "lock", "unlock"]),
     (r"^j288_crc32_run", ["crc32"]),
+    (r"^j288_cmd_encode", ["crc32"]),
+    (r"frame\.c:j288_crc_frame", ["crc32"]),
+    (r"parser\.c:frame_crc_ok", ["crc32"]),
     (r"sched\.c:(next_slot|sched_lock|sched_unlock)", ["lock", "unlock"]),
-    (r"sched\.c:emit", ["app"]),
-    (r"sched\.c:sched_done", ["app"]),  # on_reply
+    (r"sched\.c:(emit|sched_done|take_reply)", ["app"]),
+    (r"^j288_joint_bus_on_reply|joint\.c:report", ["app"]),  # on_event
     (r"j288_stm32\.c:now_of", ["app"]),
 ]
 

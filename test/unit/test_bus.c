@@ -191,6 +191,43 @@ static void test_reply_budget_and_wire_time(void)
     TEST_ASSERT_EQUAL_UINT32(0u, j288_bus_reply_budget_us(NULL));
 }
 
+/* j288_wire_time_us() divides without a division: exact against 64-bit arithmetic (modulo
+ * 2^32 where the result does not fit), at the edges and at random. */
+static uint32_t wire_time_ref(uint32_t baud, uint32_t nbytes)
+{
+    uint64_t b = (baud == 0u) ? 6000000u : baud;
+    return (uint32_t)(((uint64_t)nbytes * 10000000u + b - 1u) / b);
+}
+
+static void test_wire_time_exact(void)
+{
+    static const uint32_t bauds[] = {0u, 1u, 2u, 3u, 7u, 9600u, 115200u, 1000000u, 6000000u,
+                                     9999999u, 10000000u, 10000001u, 0x7FFFFFFFu, 0x80000000u,
+                                     0x80000001u, 0xFFFFFFFEu, 0xFFFFFFFFu};
+    static const uint32_t counts[] = {0u, 1u, 2u, 20u, 26u, 46u, 429u, 430u, 65535u,
+                                      0x7FFFFFFFu, 0x80000000u, 0xFFFFFFFFu};
+    uint32_t x = 0x12345678u;
+    size_t i, j;
+    for (i = 0u; i < sizeof bauds / sizeof bauds[0]; i++) {
+        for (j = 0u; j < sizeof counts / sizeof counts[0]; j++) {
+            TEST_ASSERT_EQUAL_UINT32(wire_time_ref(bauds[i], counts[j]),
+                                     j288_wire_time_us(bauds[i], counts[j]));
+        }
+    }
+    for (i = 0u; i < 20000u; i++) {
+        uint32_t b, n;
+        x ^= x << 13;
+        x ^= x >> 17;
+        x ^= x << 5;
+        b = x >> (x & 31u);
+        x ^= x << 13;
+        x ^= x >> 17;
+        x ^= x << 5;
+        n = x >> (x & 31u);
+        TEST_ASSERT_EQUAL_UINT32(wire_time_ref(b, n), j288_wire_time_us(b, n));
+    }
+}
+
 /* A configured guard is the gap between a reply and the next transmit. */
 static void test_configured_guard(void)
 {
@@ -362,10 +399,11 @@ static void test_echo_mismatch_is_collision(void)
     TEST_ASSERT_EQUAL_UINT32(33u, cb.txn.latency_us);
     TEST_ASSERT_EQUAL_UINT32(1u, j288_bus_stats(&bus)->collisions);
     TEST_ASSERT_EQUAL_INT(J288_BUS_GUARD, j288_bus_state(&bus));
-    /* The servo's reply falls into the long guard: stale, not a result. */
-    fake_port_run_until(&fp, 33u * US + BUDGET_US * US - 1u);
+    /* The servo's reply falls into the long guard (to a budget after the attempt's
+     * deadline, not after the collision): stale, not a result. */
+    fake_port_run_until(&fp, 2u * BUDGET_US * US - 1u);
     TEST_ASSERT_EQUAL_INT(J288_BUS_GUARD, j288_bus_state(&bus));
-    fake_port_run_until(&fp, 33u * US + BUDGET_US * US);
+    fake_port_run_until(&fp, 2u * BUDGET_US * US);
     TEST_ASSERT_EQUAL_INT(J288_BUS_IDLE, j288_bus_state(&bus));
     /* the rest of our own echo after the mismatch (12 bytes) and the reply */
     TEST_ASSERT_EQUAL_UINT32(12u + J288_REPLY_LEN, j288_bus_stats(&bus)->stale_bytes);
@@ -637,13 +675,13 @@ static void test_retries_keep_each_reason(void)
     fp.start_tx_fail = 1; /* attempt 1: port error; 2: silent; 3: corrupt; 4: good */
     submit_ok(&cmd);
     TEST_ASSERT_EQUAL_UINT32(0u, fp.nframes);
-    fake_port_run_until(&fp, BUDGET_US * US);
-    TEST_ASSERT_EQUAL_UINT32(1u, fp.nframes);
     fake_port_run_until(&fp, 2u * BUDGET_US * US);
+    TEST_ASSERT_EQUAL_UINT32(1u, fp.nframes);
+    fake_port_run_until(&fp, 4u * BUDGET_US * US - 1u);
     TEST_ASSERT_EQUAL_INT(0, cb.calls);
     fake_port_add_servo(&fp, 3u, &r);
     fp.servo[3].corrupt = true;
-    fake_port_run_until(&fp, 3u * BUDGET_US * US + 40u * US); /* servo heard attempt 3 */
+    fake_port_run_until(&fp, 4u * BUDGET_US * US + 40u * US); /* servo heard attempt 3 */
     TEST_ASSERT_EQUAL_UINT32(2u, fp.nframes);
     fp.servo[3].corrupt = false;
     TEST_ASSERT_TRUE(fake_port_run_until_idle(&fp, 5000u * US));
@@ -658,11 +696,11 @@ static void test_retries_keep_each_reason(void)
     assert_frame_cmd(0u, &cmd);
     assert_frame_cmd(1u, &cmd);
     assert_frame_cmd(2u, &cmd);
-    /* each retry after a full-budget guard */
-    TEST_ASSERT_EQUAL_UINT32(BUDGET_US, fake_port_frame(&fp, 0u)->start_us);
-    TEST_ASSERT_EQUAL_UINT32(3u * BUDGET_US, fake_port_frame(&fp, 1u)->start_us);
-    TEST_ASSERT_EQUAL_UINT32(5u * BUDGET_US, fake_port_frame(&fp, 2u)->start_us);
-    TEST_ASSERT_EQUAL_UINT32(5u * BUDGET_US, cb.txn.start_us);
+    /* each retry a budget after the failed attempt's deadline (the port error at 0 too) */
+    TEST_ASSERT_EQUAL_UINT32(2u * BUDGET_US, fake_port_frame(&fp, 0u)->start_us);
+    TEST_ASSERT_EQUAL_UINT32(4u * BUDGET_US, fake_port_frame(&fp, 1u)->start_us);
+    TEST_ASSERT_EQUAL_UINT32(6u * BUDGET_US, fake_port_frame(&fp, 2u)->start_us);
+    TEST_ASSERT_EQUAL_UINT32(6u * BUDGET_US, cb.txn.start_us);
     TEST_ASSERT_EQUAL_UINT32(1u, j288_bus_stats(&bus)->transactions);
     TEST_ASSERT_EQUAL_UINT32(4u, j288_bus_stats(&bus)->attempts);
     TEST_ASSERT_EQUAL_UINT32(1u, j288_bus_stats(&bus)->port_errors);
@@ -783,7 +821,8 @@ static void test_broadcast_with_line_error_is_retried(void)
     TEST_ASSERT_EQUAL_UINT8(2u, cb.txn.attempts);
     TEST_ASSERT_EQUAL_INT(J288_ERR_LINE, cb.txn.attempt_result[0]);
     TEST_ASSERT_EQUAL_UINT32(2u, fp.nframes);
-    TEST_ASSERT_EQUAL_UINT32(33u + BUDGET_US, fake_port_frame(&fp, 1u)->start_us);
+    /* ended at its tx done (33 us), re-sent a budget after its deadline */
+    TEST_ASSERT_EQUAL_UINT32(2u * BUDGET_US, fake_port_frame(&fp, 1u)->start_us);
 }
 
 /* ---- line errors */
@@ -1061,7 +1100,8 @@ static void test_estop_resent_after_port_error(void)
     TEST_ASSERT_TRUE(fake_port_run_until_idle(&fp, 5000u * US));
     TEST_ASSERT_EQUAL_UINT32(1u, fp.nframes);
     assert_frame_cmd(0u, &stop);
-    TEST_ASSERT_EQUAL_UINT32(BUDGET_US, fake_port_frame(&fp, 0u)->start_us); /* after a guard */
+    /* after the guard of a failed attempt: a budget after its deadline */
+    TEST_ASSERT_EQUAL_UINT32(2u * BUDGET_US, fake_port_frame(&fp, 0u)->start_us);
     TEST_ASSERT_EQUAL_UINT32(1u, j288_bus_stats(&bus)->estops);
     TEST_ASSERT_EQUAL_UINT32(0u, j288_bus_stats(&bus)->estop_failures);
     TEST_ASSERT_EQUAL_UINT32(2u, j288_bus_stats(&bus)->attempts);
@@ -1085,7 +1125,7 @@ static void test_estop_resent_after_collision(void)
     TEST_ASSERT_TRUE(fake_port_run_until_idle(&fp, 5000u * US));
     TEST_ASSERT_EQUAL_UINT32(2u, fp.nframes);
     assert_frame_cmd(1u, &stop);
-    TEST_ASSERT_EQUAL_UINT32(33u + BUDGET_US, fake_port_frame(&fp, 1u)->start_us);
+    TEST_ASSERT_EQUAL_UINT32(2u * BUDGET_US, fake_port_frame(&fp, 1u)->start_us);
     TEST_ASSERT_EQUAL_UINT32(1u, j288_bus_stats(&bus)->collisions);
     TEST_ASSERT_EQUAL_UINT32(1u, j288_bus_stats(&bus)->estops);
     TEST_ASSERT_EQUAL_UINT32(0u, j288_bus_stats(&bus)->estop_failures);
@@ -1108,7 +1148,7 @@ static void test_estop_resent_after_tx_timeout_and_line_error(void)
     assert_frame_cmd(1u, &stop);
     assert_frame_cmd(2u, &stop);
     TEST_ASSERT_EQUAL_UINT32(2u * BUDGET_US, fake_port_frame(&fp, 1u)->start_us);
-    TEST_ASSERT_EQUAL_UINT32(2u * BUDGET_US + 33u + BUDGET_US, fake_port_frame(&fp, 2u)->start_us);
+    TEST_ASSERT_EQUAL_UINT32(4u * BUDGET_US, fake_port_frame(&fp, 2u)->start_us);
     TEST_ASSERT_EQUAL_UINT32(1u, j288_bus_stats(&bus)->estops);
     TEST_ASSERT_EQUAL_UINT32(0u, j288_bus_stats(&bus)->estop_failures);
     TEST_ASSERT_EQUAL_UINT32(3u, j288_bus_stats(&bus)->attempts);
@@ -1127,8 +1167,8 @@ static void test_estop_dead_port_gives_up_bounded(void)
     TEST_ASSERT_EQUAL_UINT32(1u, j288_bus_stats(&bus)->estops);
     TEST_ASSERT_EQUAL_UINT32(1u, j288_bus_stats(&bus)->estop_failures);
     TEST_ASSERT_EQUAL_INT(1000 - (int)J288_ESTOP_ATTEMPTS, fp.start_tx_fail);
-    /* each re-send after a reply budget; idle one more budget after the last */
-    TEST_ASSERT_EQUAL_UINT32((J288_ESTOP_ATTEMPTS + 0u) * BUDGET_US, fake_port_now_us(&fp));
+    /* each re-send a budget after the failed attempt's deadline; idle as long after the last */
+    TEST_ASSERT_EQUAL_UINT32(2u * J288_ESTOP_ATTEMPTS * BUDGET_US, fake_port_now_us(&fp));
     TEST_ASSERT_EQUAL_UINT32(0u, j288_bus_stats(&bus)->transactions);
     TEST_ASSERT_EQUAL_UINT32(0u, j288_bus_stats(&bus)->failed);
     /* given up: the bus takes work again (and reports the port's error) */
@@ -1334,53 +1374,214 @@ static void test_bytes_after_broadcast_in_same_poll(void)
     TEST_ASSERT_EQUAL_UINT32(J288_REPLY_LEN, j288_bus_stats(&bus)->stale_bytes);
 }
 
-static void test_idle_splits_frames_in_order(void)
+/* An echo that differs at byte 5: the attempt is a collision, and the 14 bytes after the
+ * difference are stale whether the echo comes in one piece or byte by byte (they were once
+ * compared and dropped uncounted when they came in the same piece). */
+static void test_echo_mismatch_same_in_any_chunking(void)
 {
-    /* One poll sees: 15 bytes, idle, a whole reply. The idle belongs between them. */
-    j288_cmd_raw_t cmd = worked_cmd();
-    setup();
-    fp.poll_fn = NULL;
-    submit_ok(&cmd);
-    fake_port_rx_at(&fp, 50u * US, WORKED_REPLY3, 15u);
-    fake_port_idle_at(&fp, 52u * US);
-    fake_port_rx_at(&fp, 90u * US, WORKED_REPLY3, J288_REPLY_LEN);
-    fake_port_run_until(&fp, 100u * US);
-    j288_bus_poll(&bus, fake_port_now_us(&fp));
-    TEST_ASSERT_EQUAL_INT(J288_OK, cb.txn.result);
-    TEST_ASSERT_EQUAL_UINT32(1u, j288_bus_parser_stats(&bus)->truncated);
-    TEST_ASSERT_EQUAL_UINT32(0u, j288_bus_parser_stats(&bus)->crc_errors);
-    TEST_ASSERT_EQUAL_UINT32(1u, j288_bus_stats(&bus)->crc_errors);
+    j288_bus_config_t cfg;
+    j288_cmd_raw_t cmd = lock_cmd(4u);
+    uint8_t echo[J288_CMD_LEN];
+    int pass;
+    for (pass = 0; pass < 2; pass++) {
+        size_t i;
+        memset(&cfg, 0, sizeof cfg);
+        cfg.echo = true;
+        setup_cfg(&cfg);
+        fp.poll_fn = NULL;
+        fp.txdone = FAKE_TXDONE_MANUAL;
+        submit_ok(&cmd);
+        memcpy(echo, fake_port_frame(&fp, 0u)->data, sizeof echo);
+        echo[5] ^= 0x20u;
+        if (pass == 0) {
+            j288_bus_on_rx(&bus, echo, sizeof echo);
+        } else {
+            for (i = 0u; i < sizeof echo; i++) {
+                j288_bus_on_rx(&bus, &echo[i], 1u);
+                j288_bus_poll(&bus, 20u);
+            }
+        }
+        j288_bus_on_tx_done(&bus);
+        j288_bus_poll(&bus, 34u);
+        TEST_ASSERT_EQUAL_INT(1, cb.calls);
+        TEST_ASSERT_EQUAL_INT(J288_ERR_COLLISION, cb.txn.result);
+        TEST_ASSERT_EQUAL_UINT32(14u, j288_bus_stats(&bus)->stale_bytes);
+    }
 }
 
-/* In poll mode an ISR may record a second idle between the advance's reads of ev_idle and
- * idle_mark: that advance consumes and flushes up to the second idle, and the next one finds
- * an idle whose mark lies behind the tail. The test builds that state directly (no
- * single-threaded call sequence can interleave there): the frame that started after the
- * mark must not be cut, nor any byte taken twice. */
-static void test_idle_already_consumed_is_not_taken_again(void)
+/* ---- pauses inside a reply: the line goes idle, the frame goes on */
+
+/* WORKED_REPLY3 in two parts with an idle line between them (split: bytes in the first part);
+ * heard whole, in poll mode and with the bus advanced in the event calls. */
+static void check_reply_split_by_pause(size_t split, bool isr)
 {
-    static const uint8_t noise[7] = {1, 2, 3, 4, 5, 6, 7};
+    j288_bus_config_t cfg;
     j288_cmd_raw_t cmd = worked_cmd();
-    setup();
-    fp.poll_fn = NULL;
+    memset(&cfg, 0, sizeof cfg);
+    cfg.advance_in_isr = isr;
+    setup_cfg(&cfg);
     submit_ok(&cmd);
-    fake_port_run_until(&fp, TX_END_NS);
-    j288_bus_poll(&bus, fake_port_now_us(&fp));
-    TEST_ASSERT_EQUAL_INT(J288_BUS_WAIT_REPLY, j288_bus_state(&bus));
-    j288_bus_on_rx(&bus, noise, sizeof noise);
-    j288_bus_on_rx_idle(&bus); /* the idle at index 7 */
-    j288_bus_on_rx(&bus, WORKED_REPLY3, 10u);
-    j288_bus_poll(&bus, fake_port_now_us(&fp));
-    bus.ev_idle++; /* the racing advance took the idle at index 7 under the previous count */
-    j288_bus_poll(&bus, fake_port_now_us(&fp));
-    j288_bus_on_rx(&bus, &WORKED_REPLY3[10], J288_REPLY_LEN - 10u);
-    j288_bus_poll(&bus, fake_port_now_us(&fp));
+    fake_port_idle_at(&fp, 40u * US); /* before the reply starts */
+    fake_port_rx_at(&fp, 45u * US, WORKED_REPLY3, split);
+    fake_port_idle_at(&fp, 47u * US);
+    fake_port_rx_at(&fp, 90u * US, &WORKED_REPLY3[split], J288_REPLY_LEN - split);
+    fake_port_idle_at(&fp, 92u * US);
+    TEST_ASSERT_TRUE(fake_port_run_until_idle(&fp, 2000u * US));
     TEST_ASSERT_EQUAL_INT(1, cb.calls);
     TEST_ASSERT_EQUAL_INT(J288_OK, cb.txn.result);
     TEST_ASSERT_EQUAL_INT32(5215, cb.txn.reply.pos);
+    TEST_ASSERT_EQUAL_UINT32(90u, cb.txn.latency_us); /* taken when its last byte came */
     TEST_ASSERT_EQUAL_UINT32(0u, j288_bus_parser_stats(&bus)->truncated);
-    TEST_ASSERT_EQUAL_UINT32(7u, j288_bus_parser_stats(&bus)->garbage_bytes);
     TEST_ASSERT_EQUAL_UINT32(0u, j288_bus_stats(&bus)->crc_errors);
+}
+
+static void test_pause_inside_head_keeps_frame(void)
+{
+    check_reply_split_by_pause(1u, false);
+    check_reply_split_by_pause(1u, true);
+}
+
+static void test_pause_inside_payload_keeps_frame(void)
+{
+    check_reply_split_by_pause(15u, false);
+    check_reply_split_by_pause(15u, true);
+    check_reply_split_by_pause(J288_REPLY_LEN - 1u, true);
+}
+
+/* A pause before the reply starts changes nothing either. */
+static void test_pause_before_reply(void)
+{
+    check_reply_split_by_pause(0u, false);
+    check_reply_split_by_pause(0u, true);
+}
+
+/* A partial frame, a pause, then a corrupt whole frame: the pause does not cut the first, the
+ * two make one bad frame and then the second, both CRC failures (nothing truncated). A corrupt
+ * frame and then a partial one still held at the deadline: CRC outranks TRUNCATED, and the
+ * bus counts both frames. */
+static void test_crc_outranks_truncated(void)
+{
+    j288_cmd_raw_t cmd = worked_cmd();
+    uint8_t bad[J288_REPLY_LEN];
+    memcpy(bad, WORKED_REPLY3, sizeof bad);
+    bad[12] ^= 0x01u;
+
+    setup();
+    submit_ok(&cmd);
+    fake_port_rx_at(&fp, 45u * US, WORKED_REPLY3, 10u);
+    fake_port_idle_at(&fp, 47u * US);
+    fake_port_rx_at(&fp, 90u * US, bad, sizeof bad);
+    TEST_ASSERT_TRUE(fake_port_run_until_idle(&fp, 2000u * US));
+    TEST_ASSERT_EQUAL_INT(J288_ERR_CRC, cb.txn.result);
+    TEST_ASSERT_EQUAL_UINT32(BUDGET_US, cb.txn.latency_us);
+    TEST_ASSERT_EQUAL_UINT32(2u, j288_bus_parser_stats(&bus)->crc_errors);
+    TEST_ASSERT_EQUAL_UINT32(0u, j288_bus_parser_stats(&bus)->truncated);
+    TEST_ASSERT_EQUAL_UINT32(2u, j288_bus_stats(&bus)->crc_errors);
+
+    setup();
+    submit_ok(&cmd);
+    fake_port_rx_at(&fp, 45u * US, bad, sizeof bad);
+    fake_port_rx_at(&fp, 100u * US, WORKED_REPLY3, 7u);
+    TEST_ASSERT_TRUE(fake_port_run_until_idle(&fp, 2000u * US));
+    TEST_ASSERT_EQUAL_INT(J288_ERR_CRC, cb.txn.result);
+    TEST_ASSERT_EQUAL_UINT32(1u, j288_bus_parser_stats(&bus)->crc_errors);
+    TEST_ASSERT_EQUAL_UINT32(1u, j288_bus_parser_stats(&bus)->truncated);
+    TEST_ASSERT_EQUAL_UINT32(2u, j288_bus_stats(&bus)->crc_errors);
+}
+
+/* An attempt that ended early (a collision at its tx done, 33 us) is retried only a reply
+ * budget after its deadline: the servo's late answer to it (at 250 us) falls into the guard
+ * and is never taken as the retry's reply. */
+static void test_late_reply_after_early_failure_dies_out(void)
+{
+    j288_bus_config_t cfg;
+    j288_cmd_raw_t cmd = lock_cmd(4u);
+    j288_reply_raw_t r = reply_for(4u, 4444);
+    uint8_t late[J288_REPLY_LEN];
+    memset(&cfg, 0, sizeof cfg);
+    cfg.echo = true;
+    cfg.retries = 1u;
+    setup_cfg(&cfg);
+    fp.echo = true;
+    fp.echo_flip_at = 7;
+    fake_port_encode_reply(&r, late);
+    submit_ok(&cmd);
+    fake_port_run_until(&fp, TX_END_NS + 1000u);
+    TEST_ASSERT_EQUAL_UINT32(1u, j288_bus_stats(&bus)->collisions);
+    fp.echo_flip_at = -1;
+    fake_port_rx_at(&fp, 250u * US, late, sizeof late);
+    TEST_ASSERT_TRUE(fake_port_run_until_idle(&fp, 5000u * US));
+    TEST_ASSERT_EQUAL_INT(1, cb.calls);
+    TEST_ASSERT_EQUAL_INT(J288_ERR_TIMEOUT, cb.txn.result);
+    TEST_ASSERT_EQUAL_INT(J288_ERR_COLLISION, cb.txn.attempt_result[0]);
+    TEST_ASSERT_EQUAL_UINT32(2u, fp.nframes);
+    TEST_ASSERT_EQUAL_UINT32(2u * BUDGET_US, fake_port_frame(&fp, 1u)->start_us);
+    TEST_ASSERT_EQUAL_UINT32(0u, j288_bus_parser_stats(&bus)->frames);
+    /* the rest of the corrupt echo (12 bytes) and the late reply */
+    TEST_ASSERT_EQUAL_UINT32(12u + J288_REPLY_LEN, j288_bus_stats(&bus)->stale_bytes);
+}
+
+/* With the bus advanced in the event calls, on_rx takes its bytes in place; what a full ring
+ * could not have held is lost and counted the same way as through the ring (poll mode). */
+static void test_rx_overflow_same_in_isr_mode(void)
+{
+    uint8_t junk[100];
+    j288_bus_config_t cfg;
+    j288_cmd_raw_t cmd = worked_cmd();
+    int pass;
+    memset(junk, 0x42, sizeof junk);
+    for (pass = 0; pass < 2; pass++) {
+        memset(&cfg, 0, sizeof cfg);
+        cfg.advance_in_isr = (pass == 1);
+        setup_cfg(&cfg);
+        fp.poll_fn = NULL;
+        submit_ok(&cmd);
+        fake_port_run_until(&fp, TX_END_NS);
+        j288_bus_poll(&bus, fake_port_now_us(&fp));
+        TEST_ASSERT_EQUAL_INT(J288_BUS_WAIT_REPLY, j288_bus_state(&bus));
+        j288_bus_on_rx(&bus, junk, sizeof junk);
+        j288_bus_poll(&bus, fake_port_now_us(&fp));
+        TEST_ASSERT_EQUAL_UINT32(100u - J288_CONFIG_RX_RING_SIZE,
+                                 j288_bus_stats(&bus)->rx_overflows);
+        TEST_ASSERT_EQUAL_UINT32(J288_CONFIG_RX_RING_SIZE,
+                                 j288_bus_parser_stats(&bus)->garbage_bytes);
+        j288_bus_on_rx(&bus, WORKED_REPLY3, J288_REPLY_LEN);
+        j288_bus_poll(&bus, fake_port_now_us(&fp));
+        TEST_ASSERT_EQUAL_INT(J288_OK, cb.txn.result);
+    }
+}
+
+/* Bytes reported from inside an advance (here by the completion callback of a timed-out
+ * transaction, as a port may from inside one of its operations) wait in the ring; bytes
+ * arriving later queue behind them instead of being taken in place first. */
+static bool feed_in_callback;
+
+static void on_done_feeds(void *user, const j288_txn_t *txn)
+{
+    on_done(user, txn);
+    if (feed_in_callback) {
+        feed_in_callback = false;
+        j288_bus_on_rx(&bus, WORKED_REPLY3, 3u);
+    }
+}
+
+static void test_rx_from_inside_an_advance_keeps_order(void)
+{
+    j288_bus_config_t cfg;
+    j288_cmd_raw_t cmd = worked_cmd();
+    memset(&cfg, 0, sizeof cfg);
+    cfg.advance_in_isr = true;
+    setup_cfg(&cfg);
+    fp.poll_fn = NULL;
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_bus_submit(&bus, &cmd, 0u, on_done_feeds, &cb));
+    feed_in_callback = true;
+    fake_port_run_until(&fp, BUDGET_US * US); /* tx done, then the deadline */
+    TEST_ASSERT_EQUAL_INT(1, cb.calls);
+    TEST_ASSERT_EQUAL_INT(J288_ERR_TIMEOUT, cb.txn.result);
+    TEST_ASSERT_EQUAL_UINT32(0u, j288_bus_stats(&bus)->stale_bytes); /* 3 bytes wait */
+    j288_bus_on_rx(&bus, &WORKED_REPLY3[3], 5u); /* through the ring, behind them */
+    TEST_ASSERT_EQUAL_UINT32(8u, j288_bus_stats(&bus)->stale_bytes);
+    TEST_ASSERT_EQUAL_UINT32(0u, j288_bus_stats(&bus)->rx_overflows);
 }
 
 /* ---- time wrap-around */
@@ -1610,6 +1811,7 @@ int main(void)
     UNITY_BEGIN();
     RUN_TEST(test_init_rejections);
     RUN_TEST(test_reply_budget_and_wire_time);
+    RUN_TEST(test_wire_time_exact);
     RUN_TEST(test_configured_guard);
     RUN_TEST(test_normal_transaction);
     RUN_TEST(test_worked_lock_frame_through_bus);
@@ -1656,8 +1858,14 @@ int main(void)
     RUN_TEST(test_failure_ranking);
     RUN_TEST(test_noise_while_idle_is_not_echo);
     RUN_TEST(test_bytes_after_broadcast_in_same_poll);
-    RUN_TEST(test_idle_splits_frames_in_order);
-    RUN_TEST(test_idle_already_consumed_is_not_taken_again);
+    RUN_TEST(test_echo_mismatch_same_in_any_chunking);
+    RUN_TEST(test_pause_inside_head_keeps_frame);
+    RUN_TEST(test_pause_inside_payload_keeps_frame);
+    RUN_TEST(test_pause_before_reply);
+    RUN_TEST(test_crc_outranks_truncated);
+    RUN_TEST(test_late_reply_after_early_failure_dies_out);
+    RUN_TEST(test_rx_overflow_same_in_isr_mode);
+    RUN_TEST(test_rx_from_inside_an_advance_keeps_order);
     RUN_TEST(test_time_wraps_at_2_pow_32);
     RUN_TEST(test_several_buses_are_independent);
     RUN_TEST(test_transfer_blocking);

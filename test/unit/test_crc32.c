@@ -16,6 +16,10 @@ static uint32_t whole_table(const uint8_t *d, size_t n)
 {
     return j288_crc32_update_table(J288_CRC32_INIT, d, n);
 }
+static uint32_t whole_slice4(const uint8_t *d, size_t n)
+{
+    return j288_crc32_update_slice4(J288_CRC32_INIT, d, n);
+}
 static uint32_t whole_nibble(const uint8_t *d, size_t n)
 {
     return j288_crc32_update_nibble(J288_CRC32_INIT, d, n);
@@ -44,13 +48,14 @@ typedef struct {
 } backend_t;
 
 static const backend_t backends[] = {
-    {"table", whole_table},     {"nibble", whole_nibble},      {"bitwise", whole_bitwise},
-    {"default", whole_default}, {"run(NULL)", whole_run_null}, {"run(fn NULL)", whole_run_nullfn},
+    {"table", whole_table},     {"slice4", whole_slice4},      {"nibble", whole_nibble},
+    {"bitwise", whole_bitwise}, {"default", whole_default},    {"run(NULL)", whole_run_null},
+    {"run(fn NULL)", whole_run_nullfn},
 };
 #define N_BACKENDS (sizeof backends / sizeof backends[0])
 
-static const update_fn updates[] = {j288_crc32_update_table, j288_crc32_update_nibble,
-                                    j288_crc32_update_bitwise};
+static const update_fn updates[] = {j288_crc32_update_table, j288_crc32_update_slice4,
+                                    j288_crc32_update_nibble, j288_crc32_update_bitwise};
 
 static void test_check_value_mpeg2(void)
 {

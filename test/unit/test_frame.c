@@ -20,6 +20,11 @@ static uint32_t table_engine(void *ctx, const uint8_t *d, size_t n)
     (void)ctx;
     return j288_crc32_update_table(J288_CRC32_INIT, d, n);
 }
+static uint32_t slice4_engine(void *ctx, const uint8_t *d, size_t n)
+{
+    (void)ctx;
+    return j288_crc32_update_slice4(J288_CRC32_INIT, d, n);
+}
 static uint32_t nibble_engine(void *ctx, const uint8_t *d, size_t n)
 {
     (void)ctx;
@@ -31,9 +36,11 @@ static uint32_t bitwise_engine(void *ctx, const uint8_t *d, size_t n)
     return j288_crc32_update_bitwise(J288_CRC32_INIT, d, n);
 }
 static const j288_crc_t eng_table = {table_engine, NULL};
+static const j288_crc_t eng_slice4 = {slice4_engine, NULL};
 static const j288_crc_t eng_nibble = {nibble_engine, NULL};
 static const j288_crc_t eng_bitwise = {bitwise_engine, NULL};
-static const j288_crc_t *const engines[] = {NULL, &eng_table, &eng_nibble, &eng_bitwise};
+static const j288_crc_t *const engines[] = {NULL, &eng_table, &eng_slice4, &eng_nibble,
+                                            &eng_bitwise};
 #define N_ENGINES (sizeof engines / sizeof engines[0])
 
 static j288_cmd_raw_t golden_cmd_fields(const golden_cmd_t *g)

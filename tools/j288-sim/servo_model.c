@@ -29,6 +29,7 @@ void j288_sim_params_default(j288_sim_params_t *prm)
     prm->voltage = 24.0;
     prm->ambient_c = 25.0;
     prm->loss_per_nm2 = 2400.0;
+    prm->backlash = 0.0;
 }
 
 static double wrap_2pi(double a)
@@ -41,8 +42,63 @@ static double wrap_2pi(double a)
     return r;
 }
 
-void j288_sim_servo_init(j288_sim_servo_t *s, uint8_t id, const j288_sim_params_t *prm,
-                         double start_angle, double out_angle)
+/* ---- the joint: r = N * theta_gear + c, p = r - 2 pi k ----------------------------------- */
+
+static double rotor_angle(const j288_sim_servo_t *s)
+{
+    return s->p + TWO_PI * (double)s->k;
+}
+
+static double gear_angle(const j288_sim_servo_t *s)
+{
+    return (rotor_angle(s) - s->c) / J288_GEAR_RATIO;
+}
+
+/* What the single-turn rotor encoder makes of r at power-up: p in [0, 2 pi), k turns lost. */
+static void rotor_power_up(j288_sim_servo_t *s, double r)
+{
+    double k = floor(r / TWO_PI);
+    double p = r - k * TWO_PI;
+    /* r / TWO_PI may round across an integer: bring p back into [0, 2 pi). */
+    if (p >= TWO_PI) {
+        p -= TWO_PI;
+        k += 1.0;
+    } else if (p < 0.0) {
+        p += TWO_PI;
+        k -= 1.0;
+    }
+    s->p = p;
+    s->k = (long)k;
+}
+
+/* Which side of the play the load keeps the shaft on: -1, +1, or 0 (no load: it stays where
+ * the gear left it). A positive load torque pulls the output backwards (see step()). */
+static double load_side(const j288_sim_servo_t *s)
+{
+    if (s->prm.load_torque > 0.0)
+        return -1.0;
+    if (s->prm.load_torque < 0.0)
+        return 1.0;
+    return 0.0;
+}
+
+/* The massless output shaft inside the play: pressed against the load's side, or pushed
+ * along by the gear when it reaches an edge. Without backlash it is the gear side. */
+static void shaft_follow(j288_sim_servo_t *s)
+{
+    double g = gear_angle(s);
+    double half = 0.5 * s->prm.backlash;
+    double side = load_side(s);
+    if (side != 0.0)
+        s->theta = g + side * half;
+    else if (s->theta > g + half)
+        s->theta = g + half;
+    else if (s->theta < g - half)
+        s->theta = g - half;
+}
+
+void j288_sim_servo_init(j288_sim_servo_t *s, uint8_t id, const j288_sim_params_t *prm, double c,
+                         double out_angle)
 {
     memset(s, 0, sizeof *s);
     s->id = id;
@@ -50,19 +106,22 @@ void j288_sim_servo_init(j288_sim_servo_t *s, uint8_t id, const j288_sim_params_
         s->prm = *prm;
     else
         j288_sim_params_default(&s->prm);
-    s->p = wrap_2pi(start_angle);
-    s->out_offset = wrap_2pi(out_angle) - s->p / J288_GEAR_RATIO;
+    s->c = c;
+    s->theta = out_angle;
+    /* The gear side sits where the load keeps the shaft against it, else at the shaft. */
+    rotor_power_up(s, J288_GEAR_RATIO * (out_angle - load_side(s) * 0.5 * s->prm.backlash) + c);
     s->t_wind = s->prm.ambient_c;
     s->t_case = s->prm.ambient_c;
     s->mode = J288_MODE_LOCK;
     s->cmd.id = id;
+    s->powered = true;
 }
 
 static bool torque_inhibited(const j288_sim_servo_t *s)
 {
     const uint32_t stop = J288_FAULT_WINDING_TEMP | J288_FAULT_CASE_TEMP |
                           J288_FAULT_UNDER_VOLTAGE | J288_FAULT_OVER_VOLTAGE;
-    return s->mode != J288_MODE_FOC || (s->faults_active & stop) != 0u;
+    return !s->powered || s->mode != J288_MODE_FOC || (s->faults_active & stop) != 0u;
 }
 
 /* The hybrid law on the rotor, from the last command, saturated at the motor's limit. */
@@ -125,8 +184,9 @@ static void step(j288_sim_servo_t *s, double dt)
         s->w = w_new;
     }
     s->p += s->w * dt;
+    shaft_follow(s);
 
-    p_loss = s->prm.loss_per_nm2 * tau_m * tau_m + P_IDLE;
+    p_loss = s->prm.loss_per_nm2 * tau_m * tau_m + (s->powered ? P_IDLE : 0.0);
     {
         double q_wc = (s->t_wind - s->t_case) / R_WIND_CASE;
         double q_ca = (s->t_case - s->prm.ambient_c) / R_CASE_AMB;
@@ -154,8 +214,19 @@ static void integrate(j288_sim_servo_t *s, uint64_t until_us)
     }
 }
 
+/* Back from a power cycle: the turn count is gone, the rest is as at the first power-up. */
+static void power_on(j288_sim_servo_t *s)
+{
+    rotor_power_up(s, rotor_angle(s));
+    s->powered = true;
+}
+
 void j288_sim_servo_advance(j288_sim_servo_t *s, uint64_t now_us)
 {
+    if (!s->powered && s->power_on_us <= now_us) {
+        integrate(s, s->power_on_us);
+        power_on(s);
+    }
     if (s->wd_enabled && !s->wd_tripped) {
         uint64_t trip_at = s->last_cmd_us + J288_SIM_WATCHDOG_US;
         if (trip_at <= now_us) {
@@ -167,28 +238,47 @@ void j288_sim_servo_advance(j288_sim_servo_t *s, uint64_t now_us)
     update_conditions(s);
 }
 
-void j288_sim_servo_command(j288_sim_servo_t *s, const j288_cmd_raw_t *cmd, uint64_t now_us)
+bool j288_sim_servo_command(j288_sim_servo_t *s, const j288_cmd_raw_t *cmd, uint64_t now_us)
 {
     j288_sim_servo_advance(s, now_us);
+    if (!s->powered)
+        return false;
     s->last_cmd_us = now_us;
     if (s->wd_tripped) {
         if (cmd->watchdog)
-            return; /* stays locked, keeps reporting the trip */
+            return true; /* stays locked, keeps reporting the trip */
         s->wd_tripped = false;
     }
     s->wd_enabled = cmd->watchdog;
     s->cmd = *cmd;
     s->mode = (cmd->status == J288_MODE_FOC) ? J288_MODE_FOC : J288_MODE_LOCK;
+    return true;
 }
 
 void j288_sim_servo_bad_crc(j288_sim_servo_t *s)
 {
-    s->faults_latched |= J288_FAULT_COMM_CHECKSUM;
+    if (s->powered)
+        s->faults_latched |= J288_FAULT_COMM_CHECKSUM;
+}
+
+void j288_sim_servo_power_cycle(j288_sim_servo_t *s, uint64_t now_us, uint32_t off_us)
+{
+    j288_sim_servo_advance(s, now_us);
+    s->powered = false;
+    s->power_on_us = s->now_us + off_us; /* the model may already be past now_us */
+    s->power_cycles++;
+    /* Power-up state: lock, watchdog off and clear, nothing latched. */
+    s->mode = J288_MODE_LOCK;
+    s->wd_enabled = false;
+    s->wd_tripped = false;
+    s->faults_latched = 0u;
+    if (off_us == 0u)
+        power_on(s);
 }
 
 double j288_sim_servo_out_angle(const j288_sim_servo_t *s)
 {
-    return s->out_offset + s->p / J288_GEAR_RATIO;
+    return s->theta;
 }
 
 uint16_t j288_sim_servo_out_pos(const j288_sim_servo_t *s)
@@ -196,6 +286,19 @@ uint16_t j288_sim_servo_out_pos(const j288_sim_servo_t *s)
     double frac = wrap_2pi(j288_sim_servo_out_angle(s)) / TWO_PI;
     long counts = (long)floor(frac * (double)J288_OUT_POS_COUNTS);
     return (uint16_t)((unsigned long)counts & (J288_OUT_POS_COUNTS - 1u));
+}
+
+void j288_sim_servo_truth(const j288_sim_servo_t *s, j288_sim_truth_t *t)
+{
+    t->theta = s->theta;
+    t->theta_gear = gear_angle(s);
+    t->c = s->c;
+    t->r = rotor_angle(s);
+    t->p = s->p;
+    t->k = s->k;
+    t->out_pos = j288_sim_servo_out_pos(s);
+    t->powered = s->powered;
+    t->power_cycles = s->power_cycles;
 }
 
 static long round_clamp(double v, double lo, double hi)
@@ -242,6 +345,11 @@ static double rng_unit(uint64_t *state)
     return (double)(rng_next(state) >> 11) * 0x1.0p-53;
 }
 
+static bool has_dup(const j288_sim_bus_t *b, uint8_t id)
+{
+    return (b->cfg.dup_ids & (1u << id)) != 0u;
+}
+
 int j288_sim_bus_init(j288_sim_bus_t *b, uint16_t ids, const j288_sim_bus_config_t *cfg,
                       const j288_sim_params_t *prm, j288_sim_send_fn send, j288_sim_log_fn log,
                       void *user)
@@ -262,17 +370,54 @@ int j288_sim_bus_init(j288_sim_bus_t *b, uint16_t ids, const j288_sim_bus_config
     b->log = log;
     b->user = user;
     (void)j288_parser_init(&b->parser, J288_PARSE_COMMAND, NULL);
-    /* Power-up angles drawn for every id, present or not, so that a servo's start does not
-     * depend on which others are on the bus. */
+    /* Rotor phase and start angle drawn for every id, present or not, so that a servo's
+     * start does not depend on which others are on the bus. Four draws per id whatever they
+     * are used for: the fault sequence after them depends on the seed alone. */
     for (id = 0u; id < J288_MAX_SERVOS; id++) {
-        double a = rng_unit(&b->rng) * TWO_PI;
-        double o = rng_unit(&b->rng) * TWO_PI;
-        double a2 = rng_unit(&b->rng) * TWO_PI;
-        double o2 = rng_unit(&b->rng) * TWO_PI;
-        j288_sim_servo_init(&b->servo[id], id, prm, a, o);
-        j288_sim_servo_init(&b->dup[id], id, prm, a2, o2);
+        double c = rng_unit(&b->rng) * TWO_PI;
+        double o = rng_unit(&b->rng) * TWO_PI - J288_PI;
+        double c2 = rng_unit(&b->rng) * TWO_PI;
+        double o2 = rng_unit(&b->rng) * TWO_PI - J288_PI;
+        j288_sim_servo_init(&b->servo[id], id, prm, c, o);
+        j288_sim_servo_init(&b->dup[id], id, prm, c2, o2);
     }
     return 0;
+}
+
+int j288_sim_bus_set_joint(j288_sim_bus_t *b, uint8_t id, double c, double theta)
+{
+    j288_sim_servo_t *s = j288_sim_bus_servo(b, id);
+    j288_sim_params_t prm;
+    uint32_t injected;
+    if (s == NULL)
+        return -1;
+    prm = s->prm;
+    injected = s->faults_injected;
+    j288_sim_servo_init(s, id, &prm, c, theta);
+    s->faults_injected = injected;
+    return 0;
+}
+
+int j288_sim_bus_power_cycle(j288_sim_bus_t *b, uint16_t ids, uint64_t now_us)
+{
+    uint8_t id;
+    int n = 0;
+    if ((ids & ~b->present) != 0u)
+        return -1;
+    if (now_us > b->now_us)
+        b->now_us = now_us;
+    for (id = 0u; id < J288_MAX_SERVOS; id++) {
+        if ((ids & (1u << id)) == 0u)
+            continue;
+        j288_sim_servo_power_cycle(&b->servo[id], now_us, b->cfg.power_off_us);
+        n++;
+        if (has_dup(b, id)) {
+            j288_sim_servo_power_cycle(&b->dup[id], now_us, b->cfg.power_off_us);
+            n++;
+        }
+    }
+    b->stats.power_cycles += (uint64_t)n;
+    return n;
 }
 
 int j288_sim_bus_inject_faults(j288_sim_bus_t *b, uint8_t id, uint32_t bits)
@@ -294,11 +439,6 @@ j288_sim_servo_t *j288_sim_bus_servo(j288_sim_bus_t *b, uint8_t id)
     if (id > J288_MAX_ID || (b->present & (1u << id)) == 0u)
         return NULL;
     return &b->servo[id];
-}
-
-static bool has_dup(const j288_sim_bus_t *b, uint8_t id)
-{
-    return (b->cfg.dup_ids & (1u << id)) != 0u;
 }
 
 void j288_sim_bus_advance(j288_sim_bus_t *b, uint64_t now_us)
@@ -382,9 +522,9 @@ static void dispatch(j288_sim_bus_t *b, const j288_cmd_raw_t *cmd, uint64_t now_
         for (id = 0u; id < J288_MAX_SERVOS; id++) {
             if ((b->present & (1u << id)) == 0u)
                 continue;
-            j288_sim_servo_command(&b->servo[id], cmd, now_us);
+            (void)j288_sim_servo_command(&b->servo[id], cmd, now_us);
             if (has_dup(b, id))
-                j288_sim_servo_command(&b->dup[id], cmd, now_us);
+                (void)j288_sim_servo_command(&b->dup[id], cmd, now_us);
         }
         return; /* obeyed silently */
     }
@@ -393,11 +533,10 @@ static void dispatch(j288_sim_bus_t *b, const j288_cmd_raw_t *cmd, uint64_t now_
         b->stats.for_others++;
         return;
     }
-    j288_sim_servo_command(&b->servo[id], cmd, now_us);
-    answer(b, &b->servo[id], now_us);
+    if (j288_sim_servo_command(&b->servo[id], cmd, now_us))
+        answer(b, &b->servo[id], now_us);
     if (has_dup(b, id)) {
-        j288_sim_servo_command(&b->dup[id], cmd, now_us);
-        if (!b->faults_off) {
+        if (j288_sim_servo_command(&b->dup[id], cmd, now_us) && !b->faults_off) {
             answer(b, &b->dup[id], now_us);
             b->stats.duplicates++;
         }

@@ -7,6 +7,19 @@
  *   (inertia, viscous and Coulomb friction, an optional output load through the 288.35
  *   gear), with a two-node thermal model (winding, case) and a supply voltage. Integrated in
  *   fixed steps of at most J288_SIM_STEP_US up to whatever time the caller gives.
+ *   Its joint: the continuous rotor angle is r = N * theta_gear + c, where N is the gear
+ *   ratio (J288_GEAR_RATIO), theta_gear the gear side of the output stage and c the rotor
+ *   phase fixed at assembly. The rotor encoder is single-turn: the position a reply reports
+ *   is p = r - 2 pi k, with k chosen at power-up so that p starts in [0, 2 pi), and p
+ *   counts turns from there. The output shaft angle theta (what the 13-bit output encoder
+ *   measures, OutPos = floor(8192 * (theta mod 2 pi) / 2 pi)) equals theta_gear, or with
+ *   backlash (params.backlash > 0) lies within half the play of it (see "Backlash" below).
+ *   c goes with the labelling of theta's turns (theta + 2 pi gives another c); angles drawn
+ *   from the seed are labelled in [-pi, pi), the frame the joint layer uses without
+ *   configuration. A power cycle (j288_sim_servo_power_cycle) leaves theta, theta_gear and
+ *   c where they are and loses the turn count: at power-up p restarts inside [0, 2 pi) (a
+ *   new k). While off, the servo is deaf and silent and gives no torque; it comes back in
+ *   lock with the watchdog off, as after the first power-up.
  * - j288_sim_bus_t: the wire. Bytes the host sent go through lib's command parser
  *   (J288_PARSE_COMMAND) and j288_cmd_decode(); addressed servos answer through the send
  *   callback, after the turnaround, with the configured faults injected (drop, corrupt,
@@ -36,6 +49,13 @@
  *   A reply draws the same random numbers with the faults on or off (a silent duplicate
  *   draws none), so a run stays reproducible for the same commands, timing and switching.
  *   Replies already handed to the send callback (e.g. a late one) are not recalled.
+ * - Backlash: the output shaft is massless and moves only when the gear side pushes it (it
+ *   stays inside [theta_gear - b/2, theta_gear + b/2], b the play) or when the load drives
+ *   it: a load torque other than zero keeps it pressed against the side it pushes towards,
+ *   so that the gear always carries the load. The load's inertia is always felt by the rotor.
+ * - A power cycle keeps the temperatures and the injected fault bits (a broken encoder stays
+ *   broken), clears the latched checksum fault, and does not change the random sequence of
+ *   the bus (a servo that is off draws nothing: it does not answer).
  */
 #ifndef J288_SIM_SERVO_MODEL_H
 #define J288_SIM_SERVO_MODEL_H
@@ -67,6 +87,7 @@ typedef struct {
     double voltage;      /* supply, V */
     double ambient_c;    /* ambient temperature, deg C */
     double loss_per_nm2; /* copper loss per torque squared, W/(N m)^2 */
+    double backlash;     /* play between the gear and the output shaft, output rad (0: none) */
 } j288_sim_params_t;
 
 /* Sensible defaults: a small rotor, 24 V, 25 C. */
@@ -76,11 +97,17 @@ typedef struct {
     uint8_t id;
     j288_sim_params_t prm;
     /* physics */
-    double p;          /* rotor angle since power-up, rad (multi-turn) */
-    double w;          /* rotor speed, rad/s */
-    double tau;        /* motor torque applied in the last step, N m */
-    double out_offset; /* output angle = out_offset + p / N */
+    double p;     /* rotor angle since power-up, rad (multi-turn; what replies report) */
+    double w;     /* rotor speed, rad/s */
+    double tau;   /* motor torque applied in the last step, N m */
+    double c;     /* rotor phase: r = N * theta_gear + c */
+    long k;       /* turns lost at the last power-up: r = p + 2 pi k */
+    double theta; /* output shaft angle, rad (multi-turn), what the output encoder measures */
     double t_wind, t_case;
+    /* power */
+    bool powered;          /* false while a power cycle keeps it off */
+    uint64_t power_on_us;  /* when it comes back (while !powered) */
+    uint32_t power_cycles; /* since the simulation started */
     /* protocol */
     j288_cmd_raw_t cmd; /* the last command obeyed */
     uint8_t mode;       /* J288_MODE_LOCK or J288_MODE_FOC, as reported */
@@ -94,28 +121,50 @@ typedef struct {
     uint32_t watchdog_trips;
 } j288_sim_servo_t;
 
-/* Power up servo id at time 0: lock, watchdog off, rotor at start_angle (taken modulo 2 pi
- * into [0, 2 pi), as the single-turn encoder reads it), output shaft at out_angle.
- * prm NULL: defaults. */
-void j288_sim_servo_init(j288_sim_servo_t *s, uint8_t id, const j288_sim_params_t *prm,
-                         double start_angle, double out_angle);
+/* Power up servo id at time 0: lock, watchdog off, rotor phase c, output shaft at
+ * out_angle (rad, multi-turn; it labels the turns c goes with). The gear side starts at the
+ * shaft, or, with backlash and a load torque, half the play away from it (the load presses
+ * the shaft against one side); p is then r modulo 2 pi. prm NULL: defaults. */
+void j288_sim_servo_init(j288_sim_servo_t *s, uint8_t id, const j288_sim_params_t *prm, double c,
+                         double out_angle);
 
 /* Integrate up to now_us (no-op if now_us is not later). Trips the watchdog at the exact
- * time it starves. */
+ * time it starves, and powers the servo up at the exact time a power cycle ends. */
 void j288_sim_servo_advance(j288_sim_servo_t *s, uint64_t now_us);
 
-/* A good command for this servo (or broadcast) arrived at now_us. */
-void j288_sim_servo_command(j288_sim_servo_t *s, const j288_cmd_raw_t *cmd, uint64_t now_us);
+/* A good command for this servo (or broadcast) arrived at now_us. Returns false when the
+ * servo is off (power cycle) and did not hear it; it must then not answer. */
+bool j288_sim_servo_command(j288_sim_servo_t *s, const j288_cmd_raw_t *cmd, uint64_t now_us);
 
-/* A frame naming this servo failed its CRC. */
+/* A frame naming this servo failed its CRC (ignored while it is off). */
 void j288_sim_servo_bad_crc(j288_sim_servo_t *s);
 
 /* The reply the servo sends now (clears report-once faults). */
 void j288_sim_servo_reply(j288_sim_servo_t *s, j288_reply_raw_t *r);
 
+/* Switch the servo off at now_us (after advancing to it) for off_us microseconds (0: it is
+ * back at once), then on again: theta, theta_gear and c kept, p restarts inside [0, 2 pi),
+ * lock, watchdog off. A cycle while already off restarts the off time. */
+void j288_sim_servo_power_cycle(j288_sim_servo_t *s, uint64_t now_us, uint32_t off_us);
+
 /* Output shaft angle, rad (multi-turn), and the 13-bit OutPos the encoder reports. */
 double j288_sim_servo_out_angle(const j288_sim_servo_t *s);
 uint16_t j288_sim_servo_out_pos(const j288_sim_servo_t *s);
+
+/* The simulated truth, for tests that compare what the host computes with it. */
+typedef struct {
+    double theta;      /* output shaft angle, rad (multi-turn) */
+    double theta_gear; /* gear side of the output stage, rad: r = N * theta_gear + c */
+    double c;          /* rotor phase, rad */
+    double r;          /* continuous rotor angle, rad */
+    double p;          /* rotor position a reply reports, rad: p = r - 2 pi k */
+    long k;            /* turns lost at the last power-up */
+    uint16_t out_pos;  /* the output encoder's count */
+    bool powered;      /* false during a power cycle's off time */
+    uint32_t power_cycles;
+} j288_sim_truth_t;
+
+void j288_sim_servo_truth(const j288_sim_servo_t *s, j288_sim_truth_t *t);
 
 /* ---- the bus ---------------------------------------------------------------------------- */
 
@@ -129,6 +178,7 @@ typedef struct {
     uint16_t dup_ids;       /* bit n: a second servo also answers to id n */
     uint64_t seed;
     uint32_t idle_flush_us; /* a gap this long drops a partial command; 0: 5 ms */
+    uint32_t power_off_us;  /* how long a power-cycled servo stays off (0: back at once) */
 } j288_sim_bus_config_t;
 
 typedef struct {
@@ -144,6 +194,7 @@ typedef struct {
     uint64_t noise;
     uint64_t duplicates;
     uint64_t watchdog_trips;
+    uint64_t power_cycles; /* servo power cycles (each servo counts; duplicates too) */
 } j288_sim_stats_t;
 
 /* Bytes to put on the wire at at_us (>= the time of the command that caused them). */
@@ -170,11 +221,23 @@ typedef struct {
 } j288_sim_bus_t;
 
 /* Set up a bus with the servos whose bits are set in ids (bit n = id n, 0-14). Each servo's
- * power-up angles come from the seed. cfg, prm may be NULL. send may be NULL (replies are
- * counted, not sent), log may be NULL. Returns 0, or -1 for ids == 0 or ids with bit 15. */
+ * rotor phase c (in [0, 2 pi)) and start output angle (in [-pi, pi)) come from the seed,
+ * drawn for every id present or not, so a servo's draw does not depend on the others.
+ * cfg, prm may be NULL. send may be NULL (replies are counted, not sent), log may be NULL.
+ * Returns 0, or -1 for ids == 0 or ids with bit 15. */
 int j288_sim_bus_init(j288_sim_bus_t *b, uint16_t ids, const j288_sim_bus_config_t *cfg,
                       const j288_sim_params_t *prm, j288_sim_send_fn send, j288_sim_log_fn log,
                       void *user);
+
+/* Give servo id (not its duplicate) rotor phase c and start output angle theta instead of
+ * the drawn ones: it is powered up afresh with them. Call before any traffic. -1 for an id
+ * not on the bus. */
+int j288_sim_bus_set_joint(j288_sim_bus_t *b, uint8_t id, double c, double theta);
+
+/* Power-cycle the servos whose bits are set in ids (their duplicates too) at now_us, off for
+ * cfg.power_off_us. Returns the number of servos cycled, or -1 (nothing done) when ids names
+ * a servo that is not on the bus. */
+int j288_sim_bus_power_cycle(j288_sim_bus_t *b, uint16_t ids, uint64_t now_us);
 
 /* Inject fault bits (reported in every reply until changed). -1 for an id not on the bus. */
 int j288_sim_bus_inject_faults(j288_sim_bus_t *b, uint8_t id, uint32_t bits);

@@ -4,9 +4,10 @@
  * Prints the pty's path on stdout (one line), serves the servos until SIGINT/SIGTERM (or
  * --exit-after), then closes the pty master (clients see the device vanish), removes the
  * --link symlink and prints one statistics line on stderr. SIGUSR1 switches the injected
- * wire faults off, SIGUSR2 on again (the handlers only record the wish; the loop applies
- * it). The servo physics and protocol live in servo_model.c; this file is the I/O: the
- * pty, timing of replies, options, signals, the log.
+ * wire faults off, SIGUSR2 on again, SIGPWR power-cycles every servo, SIGWINCH writes the
+ * --truth file (the handlers only record the wish; the loop applies it). The servo physics
+ * and protocol live in servo_model.c; this file is the I/O: the pty, timing of replies,
+ * options, signals, the log, the truth file.
  */
 #define _GNU_SOURCE 1 /* posix_openpt, ppoll, sigaction under -std=c99 */
 
@@ -26,16 +27,23 @@
 
 #include "servo_model.h"
 
-#define QUEUE_LEN 64u
-#define CHUNK_MAX 32u
-#define TICK_US   10000u /* model advance when the line is quiet */
-#define NAP_US    1000u  /* no client has the pty open: look again this often */
+#define QUEUE_LEN  64u
+#define CHUNK_MAX  32u
+#define TICK_US    10000u /* model advance when the line is quiet */
+#define NAP_US     1000u  /* no client has the pty open: look again this often */
+#define MAX_CYCLES 16u    /* --power-cycle-after entries */
 
 typedef struct {
     uint64_t at_us;
     size_t len;
     uint8_t data[CHUNK_MAX];
 } chunk_t;
+
+/* A --power-cycle-after entry. */
+typedef struct {
+    uint64_t at_us;
+    uint16_t ids; /* 0: every servo */
+} cycle_t;
 
 typedef struct {
     int master;
@@ -47,15 +55,37 @@ typedef struct {
     bool echo;
     bool quiet;
     FILE *log;
+    const char *truth; /* --truth target, or NULL */
+    unsigned long truth_seq;
+    const cycle_t *cycle; /* --power-cycle-after entries, in time order */
+    size_t ncycles, next_cycle;
+    uint32_t power_off_us;
+    bool power_on_pending; /* a truth line is due when the cycled servos are back */
+    uint64_t power_on_us;
 } sim_io_t;
 
 static volatile sig_atomic_t g_stop;          /* set by SIGINT/SIGTERM/SIGHUP */
 static volatile sig_atomic_t g_faults_on = 1; /* SIGUSR1: 0, SIGUSR2: 1; the last one wins */
+static volatile sig_atomic_t g_power_cycle;   /* SIGPWR: power-cycle every servo */
+static volatile sig_atomic_t g_truth_wanted;  /* SIGWINCH: write the --truth file */
 
 static void on_signal(int sig)
 {
     (void)sig;
     g_stop = 1;
+}
+
+/* Async-signal-safe: one store each; serve() acts on it. */
+static void on_power_signal(int sig)
+{
+    (void)sig;
+    g_power_cycle = 1;
+}
+
+static void on_truth_signal(int sig)
+{
+    (void)sig;
+    g_truth_wanted = 1;
 }
 
 /* Async-signal-safe: one store; serve() applies it before it reads the next bytes. */
@@ -95,9 +125,16 @@ typedef struct {
     uint16_t ids;
     const char *link;
     const char *log;
+    const char *truth;
     double exit_after;
     uint32_t faults[J288_MAX_SERVOS];
     uint16_t fault_set;
+    double phase[J288_MAX_SERVOS];
+    uint16_t phase_set;
+    double angle[J288_MAX_SERVOS];
+    uint16_t angle_set;
+    cycle_t cycle[MAX_CYCLES]; /* in time order */
+    size_t ncycles;
     bool quiet;
     bool echo;
     j288_sim_bus_config_t bus;
@@ -132,8 +169,37 @@ static void usage(FILE *f)
           "  --late-us N         delay of a late reply (default 50000)\n"
           "  --noise P           probability of 1-8 noise bytes ahead of a reply\n"
           "  --dup ID            a second servo also answers to ID (repeatable)\n"
-          "  --fault ID:BITS     servo ID reports fault bits BITS (e.g. 0x200; repeatable)\n"
-          "switching faults while running:\n"
+          "  --fault ID:BITS     servo ID reports fault bits BITS (e.g. 0x200; repeatable)\n",
+          f);
+    /* In parts: C99 compilers need only take string literals of 4095 characters. */
+    fputs("joint (the rotor angle is r = N * theta + c, N = 288.35; a reply's position is\n"
+          "p = r - 2 pi k with k such that p starts in [0, 2 pi) at power-up; OutPos is the\n"
+          "output shaft angle theta in 8192 counts per turn):\n"
+          "  --phase ID:RAD      rotor phase c of servo ID, fixed at assembly (default: drawn\n"
+          "                      from --seed in [0, 2 pi)); repeatable\n"
+          "  --start-angle ID:RAD  output angle theta of servo ID at start (default: drawn from\n"
+          "                      --seed in [-pi, pi)); it labels the turns that c goes with;\n"
+          "                      repeatable\n"
+          "  --backlash RAD      play between the gear and the output shaft, output rad\n"
+          "                      (default 0): the shaft follows only when the gear pushes it\n"
+          "                      or the load (--load-torque) drives it\n"
+          "  --truth FILE        write every servo's truth to FILE ('-' = stderr) at start\n"
+          "                      (before the pty path line), on SIGWINCH, when power-cycled\n"
+          "                      servos go off and when they are back, and at exit; the file\n"
+          "                      is replaced atomically. A line '# j288-sim truth seq=N\n"
+          "                      t=SECONDS reason=start|request|power-off|power-on|exit',\n"
+          "                      then per servo 'id= theta= theta_gear= c= k= p= r= out_pos=\n"
+          "                      powered= cycles=' (angles in rad; theta_gear is theta\n"
+          "                      without the play: r = N * theta_gear + c = p + 2 pi k)\n"
+          "power cycles (the turn count is lost: p restarts inside [0, 2 pi); theta and c are\n"
+          "kept; the servo is deaf and silent while off, then in lock with the watchdog off):\n"
+          "  --power-cycle-after S[:IDS]  power-cycle servos IDS (e.g. 1,3; default all) S\n"
+          "                      seconds after start; repeatable (up to 16)\n"
+          "  --power-off-ms N    how long a power-cycled servo stays off (default 100)\n"
+          "  SIGPWR              power-cycle every servo now. Unless --quiet, each cycle\n"
+          "                      prints 'j288-sim: power cycle: servos ... off for N ms'.\n",
+          f);
+    fputs("switching faults while running:\n"
           "  SIGUSR1             wire faults off: no drop, corrupt, late, noise or duplicate-id\n"
           "                      replies from the next command on (a reply already delayed by\n"
           "                      --late still arrives when due); --fault bits are servo state\n"
@@ -141,6 +207,8 @@ static void usage(FILE *f)
           "                      ...' (the statistics line so far) when it takes effect.\n"
           "  SIGUSR2             wire faults on again as configured ('faults on: stats: ...').\n"
           "                      A signal that changes nothing prints nothing.\n"
+          "  SIGWINCH            write the --truth file now (reason=request)\n"
+          "  SIGHUP              like SIGTERM: a simulator whose terminal is gone stops\n"
           "log lines: SECONDS HEX20 then 'id=N status=N wd=0|1 tau= speed= pos= kp= kd='\n"
           "for a good frame, or 'bad-crc id=N' for a frame whose CRC failed.\n",
           f);
@@ -185,30 +253,75 @@ static uint16_t parse_id_list(const char *opt, const char *s)
     return ids;
 }
 
-static void parse_fault(options_t *o, const char *s)
+/* "ID:VALUE": the id; *value points at VALUE inside buf (cap bytes). */
+static uint8_t parse_id_colon(const char *opt, const char *s, char *buf, size_t cap,
+                              const char *what, const char **value)
 {
-    char buf[64];
     char *colon;
-    unsigned long id;
-    if (strlen(s) >= sizeof buf)
-        die("--fault: '%s' too long", s);
+    if (strlen(s) >= cap)
+        die("%s: '%s' too long", opt, s);
     strcpy(buf, s);
     colon = strchr(buf, ':');
     if (colon == NULL)
-        die("--fault: expected ID:BITS, got '%s'", s);
+        die("%s: expected ID:%s, got '%s'", opt, what, s);
     *colon = '\0';
-    id = parse_ulong("--fault", buf, J288_MAX_ID, 10);
-    o->faults[id] = (uint32_t)parse_ulong("--fault", colon + 1, 0xFFFFFFFFul, 0);
+    *value = colon + 1;
+    return (uint8_t)parse_ulong(opt, buf, J288_MAX_ID, 10);
+}
+
+static void parse_fault(options_t *o, const char *s)
+{
+    char buf[64];
+    const char *v;
+    uint8_t id = parse_id_colon("--fault", s, buf, sizeof buf, "BITS", &v);
+    o->faults[id] = (uint32_t)parse_ulong("--fault", v, 0xFFFFFFFFul, 0);
     o->fault_set = (uint16_t)(o->fault_set | (1u << id));
+}
+
+/* --phase / --start-angle ID:RAD into vals[id], marking it in *set. */
+static void parse_joint_angle(const char *opt, const char *s, double *vals, uint16_t *set)
+{
+    char buf[64];
+    const char *v;
+    uint8_t id = parse_id_colon(opt, s, buf, sizeof buf, "RAD", &v);
+    vals[id] = parse_double(opt, v, -1000.0, 1000.0);
+    *set = (uint16_t)(*set | (1u << id));
+}
+
+/* --power-cycle-after S[:IDS], kept in time order (equal times keep their order). */
+static void parse_cycle(options_t *o, const char *s)
+{
+    char buf[128];
+    char *colon;
+    cycle_t c;
+    size_t i;
+    if (o->ncycles == MAX_CYCLES)
+        die("--power-cycle-after: at most %u", MAX_CYCLES);
+    if (strlen(s) >= sizeof buf)
+        die("--power-cycle-after: '%s' too long", s);
+    strcpy(buf, s);
+    colon = strchr(buf, ':');
+    if (colon != NULL)
+        *colon = '\0';
+    c.at_us = (uint64_t)(parse_double("--power-cycle-after", buf, 0.0, 86400.0) * 1e6);
+    c.ids = (colon != NULL) ? parse_id_list("--power-cycle-after", colon + 1) : 0u;
+    i = o->ncycles;
+    while (i > 0u && o->cycle[i - 1u].at_us > c.at_us) {
+        o->cycle[i] = o->cycle[i - 1u];
+        i--;
+    }
+    o->cycle[i] = c;
+    o->ncycles++;
 }
 
 static bool takes_value(const char *opt)
 {
     static const char *const names[] = {
-        "--ids",          "--link",        "--log",           "--voltage",    "--ambient",
-        "--load-inertia", "--load-torque", "--turnaround-us", "--exit-after", "--seed",
-        "--drop",         "--corrupt",     "--late",          "--late-us",    "--noise",
-        "--dup",          "--fault"};
+        "--ids",          "--link",        "--log",           "--voltage",     "--ambient",
+        "--load-inertia", "--load-torque", "--turnaround-us", "--exit-after",  "--seed",
+        "--drop",         "--corrupt",     "--late",          "--late-us",     "--noise",
+        "--dup",          "--fault",       "--phase",         "--start-angle", "--backlash",
+        "--truth",        "--power-off-ms", "--power-cycle-after"};
     size_t i;
     for (i = 0; i < sizeof names / sizeof names[0]; i++)
         if (strcmp(opt, names[i]) == 0)
@@ -223,6 +336,7 @@ static void parse_args(options_t *o, int argc, char **argv)
     o->ids = 1u << 1;
     o->bus.seed = 1u;
     o->bus.turnaround_us = 0u;
+    o->bus.power_off_us = 100000u;
     j288_sim_params_default(&o->prm);
     for (i = 1; i < argc; i++) {
         const char *a = argv[i];
@@ -280,6 +394,18 @@ static void parse_args(options_t *o, int argc, char **argv)
             o->bus.dup_ids = (uint16_t)(o->bus.dup_ids | parse_id_list(a, v));
         else if (strcmp(a, "--fault") == 0)
             parse_fault(o, v);
+        else if (strcmp(a, "--phase") == 0)
+            parse_joint_angle(a, v, o->phase, &o->phase_set);
+        else if (strcmp(a, "--start-angle") == 0)
+            parse_joint_angle(a, v, o->angle, &o->angle_set);
+        else if (strcmp(a, "--backlash") == 0)
+            o->prm.backlash = parse_double(a, v, 0.0, 1.0);
+        else if (strcmp(a, "--truth") == 0)
+            o->truth = v;
+        else if (strcmp(a, "--power-cycle-after") == 0)
+            parse_cycle(o, v);
+        else if (strcmp(a, "--power-off-ms") == 0)
+            o->bus.power_off_us = (uint32_t)(parse_ulong(a, v, 60000ul, 10) * 1000u);
         else
             die("unknown option '%s' (see --help)", a);
     }
@@ -287,6 +413,13 @@ static void parse_args(options_t *o, int argc, char **argv)
         die("--dup names an id that is not in --ids");
     if ((o->fault_set & ~o->ids) != 0u)
         die("--fault names an id that is not in --ids");
+    if ((o->phase_set & ~o->ids) != 0u)
+        die("--phase names an id that is not in --ids");
+    if ((o->angle_set & ~o->ids) != 0u)
+        die("--start-angle names an id that is not in --ids");
+    for (i = 0; i < (int)o->ncycles; i++)
+        if ((o->cycle[i].ids & ~o->ids) != 0u)
+            die("--power-cycle-after names an id that is not in --ids");
 }
 
 /* ---- output queue ----------------------------------------------------------------------- */
@@ -344,7 +477,7 @@ static void print_stats(const sim_io_t *io, const j288_sim_bus_t *bus, const cha
     fprintf(stderr,
             "j288-sim: %s: bytes %llu commands %llu broadcast %llu bad-crc %llu "
             "other-ids %llu replies %llu dropped %llu corrupted %llu late %llu noise %llu "
-            "duplicates %llu watchdog-trips %llu garbage-bytes %lu lost %llu\n",
+            "duplicates %llu watchdog-trips %llu garbage-bytes %lu lost %llu power-cycles %llu\n",
             label, (unsigned long long)st->bytes, (unsigned long long)st->commands,
             (unsigned long long)st->broadcasts, (unsigned long long)st->bad_crc,
             (unsigned long long)st->for_others, (unsigned long long)st->replies,
@@ -352,7 +485,8 @@ static void print_stats(const sim_io_t *io, const j288_sim_bus_t *bus, const cha
             (unsigned long long)st->late, (unsigned long long)st->noise,
             (unsigned long long)st->duplicates, (unsigned long long)st->watchdog_trips,
             (unsigned long)bus->parser.stats.garbage_bytes,
-            (unsigned long long)(io->lost_no_client + io->queue_full));
+            (unsigned long long)(io->lost_no_client + io->queue_full),
+            (unsigned long long)st->power_cycles);
     fflush(stderr);
 }
 
@@ -365,6 +499,113 @@ static void apply_fault_switch(const sim_io_t *io, j288_sim_bus_t *bus)
     j288_sim_bus_set_faults(bus, on);
     if (!io->quiet)
         print_stats(io, bus, on ? "faults on: stats" : "faults off: stats");
+}
+
+/* ---- truth and power cycles ---------------------------------------------------------------- */
+
+static void print_truth(FILE *f, const j288_sim_bus_t *bus, unsigned long seq, uint64_t now_us,
+                        const char *reason)
+{
+    uint8_t id;
+    fprintf(f, "# j288-sim truth seq=%lu t=%llu.%06llu reason=%s\n", seq,
+            (unsigned long long)(now_us / 1000000u), (unsigned long long)(now_us % 1000000u),
+            reason);
+    for (id = 0; id < J288_MAX_SERVOS; id++) {
+        j288_sim_truth_t t;
+        if ((bus->present & (1u << id)) == 0u)
+            continue;
+        j288_sim_servo_truth(&bus->servo[id], &t);
+        fprintf(f,
+                "id=%u theta=%.9f theta_gear=%.9f c=%.9f k=%ld p=%.9f r=%.9f out_pos=%u "
+                "powered=%u cycles=%lu\n",
+                (unsigned)id, t.theta, t.theta_gear, t.c, t.k, t.p, t.r, (unsigned)t.out_pos,
+                t.powered ? 1u : 0u, (unsigned long)t.power_cycles);
+    }
+}
+
+/* The model at now_us into the --truth target, replaced atomically (a reader never sees half
+ * a file). False, with a message, when it cannot be written. */
+static bool write_truth(sim_io_t *io, j288_sim_bus_t *bus, uint64_t now_us, const char *reason)
+{
+    char tmp[4096];
+    FILE *f;
+    if (io->truth == NULL)
+        return true;
+    j288_sim_bus_advance(bus, now_us);
+    io->truth_seq++;
+    if (strcmp(io->truth, "-") == 0) {
+        print_truth(stderr, bus, io->truth_seq, now_us, reason);
+        fflush(stderr);
+        return true;
+    }
+    if ((size_t)snprintf(tmp, sizeof tmp, "%s.tmp", io->truth) >= sizeof tmp) {
+        fprintf(stderr, "j288-sim: --truth %s: path too long\n", io->truth);
+        return false;
+    }
+    f = fopen(tmp, "w");
+    if (f == NULL) {
+        fprintf(stderr, "j288-sim: --truth %s: %s\n", tmp, strerror(errno));
+        return false;
+    }
+    print_truth(f, bus, io->truth_seq, now_us, reason);
+    if (fclose(f) != 0 || rename(tmp, io->truth) != 0) {
+        fprintf(stderr, "j288-sim: --truth %s: %s\n", io->truth, strerror(errno));
+        (void)unlink(tmp);
+        return false;
+    }
+    return true;
+}
+
+/* Power-cycle servos ids (0: all) at at_us; the truth follows at once and when they are back. */
+static void power_cycle(sim_io_t *io, j288_sim_bus_t *bus, uint16_t ids, uint64_t at_us)
+{
+    uint8_t id;
+    if (ids == 0u)
+        ids = bus->present;
+    (void)j288_sim_bus_power_cycle(bus, ids, at_us);
+    if (!io->quiet) {
+        fprintf(stderr, "j288-sim: power cycle: servos");
+        for (id = 0; id < J288_MAX_SERVOS; id++)
+            if ((ids & (1u << id)) != 0u)
+                fprintf(stderr, " %u", (unsigned)id);
+        fprintf(stderr, " off for %lu ms\n", (unsigned long)(io->power_off_us / 1000u));
+        fflush(stderr);
+    }
+    (void)write_truth(io, bus, at_us, "power-off");
+    if (!io->power_on_pending || io->power_on_us < at_us + io->power_off_us)
+        io->power_on_us = at_us + io->power_off_us;
+    io->power_on_pending = true;
+}
+
+/* Apply the power cycles and truth requests that are due at now_us. */
+static void apply_power_and_truth(sim_io_t *io, j288_sim_bus_t *bus, uint64_t now_us)
+{
+    if (g_power_cycle) {
+        g_power_cycle = 0;
+        power_cycle(io, bus, 0u, now_us);
+    }
+    while (io->next_cycle < io->ncycles && io->cycle[io->next_cycle].at_us <= now_us) {
+        power_cycle(io, bus, io->cycle[io->next_cycle].ids, io->cycle[io->next_cycle].at_us);
+        io->next_cycle++;
+    }
+    if (io->power_on_pending && io->power_on_us <= now_us) {
+        io->power_on_pending = false;
+        (void)write_truth(io, bus, io->power_on_us, "power-on");
+    }
+    if (g_truth_wanted) {
+        g_truth_wanted = 0;
+        (void)write_truth(io, bus, now_us, "request");
+    }
+}
+
+/* The next time apply_power_and_truth() has something to do, if before wake. */
+static uint64_t power_wake(const sim_io_t *io, uint64_t wake)
+{
+    if (io->next_cycle < io->ncycles && io->cycle[io->next_cycle].at_us < wake)
+        wake = io->cycle[io->next_cycle].at_us;
+    if (io->truth != NULL && io->power_on_pending && io->power_on_us < wake)
+        wake = io->power_on_us;
+    return wake;
 }
 
 /* ---- log ------------------------------------------------------------------------------------ */
@@ -456,6 +697,10 @@ static void install_signals(sigset_t *run_mask)
     sa.sa_handler = on_fault_signal;
     (void)sigaction(SIGUSR1, &sa, NULL);
     (void)sigaction(SIGUSR2, &sa, NULL);
+    sa.sa_handler = on_power_signal;
+    (void)sigaction(SIGPWR, &sa, NULL);
+    sa.sa_handler = on_truth_signal;
+    (void)sigaction(SIGWINCH, &sa, NULL);
     sa.sa_handler = SIG_IGN;
     (void)sigaction(SIGPIPE, &sa, NULL);
     /* Signals stay blocked except inside ppoll: no wake-up is lost between a check of
@@ -466,12 +711,16 @@ static void install_signals(sigset_t *run_mask)
     sigaddset(&block, SIGHUP);
     sigaddset(&block, SIGUSR1);
     sigaddset(&block, SIGUSR2);
+    sigaddset(&block, SIGPWR);
+    sigaddset(&block, SIGWINCH);
     (void)sigprocmask(SIG_BLOCK, &block, run_mask);
     sigdelset(run_mask, SIGINT);
     sigdelset(run_mask, SIGTERM);
     sigdelset(run_mask, SIGHUP);
     sigdelset(run_mask, SIGUSR1);
     sigdelset(run_mask, SIGUSR2);
+    sigdelset(run_mask, SIGPWR);
+    sigdelset(run_mask, SIGWINCH);
 }
 
 static struct timespec ts_from_us(uint64_t us)
@@ -518,6 +767,7 @@ static void serve(sim_io_t *io, j288_sim_bus_t *bus, uint64_t exit_at_us, const 
         if (exit_at_us != 0u && now >= exit_at_us)
             break;
         apply_fault_switch(io, bus);
+        apply_power_and_truth(io, bus, now);
         flush_due(io, now);
         if (now - last_tick >= TICK_US) {
             j288_sim_bus_advance(bus, now);
@@ -527,6 +777,7 @@ static void serve(sim_io_t *io, j288_sim_bus_t *bus, uint64_t exit_at_us, const 
             wake = io->q[0].at_us;
         if (exit_at_us != 0u && exit_at_us < wake)
             wake = exit_at_us;
+        wake = power_wake(io, wake);
         ts = ts_from_us(wake > now ? wake - now : 0u);
         pfd.fd = io->master;
         pfd.events = POLLIN;
@@ -561,6 +812,10 @@ int main(int argc, char **argv)
     memset(&io, 0, sizeof io);
     io.echo = o.echo;
     io.quiet = o.quiet;
+    io.truth = o.truth;
+    io.cycle = o.cycle;
+    io.ncycles = o.ncycles;
+    io.power_off_us = o.bus.power_off_us;
     bus = calloc(1, sizeof *bus);
     if (bus == NULL)
         die("out of memory");
@@ -574,9 +829,18 @@ int main(int argc, char **argv)
     }
     if (j288_sim_bus_init(bus, o.ids, &o.bus, &o.prm, queue_send, log_frame, &io) != 0)
         die("bad --ids");
-    for (id = 0; id < J288_MAX_SERVOS; id++)
+    for (id = 0; id < J288_MAX_SERVOS; id++) {
+        const j288_sim_servo_t *s = j288_sim_bus_servo(bus, id);
+        if (s != NULL && ((o.phase_set | o.angle_set) & (1u << id)) != 0u)
+            (void)j288_sim_bus_set_joint(
+                bus, id, ((o.phase_set & (1u << id)) != 0u) ? o.phase[id] : s->c,
+                ((o.angle_set & (1u << id)) != 0u) ? o.angle[id] : s->theta);
         if ((o.fault_set & (1u << id)) != 0u)
             (void)j288_sim_bus_inject_faults(bus, id, o.faults[id]);
+    }
+    /* Before the path line: whoever waits for it can read the truth at once. */
+    if (!write_truth(&io, bus, 0u, "start"))
+        exit(2);
 
     io.master = open_pty(path, sizeof path);
     if (o.link != NULL)
@@ -601,6 +865,7 @@ int main(int argc, char **argv)
     if (o.link != NULL)
         remove_link(o.link, path);
     j288_sim_bus_advance(bus, sim_now_us(&io));
+    (void)write_truth(&io, bus, sim_now_us(&io), "exit");
     print_stats(&io, bus, "stats");
     if (io.log != NULL && io.log != stderr)
         fclose(io.log);

@@ -4,14 +4,24 @@
  * A transaction sends one 20-byte command and, unless it is a broadcast (id 15), waits for
  * the addressed servo's 26-byte reply until a deadline: the wire time of command and reply
  * at the configured baud plus turnaround_us plus margin_us, counted from the start of
- * transmit. Its result is J288_OK or the most specific failure seen (wrong id > line >
- * crc/truncated > timeout; a differing echo is a collision; a line gone ends it at once,
- * J288_ERR_OFFLINE). A failed attempt is re-sent up to config.retries times, each attempt's
- * result kept in the j288_txn_t. A quiet guard follows every transaction (the full reply
- * budget after a failure, so that a late reply dies out): a frame from another id, or one
- * received outside the reply window, is counted and never credited to a transaction. Bytes
- * received before a poll are examined before its deadline check: a late poll does not turn a
- * good reply into a timeout.
+ * transmit. A pause inside a reply does not end it: a frame still incomplete at the deadline
+ * is J288_ERR_TRUNCATED. The result is J288_OK or the most specific failure seen (wrong id >
+ * line > crc > truncated > timeout; a differing echo is a collision; a line gone ends the
+ * attempt at once, J288_ERR_OFFLINE). A failed attempt is re-sent up to config.retries times,
+ * each attempt's result kept in the j288_txn_t. stats.crc_errors counts frames (each corrupt
+ * one and each partial one given up); the scheduler's per-servo crc_errors counts
+ * transactions.
+ *
+ * A quiet guard follows every transaction: guard_us after success; after a failure, one
+ * reply budget after the later of the failure and the attempt's deadline, so that a late
+ * reply dies out. A frame from another id, or bytes received outside the reply window, are
+ * counted and never credited to a transaction. Bytes received before a poll are examined
+ * before its deadline check: a late poll does not turn a good reply into a timeout.
+ *
+ * Clock: start, deadline and guard come from the now_us given to j288_bus_submit(),
+ * j288_bus_poll() or j288_bus_estop() when that call advances the machine, and from
+ * port->now_us() when an event call does (advance_in_isr) and in
+ * j288_bus_transfer_blocking(): both must be the same clock (same epoch, microseconds).
  *
  * Contexts: the port's event calls (j288_bus_on_*) only record, lock-free, from any context
  * (32-bit loads and stores must be atomic, as on every Cortex-M). The machine advances in
@@ -100,7 +110,8 @@ typedef struct {
     uint32_t failed;       /* user transactions that ended with any other result (after all
                               their retries), except J288_ERR_ABORTED */
     uint32_t timeouts;     /* attempts ended by the deadline (reply or tx done) */
-    uint32_t crc_errors;   /* corrupt or truncated frames in a reply window */
+    uint32_t crc_errors;   /* frames in a reply window: each corrupt one and each partial one
+                              given up at the deadline (the slot's counts transactions) */
     uint32_t wrong_id;     /* good frames from another id in a reply window */
     uint32_t collisions;   /* attempts whose echo differed or never came back */
     uint32_t line_errors;  /* line error reports, any state */
@@ -124,7 +135,7 @@ typedef struct j288_bus {
     j288_crc_t crc;
     j288_bus_config_t cfg;
     uint32_t reply_budget_us;
-    volatile uint8_t state;
+    uint8_t state;                /* read from other contexts through j288_bus_state() */
     uint8_t tx_buf[J288_CMD_LEN]; /* owned by the port from start_tx until tx done */
     uint8_t tx_id;                /* id addressed by tx_buf */
     j288_parser_t parser;
@@ -133,13 +144,14 @@ typedef struct j288_bus {
     volatile uint32_t ring_head;   /* (ev) */
     volatile uint32_t ring_tail;
     volatile uint32_t ev_tx_done;  /* (ev) event counters: compared with the seen_* copies */
-    volatile uint32_t ev_idle;     /* (ev) */
     volatile uint32_t ev_line;     /* (ev) */
     volatile uint32_t ev_gone;     /* (ev) */
     volatile uint32_t txdone_mark; /* (ev) ring_head when the transmit completed */
-    volatile uint32_t idle_mark;   /* (ev) ring_head at the latest idle */
     volatile uint32_t line_flags;  /* (ev) OR of every line flag reported (diagnostic) */
-    uint32_t seen_tx_done, seen_idle, seen_line, seen_gone;
+    uint32_t seen_tx_done, seen_line, seen_gone;
+    const uint8_t *direct;         /* bytes of an on_rx taken in place (advance_in_isr), */
+    uint32_t direct_pos;           /* at these ring positions, during that call only */
+    uint32_t direct_len;
     uint8_t echo_pos;     /* echo bytes matched so far */
     uint8_t cur;          /* txn[cur] is the transaction in progress */
     bool tx_complete;     /* this attempt's transmit has completed */
@@ -191,11 +203,14 @@ int j288_bus_submit(j288_bus_t *bus, const j288_cmd_raw_t *cmd, uint32_t now_us,
 void j288_bus_poll(j288_bus_t *bus, uint32_t now_us);
 
 /* Port events. ISR-safe: they record and return (and advance the machine when
- * advance_in_isr). data is copied; it may be reused as soon as on_rx returns; bytes beyond
- * the ring's free space are dropped and counted (rx_overflows). on_tx_done also switches
- * the port to receive at once (set_dir(RX), then start_rx unless config.echo, whose receiver
- * was started before the transmit); it may be called from inside start_tx. on_timer only
- * matters with advance_in_isr (in poll mode the next poll looks at the clock itself). */
+ * advance_in_isr). on_rx never keeps data: it is copied into the ring, or with advance_in_isr
+ * taken during the call; data may be reused as soon as on_rx returns; bytes beyond the
+ * ring's free space are dropped and counted (rx_overflows). on_tx_done also switches the port
+ * to receive at once (set_dir(RX), then start_rx unless config.echo, whose receiver was
+ * started before the transmit); it may be called from inside start_tx. on_timer only matters
+ * with advance_in_isr (in poll mode the next poll looks at the clock itself). on_rx_idle does
+ * nothing: a pause never ends a frame (see above); ports that see idle lines may still call
+ * it. */
 void j288_bus_on_tx_done(j288_bus_t *bus);
 void j288_bus_on_rx(j288_bus_t *bus, const uint8_t *data, size_t len);
 void j288_bus_on_rx_idle(j288_bus_t *bus);
@@ -209,8 +224,8 @@ void j288_bus_on_timer(j288_bus_t *bus);
  * attempt_result[]; a submit queued behind a guard ends J288_ERR_ABORTED with 0 attempts.
  * The stop frame then goes out at once (skipping the guard).
  * A stop frame whose transmit fails (start_tx error, echo collision or incomplete echo, no tx
- * done by its deadline, a line error during it) is sent again after a reply budget's guard,
- * whatever config.retries says, up to J288_ESTOP_ATTEMPTS transmits in all; J288_LINE_GONE
+ * done by its deadline, a line error during it) is sent again when the guard after a failed
+ * attempt has passed (the guard after a failure, above), whatever config.retries says, up to J288_ESTOP_ATTEMPTS transmits in all; J288_LINE_GONE
  * (during a transmit or while waiting to re-send) ends it at once. A stop given up this way
  * counts in stats.estop_failures (stats.estops counts every stop started); the port's own
  * errors are counted as usual (port_errors, collisions, timeouts, line_errors).

@@ -33,11 +33,14 @@
 #define J288_CONFIG_SI_FLOAT 0
 #endif
 
-/* Which CRC32 backend serves a NULL j288_crc_t (see crc32.h). */
-#define J288_CRC_BACKEND_TABLE 1   /* 256-entry table, 1 KiB flash, fastest in software  */
-#define J288_CRC_BACKEND_NIBBLE 2  /* 16-entry table, 64 bytes flash                    */
-#define J288_CRC_BACKEND_BITWISE 3 /* no table, slowest: the reference                   */
+/* Which CRC32 backend serves a NULL j288_crc_t (see crc32.h); docs/performance.md gives
+ * their speed and flash on Cortex-M. */
+#define J288_CRC_BACKEND_TABLE 1   /* 256-entry table, 1 KiB flash                        */
+#define J288_CRC_BACKEND_NIBBLE 2  /* 16-entry table, 64 bytes flash                      */
+#define J288_CRC_BACKEND_BITWISE 3 /* no table, slowest: the reference                     */
 #define J288_CRC_BACKEND_HW 4      /* J288_CONFIG_CRC_HW_FUNCTION, e.g. the STM32 CRC unit */
+#define J288_CRC_BACKEND_SLICE4 5  /* slicing by 4: four 256-entry tables, 4 KiB flash,
+                                      fastest in software                                 */
 
 #ifndef J288_CONFIG_CRC_BACKEND
 #define J288_CONFIG_CRC_BACKEND J288_CRC_BACKEND_TABLE
@@ -51,6 +54,7 @@
 #error "J288_CONFIG_CRC_BACKEND is HW but J288_CONFIG_CRC_HW_FUNCTION names no function"
 #endif
 #elif (J288_CONFIG_CRC_BACKEND != J288_CRC_BACKEND_TABLE) &&                                 \
+    (J288_CONFIG_CRC_BACKEND != J288_CRC_BACKEND_SLICE4) &&                                    \
     (J288_CONFIG_CRC_BACKEND != J288_CRC_BACKEND_NIBBLE) &&                                    \
     (J288_CONFIG_CRC_BACKEND != J288_CRC_BACKEND_BITWISE)
 #error "J288_CONFIG_CRC_BACKEND must be one of the J288_CRC_BACKEND_* values"

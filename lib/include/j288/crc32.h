@@ -8,8 +8,8 @@
  * byte-stream CRC is CRC-32/MPEG-2 over each 4-byte group reversed (check value for
  * "123456789": 0x0376E6E7, available here as j288_crc32_mpeg2_bytes()).
  *
- * Backends (bit-identical): 256-entry table, 16-entry nibble table, bitwise reference, and a
- * hardware hook. Each software backend is a streaming update: start from J288_CRC32_INIT and
+ * Backends (bit-identical): 256-entry table, slicing by 4 (four 256-entry tables), 16-entry
+ * nibble table, bitwise reference, and a hardware hook. Each software backend is a streaming update: start from J288_CRC32_INIT and
  * feed words in as many calls as you like. All functions are pure: ISR-safe and reentrant.
  */
 #ifndef J288_CRC32_H
@@ -30,6 +30,7 @@ extern "C" {
 /* Streaming software backends: fold nwords words (4 * nwords bytes from data, little-endian
  * words) into crc and return the new value. data may be NULL only when nwords is 0. */
 uint32_t j288_crc32_update_table(uint32_t crc, const uint8_t *data, size_t nwords);
+uint32_t j288_crc32_update_slice4(uint32_t crc, const uint8_t *data, size_t nwords);
 uint32_t j288_crc32_update_nibble(uint32_t crc, const uint8_t *data, size_t nwords);
 uint32_t j288_crc32_update_bitwise(uint32_t crc, const uint8_t *data, size_t nwords);
 

@@ -34,7 +34,7 @@ enum {
     /* Frame errors: bytes that are not a valid frame. */
     J288_ERR_BAD_HEADER = -20, /* first two bytes are not the expected head */
     J288_ERR_CRC = -21,        /* CRC mismatch */
-    J288_ERR_TRUNCATED = -22,  /* the line went idle inside a frame */
+    J288_ERR_TRUNCATED = -22,  /* a frame still incomplete at the deadline (or a flush) */
 
     /* Bus results. */
     J288_ERR_BUSY = -30,       /* a transaction is already in progress */
@@ -46,7 +46,15 @@ enum {
     J288_ERR_TX_TIMEOUT = -36, /* transmit-complete never came */
     J288_ERR_ABORTED = -37,    /* dropped by an emergency stop or an abort */
     J288_ERR_OVERFLOW = -38,   /* received bytes arrived faster than they were consumed */
-    J288_ERR_OFFLINE = -39     /* device gone (unplugged adapter, closed simulator) */
+    J288_ERR_OFFLINE = -39,    /* device gone (unplugged adapter, closed simulator) */
+
+    /* Joint layer (joint.h): nothing was produced. */
+    J288_ERR_ANGLE_UNKNOWN = -50, /* the joint's absolute angle is not known (yet, or any more) */
+    J288_ERR_CAL_MISMATCH = -51,  /* the calibrated phase disagrees with the output encoder */
+    J288_ERR_LIMIT_POS = -52,     /* target position outside the joint's soft limits */
+    J288_ERR_LIMIT_SPEED = -53,   /* target speed beyond the joint's limit */
+    J288_ERR_LIMIT_TORQUE = -54,  /* target torque beyond the joint's limit */
+    J288_ERR_CAL_DATA = -55       /* calibration data fail a quality check */
 };
 
 /* A short English description of a result code; never NULL, "unknown error" for a code

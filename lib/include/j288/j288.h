@@ -13,6 +13,7 @@
 #include "j288/port.h"
 #include "j288/bus.h"
 #include "j288/sched.h"
+#include "j288/joint.h"
 
 #define J288_VERSION_MAJOR 0
 #define J288_VERSION_MINOR 1

@@ -43,7 +43,9 @@ typedef struct j288_port {
     int (*start_tx)(void *ctx, const uint8_t *data, size_t len);
 
     /* REQUIRED. Monotonic microseconds; wraps at 2^32 (the bus compares times modulo 2^32,
-     * so intervals up to 35 minutes are handled). Any context. */
+     * so intervals up to 35 minutes are handled). Any context. The bus reads it when it
+     * advances inside an event call (advance_in_isr) and in j288_bus_transfer_blocking();
+     * the now_us the application passes to submit, poll and estop must be this same clock. */
     uint32_t (*now_us)(void *ctx);
 
     /* Optional. (Re)arm reception after a transmit: e.g. start a ReceiveToIdle DMA into the

@@ -12,7 +12,8 @@
  * next command to that servo goes out with the watchdog bit 0, as the manual requires.
  *
  * Statistics: every completed transaction of a slot counts once, under its final result
- * (crc_errors includes truncated replies; other_errors: line, port, tx timeout, offline,
+ * (crc_errors: transactions that ended J288_ERR_CRC or J288_ERR_TRUNCATED, where the bus's
+ * stats.crc_errors counts every bad frame; other_errors: line, port, tx timeout, offline,
  * aborted). consecutive_failures counts failures since the last good reply, except
  * J288_ERR_ABORTED (an emergency stop says nothing about the servo). Latencies are those of
  * good replies. A slot starts offline: its first good reply reports J288_EV_ONLINE; it goes
@@ -45,7 +46,7 @@ typedef struct {
     uint32_t transactions;
     uint32_t successes;
     uint32_t timeouts;
-    uint32_t crc_errors;
+    uint32_t crc_errors;       /* transactions ended CRC or TRUNCATED (not frames) */
     uint32_t wrong_id;
     uint32_t collisions;
     uint32_t other_errors;     /* line, port, tx timeout, aborted */

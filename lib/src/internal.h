@@ -1,0 +1,234 @@
+/*
+ * internal.h - what the library's modules share and a user never sees: the default CRC
+ * backend as a direct call, the command checks and the lock command (one copy for the
+ * encoder, the bus and the scheduler), the bus's thread-side lock, and the parser's scan that
+ * leaves a frame where it lies. Not installed; nothing here is API.
+ */
+#ifndef J288_INTERNAL_H
+#define J288_INTERNAL_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <string.h>
+
+#include "j288/bus.h"
+#include "j288/config.h"
+#include "j288/crc32.h"
+#include "j288/frame.h"
+#include "j288/parser.h"
+
+/* Keeps a rarely taken path out of its caller, so that the common path stays short (no
+ * register spills for the slow path's state). Only a hint. */
+#if defined(__GNUC__)
+#define J288_NOINLINE __attribute__((noinline))
+#else
+#define J288_NOINLINE
+#endif
+
+/* A small function on a hot path that has more than one caller: inlined in each (the
+ * compiler would otherwise keep one out-of-line copy and a call). Only a hint. */
+#if defined(__GNUC__)
+#define J288_INLINE_HOT inline __attribute__((always_inline))
+#else
+#define J288_INLINE_HOT inline
+#endif
+
+/* ---- bytes */
+
+/* Store v little-endian at p, any alignment. Where the core stores unaligned words and is
+ * little-endian, this is a 4-byte memcpy, which the compiler turns into one store; elsewhere
+ * byte by byte (the compiler's store merging does not see through the frame's words). */
+#if defined(__BYTE_ORDER__) && defined(__ORDER_LITTLE_ENDIAN__) &&                            \
+    (__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__) &&                                             \
+    (defined(__ARM_FEATURE_UNALIGNED) || defined(__x86_64__) || defined(__i386__) ||           \
+     defined(__aarch64__))
+#define J288_STORE32_AS_WORD 1
+#else
+#define J288_STORE32_AS_WORD 0
+#endif
+
+static inline void j288_store_le32(uint8_t *p, uint32_t v)
+{
+#if J288_STORE32_AS_WORD
+    /* cppcheck-suppress misra-c2012-21.15 ; the bytes of a word into a byte buffer, see above */
+    (void)memcpy(p, &v, sizeof v);
+#else
+    j288_put_u32le(p, v);
+#endif
+}
+
+/* ---- CRC */
+
+#if J288_CONFIG_CRC_BACKEND == J288_CRC_BACKEND_HW
+extern uint32_t J288_CONFIG_CRC_HW_FUNCTION(const uint8_t *data, size_t nwords);
+#endif
+
+/* The compile-time default backend over nwords words, from J288_CRC32_INIT. */
+static inline uint32_t j288_crc_default(const uint8_t *data, size_t nwords)
+{
+#if J288_CONFIG_CRC_BACKEND == J288_CRC_BACKEND_TABLE
+    return j288_crc32_update_table(J288_CRC32_INIT, data, nwords);
+#elif J288_CONFIG_CRC_BACKEND == J288_CRC_BACKEND_SLICE4
+    return j288_crc32_update_slice4(J288_CRC32_INIT, data, nwords);
+#elif J288_CONFIG_CRC_BACKEND == J288_CRC_BACKEND_NIBBLE
+    return j288_crc32_update_nibble(J288_CRC32_INIT, data, nwords);
+#elif J288_CONFIG_CRC_BACKEND == J288_CRC_BACKEND_BITWISE
+    return j288_crc32_update_bitwise(J288_CRC32_INIT, data, nwords);
+#else
+    return J288_CONFIG_CRC_HW_FUNCTION(data, nwords);
+#endif
+}
+
+/* The tables (crc32.c): T0[i] = i * x^32 mod P, Tk[i] = i * x^(32 + 8k) mod P. */
+extern const uint32_t j288_crc_table256[256];
+extern const uint32_t j288_crc_slice1[256];
+extern const uint32_t j288_crc_slice2[256];
+extern const uint32_t j288_crc_slice3[256];
+
+/* One little-endian word into the register, MSB first: XOR it in, then shift the 32 bits out,
+ * a byte at a time through T0, or all four bytes at once through T3..T0 (slicing by 4). */
+static inline uint32_t j288_crc_table_word(uint32_t crc, const uint8_t *p)
+{
+    uint32_t c = crc ^ j288_get_u32le(p);
+    c = (c << 8) ^ j288_crc_table256[c >> 24];
+    c = (c << 8) ^ j288_crc_table256[c >> 24];
+    c = (c << 8) ^ j288_crc_table256[c >> 24];
+    return (c << 8) ^ j288_crc_table256[c >> 24];
+}
+
+static inline uint32_t j288_crc_slice4_word(uint32_t crc, const uint8_t *p)
+{
+    uint32_t c = crc ^ j288_get_u32le(p);
+    return j288_crc_slice3[c >> 24] ^ j288_crc_slice2[(c >> 16) & 0xFFu] ^
+           j288_crc_slice1[(c >> 8) & 0xFFu] ^ j288_crc_table256[c & 0xFFu];
+}
+
+/* One word of the default table backend. */
+#if J288_CONFIG_CRC_BACKEND == J288_CRC_BACKEND_TABLE
+static inline uint32_t j288_crc_frame_word(uint32_t crc, const uint8_t *p)
+{
+    return j288_crc_table_word(crc, p);
+}
+#elif J288_CONFIG_CRC_BACKEND == J288_CRC_BACKEND_SLICE4
+static inline uint32_t j288_crc_frame_word(uint32_t crc, const uint8_t *p)
+{
+    return j288_crc_slice4_word(crc, p);
+}
+#endif
+
+/* The default backend over a frame's CRC'd words (nwords at least 4: a command's 4, a
+ * reply's 5). Frames are checked at the wire's rate: the table backends are unrolled for
+ * a frame's four or five words and inlined where a frame is built or checked in the hot path
+ * (a loop and a call would cost a fifth of a word's work per word). */
+static inline uint32_t j288_crc_frame_unrolled(const uint8_t *data, size_t nwords)
+{
+#if (J288_CONFIG_CRC_BACKEND == J288_CRC_BACKEND_TABLE) ||                                   \
+    (J288_CONFIG_CRC_BACKEND == J288_CRC_BACKEND_SLICE4)
+    uint32_t c = j288_crc_frame_word(J288_CRC32_INIT, data);
+    size_t w;
+    c = j288_crc_frame_word(c, &data[4]);
+    c = j288_crc_frame_word(c, &data[8]);
+    c = j288_crc_frame_word(c, &data[12]);
+    for (w = 4u; w < nwords; w++) {
+        c = j288_crc_frame_word(c, &data[4u * w]);
+    }
+    return c;
+#else
+    return j288_crc_default(data, nwords);
+#endif
+}
+
+/* The same, called (for the paths that are not hot). */
+uint32_t j288_crc_frame_default(const uint8_t *data, size_t nwords);
+
+/* A frame's CRC in the hot path: the run-time engine crc if it has one, else the default
+ * backend inlined. */
+static inline uint32_t j288_crc_frame_hot(const j288_crc_t *crc, const uint8_t *data,
+                                          size_t nwords)
+{
+    if ((crc != NULL) && (crc->fn != NULL)) {
+        return crc->fn(crc->ctx, data, nwords);
+    }
+    return j288_crc_frame_unrolled(data, nwords);
+}
+
+/* A frame's CRC (nwords at least 4): the run-time engine crc if it has one, else the default
+ * backend. j288_crc32_run() for the frame paths. */
+static inline uint32_t j288_crc_frame(const j288_crc_t *crc, const uint8_t *data, size_t nwords)
+{
+    if ((crc != NULL) && (crc->fn != NULL)) {
+        return crc->fn(crc->ctx, data, nwords);
+    }
+    return j288_crc_frame_default(data, nwords);
+}
+
+/* ---- commands */
+
+/* The encoder's checks, in its order: J288_ERR_BAD_ID (id > 15), J288_ERR_BAD_STATUS,
+ * J288_ERR_NEG_GAIN, else J288_OK. */
+static inline int j288_cmd_check(const j288_cmd_raw_t *cmd)
+{
+    if (cmd->id > J288_BROADCAST_ID) {
+        return J288_ERR_BAD_ID;
+    }
+    if (cmd->status > J288_MODE_FOC) {
+        return J288_ERR_BAD_STATUS;
+    }
+    if ((cmd->kp < 0) || (cmd->kd < 0)) {
+        return J288_ERR_NEG_GAIN;
+    }
+    return J288_OK;
+}
+
+/* Lock (no torque), every other field 0: the scheduler's initial and post-estop command, and
+ * with id 15 and the watchdog on, the emergency stop frame. */
+static inline void j288_cmd_lock(j288_cmd_raw_t *c, uint8_t id, bool watchdog)
+{
+    (void)memset(c, 0, sizeof *c);
+    c->id = id;
+    c->status = J288_MODE_LOCK;
+    c->watchdog = watchdog;
+}
+
+/* ---- the bus's thread-side lock (bus.h: with advance_in_isr, thread calls are wrapped in
+ * the port's lock/unlock; from inside an advance the lock is already held or not needed). */
+
+static inline bool j288_bus_needs_lock(const j288_bus_t *bus)
+{
+    return bus->cfg.advance_in_isr && !bus->in_advance && (bus->port->lock != NULL);
+}
+
+static inline void j288_bus_lock(const j288_bus_t *bus)
+{
+    if (j288_bus_needs_lock(bus)) {
+        bus->port->lock(bus->port_ctx);
+    }
+}
+
+static inline void j288_bus_unlock(const j288_bus_t *bus)
+{
+    if (j288_bus_needs_lock(bus)) {
+        bus->port->unlock(bus->port_ctx);
+    }
+}
+
+/* ---- parser */
+
+/* j288_parser_reset() for the bus, which owns its parser: drop a partial frame. */
+static inline void j288_parser_drop(j288_parser_t *p)
+{
+    p->len = 0u;
+}
+
+/*
+ * j288_parser_feed() without the copy: on J288_PARSE_FRAME, *frame points at the good frame,
+ * which is inside data when it arrived whole while the parser was hunting (checked where it
+ * lies), else p->buf. Valid as long as both data and the parser are untouched. Same
+ * statistics, consumption and results as j288_parser_feed(), byte for byte; p, data (unless
+ * len is 0), consumed and frame must not be NULL.
+ */
+int j288_parser_scan(j288_parser_t *p, const uint8_t *data, size_t len, size_t *consumed,
+                     const uint8_t **frame);
+
+#endif /* J288_INTERNAL_H */

@@ -1,0 +1,154 @@
+/*
+ * j288_robot_config.h - the robot config file: buses and joints in YAML, read into a plain struct
+ * and written back in place (host side; needs libyaml, Debian's libyaml-dev).
+ *
+ * The file (every key but a bus's name and port and a joint's name and id is optional):
+ *
+ *   buses:                      # none: the one bus the tool's --port names
+ *     - name: left              # unique
+ *       port: /dev/ttyUSB0      # unique
+ *       baud: 6000000           # line rate
+ *       margin_us: 3000         # reply deadline margin for host latency
+ *       echo: false             # the adapter hears its own transmit
+ *   joints:
+ *     - name: hip               # unique
+ *       bus: left               # needed when there are two buses or more
+ *       id: 1                   # 0-14, unique on its bus
+ *       direction: 1            # 1 or -1 (default 1)
+ *       zero: 0.0               # rad, output-encoder frame: the pose that is joint 0 (default 0)
+ *       limits: [-1.5, 1.5]     # rad, joint frame, min < max, at most 2 pi wide
+ *                               # (default: [-pi, pi), the output encoder angle wrapped)
+ *       max_speed: 6.0          # rad/s, joint frame, above 0
+ *       max_torque: 30.0        # N*m, joint frame, above 0
+ *       kp: 20.0                # N*m/rad, joint frame, 0 or more
+ *       kd: 0.5                 # N*m*s/rad, joint frame, 0 or more
+ *       phase: 2.1              # rotor rad (c in r = N * theta + c); written by calibration
+ *       clamp: false            # true: clamp targets at the limits instead of refusing them
+ *
+ * Reading is strict, so that a typo never silently becomes a default: unknown or repeated
+ * keys, values of the wrong type (numbers must be plain, e.g. 1.5, not "1.5"; booleans are
+ * true or false), names that repeat, an id used twice on one bus, and values out of range are
+ * errors. Every error is one line "FILE:LINE: what is wrong" (LINE counts from 1; syntax
+ * errors name the column too). Aliases (*name) are refused: a value written back must belong
+ * to one joint only.
+ *
+ * Writing back (j288_robot_config_write_joint) changes one joint's zero and/or phase in the file's
+ * own text: an existing value is replaced where it stands; a missing key is added as a line
+ * "key: value" at the end of the joint's block mapping, with its indentation and line ending.
+ * Comments, order, formatting and every other byte are kept. The result is read back and
+ * compared with the original before anything is written (only the changed values may
+ * differ), then replaces the file atomically (a temporary file in the same folder, renamed
+ * over it; the file's permission bits are kept; a symlink is followed, not replaced). A
+ * joint written as a flow mapping ({name: hip, ...}) can have values replaced, not added.
+ *
+ * No allocation by callers: structures are caller-allocated with fixed capacities (the
+ * functions allocate internally for the file's text and libyaml's document, and free it
+ * before they return). Not thread-safe per object; functions are reentrant. When the build
+ * found no libyaml, every function that reads or writes a file fails with a message saying so
+ * (j288_robot_config_available() tells beforehand).
+ */
+#ifndef J288_ROBOT_CONFIG_H
+#define J288_ROBOT_CONFIG_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define J288_ROBOT_CONFIG_MAX_BUSES  16u
+#define J288_ROBOT_CONFIG_MAX_JOINTS 64u
+#define J288_ROBOT_CONFIG_NAME_MAX   32u             /* bytes with the terminating NUL */
+#define J288_ROBOT_CONFIG_PORT_MAX   256u            /* bytes with the terminating NUL */
+#define J288_ROBOT_CONFIG_FILE_MAX   (1024u * 1024u) /* largest file read */
+#define J288_ROBOT_CONFIG_ERROR_MAX  512u            /* holds any message for a name below 200 bytes */
+#define J288_ROBOT_CONFIG_NO_BUS     (-1)            /* joint.bus when the file has no buses */
+
+typedef struct {
+    char name[J288_ROBOT_CONFIG_NAME_MAX];
+    char port[J288_ROBOT_CONFIG_PORT_MAX];
+    bool has_baud;
+    uint32_t baud; /* bit/s, above 0 */
+    bool has_margin_us;
+    uint32_t margin_us;
+    bool has_echo;
+    bool echo;
+    unsigned line; /* where the entry starts in the file */
+} j288_robot_config_bus_t;
+
+/* One joint, defaults filled in (the has_ flags say what the file gave). */
+typedef struct {
+    char name[J288_ROBOT_CONFIG_NAME_MAX];
+    int bus;       /* index into j288_robot_config_t.bus[], or J288_ROBOT_CONFIG_NO_BUS */
+    uint8_t id;    /* 0-14 */
+    int direction; /* +1 or -1 */
+    double zero;   /* rad, output-encoder frame */
+    bool has_limits;
+    double pos_min, pos_max; /* rad, joint frame; default -pi, pi */
+    bool has_max_speed;
+    double max_speed; /* rad/s, joint frame */
+    bool has_max_torque;
+    double max_torque; /* N*m, joint frame */
+    bool has_kp;
+    double kp; /* N*m/rad, joint frame */
+    bool has_kd;
+    double kd; /* N*m*s/rad, joint frame */
+    bool has_phase;
+    double phase; /* rotor rad */
+    bool clamp;
+    unsigned line; /* where the entry starts in the file */
+} j288_robot_config_joint_t;
+
+typedef struct {
+    size_t nbuses;
+    j288_robot_config_bus_t bus[J288_ROBOT_CONFIG_MAX_BUSES];
+    size_t njoints;
+    j288_robot_config_joint_t joint[J288_ROBOT_CONFIG_MAX_JOINTS];
+} j288_robot_config_t;
+
+/* What j288_robot_config_write_joint() changes: the values whose set_ flag is true. */
+typedef struct {
+    bool set_zero;
+    double zero;
+    bool set_phase;
+    double phase;
+} j288_robot_config_update_t;
+
+/* True when the build has libyaml (robot config support). */
+bool j288_robot_config_available(void);
+
+/* Read and check the file at path into *cfg. 0 on success; -1 with a one-line message in err
+ * (errlen bytes, J288_ROBOT_CONFIG_ERROR_MAX is always enough) and *cfg unspecified. */
+int j288_robot_config_load(const char *path, j288_robot_config_t *cfg, char *err, size_t errlen);
+
+/* The same from len bytes of text in memory; name stands for the file in messages. */
+int j288_robot_config_parse(const char *text, size_t len, const char *name, j288_robot_config_t *cfg, char *err,
+                      size_t errlen);
+
+/* The joint called name, or NULL. */
+const j288_robot_config_joint_t *j288_robot_config_find_joint(const j288_robot_config_t *cfg, const char *name);
+
+/* The index of the bus called name, or -1. */
+int j288_robot_config_find_bus(const j288_robot_config_t *cfg, const char *name);
+
+/* Change joint's zero and/or phase in the file at path (see the top of this header). The
+ * values must be finite and within +-1e6. 0 on success; -1 with a message in err, the file
+ * then untouched (an error while replacing it leaves the old file in place). */
+int j288_robot_config_write_joint(const char *path, const char *joint, const j288_robot_config_update_t *upd,
+                            char *err, size_t errlen);
+
+/* The text-level edit behind j288_robot_config_write_joint(): the len bytes of text in, the edited
+ * text in out (outcap bytes: len plus, per key added, the joint's indentation plus 100), its
+ * length in *outlen (out is not NUL-terminated). name stands for the file in messages. Same
+ * checks and results; writes no file. */
+int j288_robot_config_edit(const char *text, size_t len, const char *name, const char *joint,
+                     const j288_robot_config_update_t *upd, char *out, size_t outcap, size_t *outlen,
+                     char *err, size_t errlen);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* J288_ROBOT_CONFIG_H */
