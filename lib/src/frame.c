@@ -56,9 +56,8 @@ static uint32_t pair16(int16_t lo, int16_t hi)
     return (uint32_t)from_i16(lo) | ((uint32_t)from_i16(hi) << 16);
 }
 
-/* The head's two bytes as one little-endian halfword, for a single compare. */
-#define CMD_HEAD16 (J288_CMD_HEAD0 | ((uint32_t)J288_CMD_HEAD1 << 8u))
-#define RPL_HEAD16 (J288_REPLY_HEAD0 | ((uint32_t)J288_REPLY_HEAD1 << 8u))
+#define CMD_HEAD16 J288_CMD_HEAD16
+#define RPL_HEAD16 J288_REPLY_HEAD16
 
 int j288_cmd_encode(const j288_cmd_raw_t *cmd, uint8_t out[J288_CMD_LEN], const j288_crc_t *crc)
 {

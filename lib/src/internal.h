@@ -163,6 +163,25 @@ static inline uint32_t j288_crc_frame(const j288_crc_t *crc, const uint8_t *data
     return j288_crc_frame_default(data, nwords);
 }
 
+/* ---- frames */
+
+/* The head's two bytes as one little-endian halfword, for a single compare. */
+#define J288_CMD_HEAD16 (J288_CMD_HEAD0 | ((uint32_t)J288_CMD_HEAD1 << 8u))
+#define J288_REPLY_HEAD16 (J288_REPLY_HEAD0 | ((uint32_t)J288_REPLY_HEAD1 << 8u))
+
+/* A whole reply's CRC (bytes 2-21) against its field (bytes 22-25), with constant offsets so
+ * that the default table backends unroll to straight-line code. The head is not checked. */
+static J288_INLINE_HOT bool j288_reply_crc_ok(const j288_crc_t *crc, const uint8_t *f)
+{
+    return j288_crc_frame_hot(crc, &f[2], 5u) == j288_get_u32le(&f[22]);
+}
+
+/* The same for a whole command (bytes 0-15, field 16-19). */
+static J288_INLINE_HOT bool j288_cmd_crc_ok(const j288_crc_t *crc, const uint8_t *f)
+{
+    return j288_crc_frame_hot(crc, f, 4u) == j288_get_u32le(&f[16]);
+}
+
 /* ---- commands */
 
 /* The encoder's checks, in its order: J288_ERR_BAD_ID (id > 15), J288_ERR_BAD_STATUS,

@@ -30,11 +30,14 @@ int j288_parser_init(j288_parser_t *p, j288_parse_kind_t kind, const j288_crc_t 
     return J288_OK;
 }
 
-/* The CRC of a whole frame at f against its field, the frame's last four bytes. */
-static inline bool frame_crc_ok(const j288_parser_t *p, const uint8_t *f)
+/* The CRC of a whole frame at f against its field, the frame's last four bytes; one
+ * straight-line check per kind (constant offsets and word counts). */
+J288_NOINLINE static bool frame_crc_ok(const j288_parser_t *p, const uint8_t *f)
 {
-    return j288_crc_frame_hot(p->crc, &f[p->crc_first], p->crc_words) ==
-           j288_get_u32le(&f[p->frame_len - 4u]);
+    if (p->kind == J288_PARSE_REPLY) {
+        return j288_reply_crc_ok(p->crc, f);
+    }
+    return j288_cmd_crc_ok(p->crc, f);
 }
 
 /* The head's two bytes as one little-endian halfword. */
@@ -108,15 +111,21 @@ static bool take_byte(j288_parser_t *p, uint8_t b)
 /* While hunting, a head with a whole frame behind it in the caller's data: checked where it
  * lies. True when good (counted); a bad one is copied into buf and dropped exactly as the byte
  * path drops it once collected. */
+/* A whole frame at f failed its CRC: into buf, dropped as the byte path drops it. */
+static void drop_whole(j288_parser_t *p, const uint8_t *f)
+{
+    (void)memcpy(p->buf, f, p->frame_len);
+    p->len = p->frame_len;
+    drop_frame(p);
+}
+
 static bool take_whole(j288_parser_t *p, const uint8_t *f)
 {
     if (frame_crc_ok(p, f)) {
         p->stats.frames++;
         return true;
     }
-    (void)memcpy(p->buf, f, p->frame_len);
-    p->len = p->frame_len;
-    drop_frame(p);
+    drop_whole(p, f);
     return false;
 }
 
@@ -207,6 +216,15 @@ int j288_parser_scan(j288_parser_t *p, const uint8_t *data, size_t len, size_t *
     return scan(p, data, len, consumed, frame);
 }
 
+/* A reply parser hunting, and data starting with a reply's head and as many bytes: the case of
+ * take_first() that a host sees for nearly every reply, handled in j288_parser_feed() with
+ * the CRC inline. */
+static bool reply_at_start(const j288_parser_t *p, const uint8_t *data, size_t len)
+{
+    return (p->len == 0u) && (p->kind == J288_PARSE_REPLY) && (len >= J288_REPLY_LEN) &&
+           (j288_get_u16le(data) == J288_REPLY_HEAD16);
+}
+
 int j288_parser_feed(j288_parser_t *p, const uint8_t *data, size_t len, size_t *consumed)
 {
     const uint8_t *f = NULL;
@@ -218,7 +236,22 @@ int j288_parser_feed(j288_parser_t *p, const uint8_t *data, size_t len, size_t *
     if ((p == NULL) || (consumed == NULL) || ((data == NULL) && (len != 0u))) {
         return J288_ERR_NULL;
     }
-    rc = scan(p, data, len, consumed, &f);
+    if (reply_at_start(p, data, len)) {
+        /* What scan() does there, with one CRC per frame as there: a good reply is copied
+         * into buf at once; a bad one is dropped as take_whole() drops it, and the scan
+         * goes on behind it. */
+        if (j288_reply_crc_ok(p->crc, data)) {
+            p->stats.frames++;
+            (void)memcpy(p->buf, data, J288_REPLY_LEN);
+            *consumed = J288_REPLY_LEN;
+            return J288_PARSE_FRAME;
+        }
+        drop_whole(p, data);
+        rc = scan(p, &data[J288_REPLY_LEN], len - J288_REPLY_LEN, consumed, &f);
+        *consumed += J288_REPLY_LEN;
+    } else {
+        rc = scan(p, data, len, consumed, &f);
+    }
     if ((rc == J288_PARSE_FRAME) && (f != p->buf)) {
         /* Checked in the caller's data: the parser keeps its own copy (constant lengths, so
          * that the compiler copies words). */
