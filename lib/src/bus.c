@@ -637,6 +637,69 @@ static void advance_from_event(j288_bus_t *bus)
     }
 }
 
+/* ---- the event calls' fast paths (advance_in_isr): the one transition a common event makes,
+ * taken directly when nothing else is pending, so that the machine's general pass (every
+ * event counter, the ring, the parser's hunt) is skipped. Each does exactly what advance()
+ * would do for that event and falls back to it in every other case. */
+
+/* Only the event being handled is new: no other event counter moved, no byte waits. */
+static bool only_this_event(const j288_bus_t *bus, uint32_t tx_done_events)
+{
+    return (bus->ev_tx_done - bus->seen_tx_done == tx_done_events) &&
+           (bus->ev_line == bus->seen_line) && (bus->ev_gone == bus->seen_gone) &&
+           (bus->ring_head == bus->ring_tail) && (bus->direct_len == 0u);
+}
+
+/* Transmit complete, no echo expected, the deadline not passed: wait for the reply. */
+static bool tx_done_fast(j288_bus_t *bus)
+{
+    uint32_t now;
+
+    if ((bus->state != J288_BUS_TX) || bus->cfg.echo || (bus->tx_id == J288_BROADCAST_ID) ||
+        !only_this_event(bus, 1u)) {
+        return false;
+    }
+    now = bus->port->now_us(bus->port_ctx);
+    if (time_reached(now, bus->deadline)) {
+        advance(bus, now);
+        return true;
+    }
+    bus->seen_tx_done = bus->ev_tx_done;
+    bus->tx_complete = true;
+    bus->state = (uint8_t)J288_BUS_WAIT_REPLY;
+    return true;
+}
+
+/* Exactly one reply from the addressed servo, in one piece, while it is awaited: taken as
+ * take_bytes() takes it (the parser's whole-frame case, then take_frame()). Nothing changes
+ * unless it is taken. */
+static bool reply_fast(j288_bus_t *bus, const uint8_t *data, size_t len)
+{
+    uint32_t head = bus->ring_head;
+    uint32_t now;
+
+    if ((len != J288_REPLY_LEN) || (bus->state != J288_BUS_WAIT_REPLY) ||
+        !only_this_event(bus, 0u) || (bus->parser.len != 0u) ||
+        (!bus->cfg.echo && (bus->txdone_mark != head)) ||
+        (j288_get_u16le(data) != J288_REPLY_HEAD16) || ((data[2] & 0x0Fu) != bus->tx_id) ||
+        !j288_reply_crc_ok(&bus->crc, data)) {
+        return false;
+    }
+    now = bus->port->now_us(bus->port_ctx);
+    bus->ring_head = head + J288_REPLY_LEN;
+    bus->ring_tail = head + J288_REPLY_LEN;
+    bus->parser.stats.frames++;
+    bus->in_advance = true;
+    bus->again = false;
+    j288_reply_unpack(data, &bus->txn[bus->cur].reply);
+    end_attempt(bus, J288_OK, now);
+    bus->in_advance = false;
+    if (bus->again) {
+        advance(bus, now); /* what the completion asked for (an estop), as advance() would */
+    }
+    return true;
+}
+
 /* ---- public entry points */
 
 int j288_bus_submit(j288_bus_t *bus, const j288_cmd_raw_t *cmd, uint32_t now_us,
@@ -697,6 +760,9 @@ void j288_bus_on_tx_done(j288_bus_t *bus)
     if (!bus->cfg.echo && (bus->port->start_rx != NULL)) {
         bus->port->start_rx(bus->port_ctx);
     }
+    if (bus->cfg.advance_in_isr && !bus->in_advance && tx_done_fast(bus)) {
+        return;
+    }
     advance_from_event(bus);
 }
 
@@ -716,6 +782,9 @@ void j288_bus_on_rx(j288_bus_t *bus, const uint8_t *data, size_t len)
     if (!bus->cfg.advance_in_isr || bus->in_advance || (head != bus->ring_tail)) {
         ring_put(bus, data, len);
         advance_from_event(bus);
+        return;
+    }
+    if (reply_fast(bus, data, len)) {
         return;
     }
     n = len;
@@ -757,9 +826,10 @@ void j288_bus_on_error(j288_bus_t *bus, uint32_t line_flags)
 
 void j288_bus_on_timer(j288_bus_t *bus)
 {
-    if (bus != NULL) {
-        advance_from_event(bus);
+    if (bus == NULL) {
+        return;
     }
+    advance_from_event(bus);
 }
 
 int j288_bus_estop(j288_bus_t *bus, uint32_t now_us)

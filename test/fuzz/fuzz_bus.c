@@ -8,7 +8,8 @@
  * start_tx, bits 3-4 retries, bit 5 port has arm_timeout, bit 6 the callback submits the next
  * transaction, bit 7 the final drain delivers tx done); byte 1 = turnaround (low nibble) and
  * margin (high nibble), x10 us; byte 2 = baud choice (low 2 bits) and guard_us (high bits);
- * then operations (one byte each, plus the bytes the operation reads).
+ * then operations (one byte each, plus the bytes the operation reads; a reply operation
+ * with bit 4 set hands its frame to on_rx in one call).
  *
  * Every injected reply carries a unique serial number in its pos field, so that a credited
  * reply can be traced back to the moment it was put on the wire. Invariants:
@@ -401,6 +402,13 @@ static void do_op(fuzz_in_t *in)
         s = make_reply(in, ((op & 15u) == 4u) ? current_id() : (uint8_t)(fuzz_u8(in) % 15u), f);
         if (s >= 0) {
             uint8_t chunk = (uint8_t)(fuzz_u8(in) % 27u);
+            if ((op & 0x10u) != 0u) {
+                /* The whole frame in one on_rx call, as a DMA of exactly one reply hands it
+                 * over (with advance_in_isr, the bus's fast path for an awaited reply). */
+                w.serial_done_event[s] = w.event_no;
+                deliver(f, sizeof f, 0u);
+                break;
+            }
             /* All but the last byte, then mark the frame complete, then its last byte (the
              * bus may take it from inside on_rx when it advances in the ISR). */
             deliver(f, sizeof f - 1u, chunk);

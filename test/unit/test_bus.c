@@ -1299,6 +1299,27 @@ static void test_advance_in_isr_with_inline_tx_done(void)
     TEST_ASSERT_EQUAL_INT(0, fp.lock_errors);
 }
 
+/* Advanced in the event calls, with no timer to wake it: a transmit that completes after the
+ * reply deadline ends the attempt there (TIMEOUT), as the general pass of the machine does; a
+ * reply only waits while the deadline is ahead. */
+static void test_isr_tx_done_after_deadline_times_out(void)
+{
+    j288_bus_config_t cfg;
+    j288_cmd_raw_t cmd = lock_cmd(3u);
+    memset(&cfg, 0, sizeof cfg);
+    cfg.advance_in_isr = true;
+    setup_cfg(&cfg);
+    fp.ops.arm_timeout = NULL;
+    fp.poll_fn = NULL;
+    fp.txdone = FAKE_TXDONE_MANUAL;
+    submit_ok(&cmd);
+    fake_port_tx_done_at(&fp, (uint64_t)(BUDGET_US + 1u) * US);
+    fake_port_run_until(&fp, (uint64_t)(BUDGET_US + 2u) * US);
+    TEST_ASSERT_EQUAL_INT(1, cb.calls);
+    TEST_ASSERT_EQUAL_INT(J288_ERR_TIMEOUT, cb.txn.result);
+    TEST_ASSERT_EQUAL_INT(J288_BUS_GUARD, j288_bus_state(&bus));
+}
+
 static void test_failure_ranking(void)
 {
     j288_cmd_raw_t cmd = lock_cmd(3u);
@@ -1855,6 +1876,7 @@ int main(void)
     RUN_TEST(test_estop_merged_into_failing_stop_starts_again);
     RUN_TEST(test_advance_in_isr_chains_without_poll);
     RUN_TEST(test_advance_in_isr_with_inline_tx_done);
+    RUN_TEST(test_isr_tx_done_after_deadline_times_out);
     RUN_TEST(test_failure_ranking);
     RUN_TEST(test_noise_while_idle_is_not_echo);
     RUN_TEST(test_bytes_after_broadcast_in_same_poll);
