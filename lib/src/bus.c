@@ -769,25 +769,16 @@ void j288_bus_on_tx_done(j288_bus_t *bus)
 /* With advance_in_isr, bytes arriving while nothing waits in the ring are taken where they
  * are, during this call, instead of being copied into the ring first: they are given the ring
  * positions they would have had (the ring stays empty, later bytes queue behind them), and
- * what the ring could not have held is lost the same way (rx_overflows). */
-void j288_bus_on_rx(j288_bus_t *bus, const uint8_t *data, size_t len)
+ * what the ring could not have held is lost the same way (rx_overflows). Out of line, so that
+ * the ring path of on_rx stays short. */
+J288_NOINLINE static void take_in_place(j288_bus_t *bus, const uint8_t *data, size_t len)
 {
-    uint32_t head;
-    size_t n;
+    uint32_t head = bus->ring_head;
+    size_t n = len;
 
-    if ((bus == NULL) || (data == NULL) || (len == 0u)) {
-        return;
-    }
-    head = bus->ring_head;
-    if (!bus->cfg.advance_in_isr || bus->in_advance || (head != bus->ring_tail)) {
-        ring_put(bus, data, len);
-        advance_from_event(bus);
-        return;
-    }
     if (reply_fast(bus, data, len)) {
         return;
     }
-    n = len;
     if (n > J288_CONFIG_RX_RING_SIZE) {
         bus->stats.rx_overflows += (uint32_t)(n - J288_CONFIG_RX_RING_SIZE);
         n = J288_CONFIG_RX_RING_SIZE;
@@ -799,6 +790,19 @@ void j288_bus_on_rx(j288_bus_t *bus, const uint8_t *data, size_t len)
     bus->ring_tail = head + (uint32_t)n;
     advance(bus, bus->port->now_us(bus->port_ctx));
     bus->direct = NULL; /* consumed by the advance's first step */
+}
+
+void j288_bus_on_rx(j288_bus_t *bus, const uint8_t *data, size_t len)
+{
+    if ((bus == NULL) || (data == NULL) || (len == 0u)) {
+        return;
+    }
+    if (!bus->cfg.advance_in_isr || bus->in_advance || (bus->ring_head != bus->ring_tail)) {
+        ring_put(bus, data, len);
+        advance_from_event(bus);
+        return;
+    }
+    take_in_place(bus, data, len);
 }
 
 /* Nothing to do: a reply with a pause inside it is heard whole until the deadline, and a
