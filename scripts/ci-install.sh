@@ -23,6 +23,8 @@ packages=(
     qemu-user                       # make test-be / test-32 (qemu-s390x, qemu-arm)
     binutils                        # make check-symbols (nm)
     python3                         # make fuzz-corpus, golden vectors
+    # RISC-V (mk/cpu/rv32imac.mk): test-target and bench-bus-target on RV32 under QEMU
+    gcc-riscv64-unknown-elf picolibc-riscv64-unknown-elf qemu-system-misc
 )
 
 missing=()

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # usage: scripts/run-target.sh CPU:QEMU:MACHINE:MODEL:ELF...
 # `make test-target`: run each test image under its QEMU system emulator (e.g.
-# m0:qemu-system-arm:microbit:cortex-m0:build/target/m0/test_bus.elf) with semihosting. Prints
+# m0:qemu-system-arm:microbit:cortex-m0:build/target/m0/test_bus.elf) with semihosting. QEMU
+# may carry the emulator's own options joined by '+' (qemu-system-riscv32+-bios+none). Prints
 # each image's Unity summary and ends with "N passed, N failed"; the exit status says whether
 # all passed.
 set -u
@@ -9,6 +10,7 @@ per_test_timeout=${TARGET_TIMEOUT:-120}
 passed=0 failed=0 failed_names=()
 for spec in "$@"; do
     IFS=: read -r core qemu machine cpu elf <<<"$spec"
+    IFS=+ read -r -a qemu_cmd <<<"$qemu"
     # An image too big for its board's RAM names the machine it was linked for instead.
     [ -f "$elf.qemu" ] && IFS=: read -r machine cpu <"$elf.qemu"
     name="$core/$(basename "$elf" .elf)"
@@ -19,7 +21,7 @@ for spec in "$@"; do
         continue
     fi
     log=$(mktemp)
-    timeout -k 5 "$per_test_timeout" "$qemu" -M "$machine" -cpu "$cpu" -nographic \
+    timeout -k 5 "$per_test_timeout" "${qemu_cmd[@]}" -M "$machine" -cpu "$cpu" -nographic \
         -monitor none -serial none -semihosting-config enable=on,target=native \
         -kernel "$elf" >"$log" 2>&1
     rc=$?
