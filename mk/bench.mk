@@ -5,8 +5,10 @@
 #                           with valgrind, host instructions per transaction (callgrind)
 #   make bench-codec        host instructions per call of the codec's hot paths (callgrind)
 #   make bench-linux        round trip and sweep rate over the simulator's pty (wall clock)
-#   make bench-target       instructions per codec transaction on Cortex-M4F (QEMU -icount)
-#   make bench-bus-target   instructions per engine transaction on Cortex-M0 and M4F (QEMU)
+#   make bench-target       instructions per codec transaction on Cortex-M4F and RV32 (QEMU
+#                           -icount)
+#   make bench-bus-target   instructions per engine transaction on Cortex-M0, M4F and RV32
+#                           (QEMU)
 .PHONY: bench bench-bus bench-codec bench-linux bench-target bench-bus-target
 bench: bench-bus bench-bus-target
 
@@ -56,36 +58,43 @@ $(BUILD)/bench-target/$(1)_$(5).elf: $(3:%.c=$(BUILD)/bench-target/$(1)_$(5)/obj
 	$(call TC,$(2),CC) $(call TGT_LINK_FLAGS,$(2),SEMIHOST,$(CPU_$(2)_LD)) $$(filter %.o,$$^) -o $$@ -lm
 endef
 
-# The codec per CRC backend on Cortex-M4F, the STM32 port's CRC unit path included.
-BENCH_CODEC_SRC := $(LIB_SRC) port/stm32_hal/j288_stm32.c test/stm32/stub/stm32_hal_stub.c \
-    test/target/bench.c $(call TC,m4f,STARTUP)
-$(foreach o,$(BENCH_OPTS),$(eval $(call BENCH_IMAGE,codec_m4f,m4f,$(BENCH_CODEC_SRC),\
-    -Iport/stm32_hal -Itest/stm32/stub -DJ288_STUB_OMIT_CRC,$(o))))
+# The codec per CRC backend on Cortex-M4F and RV32, the STM32 port's CRC unit path included (its
+# HAL stubbed: the CPU's share).
+BENCH_CODEC_CPUS := m4f rv32
+BENCH_CODEC_SRC = $(LIB_SRC) port/stm32_hal/j288_stm32.c test/stm32/stub/stm32_hal_stub.c \
+    test/target/bench.c $(call TC,$(1),STARTUP)
+$(foreach c,$(BENCH_CODEC_CPUS),$(foreach o,$(BENCH_OPTS),$(eval $(call BENCH_IMAGE,codec_$(c),$(c),\
+    $(call BENCH_CODEC_SRC,$(c)),-Iport/stm32_hal -Itest/stm32/stub -DJ288_STUB_OMIT_CRC,$(o)))))
+
+# The ARM CPUs are required; another toolchain's CPU is skipped with a notice when its tools
+# are missing outside CI (TGT_IF_TC, mk/target.mk).
+BENCH_COMMA := ,
+BENCH_REQUIRE = $(call REQUIRE_TC,$(foreach c,$(1),$(if $(filter arm,$(CPU_$(c)_TOOLCHAIN)),$(c))),QEMU)
 
 bench-target:
-	@$(call REQUIRE_TC,m4f,QEMU); \
-	 $(MAKE) --no-print-directory $(BENCH_OPTS:%=$(BUILD)/bench-target/codec_m4f_%.elf) && \
-	 for o in $(BENCH_OPTS); do \
-	    echo "Cortex-M4F ($(CPU_m4f_QEMU), QEMU -icount shift=0), -$$o:"; \
-	    $(call QEMU_BENCH,m4f,$(BUILD)/bench-target/codec_m4f_$$o.elf) || exit 1; echo; \
-	 done
+	@$(call BENCH_REQUIRE,$(BENCH_CODEC_CPUS)); \
+	 $(foreach c,$(BENCH_CODEC_CPUS),$(call TGT_IF_TC,$(c),\
+	    $(MAKE) --no-print-directory $(BENCH_OPTS:%=$(BUILD)/bench-target/codec_$(c)_%.elf) >/dev/null && \
+	    for o in $(BENCH_OPTS); do \
+	        echo "$(CPU_$(c)_DESC) ($(CPU_$(c)_QEMU)$(BENCH_COMMA) QEMU -icount shift=0)$(BENCH_COMMA) -$$o:"; \
+	        $(call QEMU_BENCH,$(c),$(BUILD)/bench-target/codec_$(c)_$$o.elf) || exit 1; echo; \
+	    done))
 
 # The bus engine and the scheduler, port operations empty, with the default CRC backend (table)
 # and with slicing-by-4 (s4).
-BENCH_BUS_CPUS := m0 m4f
+BENCH_BUS_CPUS := m0 m4f rv32
 BENCH_BUS_CRCS := table s4
 BENCH_BUS_CRC_table :=
 BENCH_BUS_CRC_s4 := -DJ288_CONFIG_CRC_BACKEND=J288_CRC_BACKEND_SLICE4
-BENCH_BUS_ELFS := $(foreach c,$(BENCH_BUS_CPUS),$(foreach v,$(BENCH_BUS_CRCS),\
-    $(BENCH_OPTS:%=$(BUILD)/bench-target/bus_$(c)_$(v)_%.elf)))
 $(foreach c,$(BENCH_BUS_CPUS),$(foreach v,$(BENCH_BUS_CRCS),$(foreach o,$(BENCH_OPTS),$(eval \
     $(call BENCH_IMAGE,bus_$(c)_$(v),$(c),test/bench/bus_target.c $(call TC,$(c),STARTUP) $(LIB_SRC),\
     $(BENCH_BUS_CRC_$(v)),$(o))))))
 
 bench-bus-target:
-	@$(call REQUIRE_TC,$(BENCH_BUS_CPUS),QEMU); \
-	 $(MAKE) --no-print-directory $(BENCH_BUS_ELFS) >/dev/null && \
-	 $(foreach c,$(BENCH_BUS_CPUS),for o in $(BENCH_OPTS); do for v in $(BENCH_BUS_CRCS); do \
-	    echo "Cortex-$(c) -$$o, CRC $$v ($(CPU_$(c)_QEMU), QEMU -icount shift=0), instructions per transaction:"; \
-	    $(call QEMU_BENCH,$(c),$(BUILD)/bench-target/bus_$(c)_$${v}_$$o.elf) || exit 1; \
-	 done; done;)
+	@$(call BENCH_REQUIRE,$(BENCH_BUS_CPUS)); \
+	 $(foreach c,$(BENCH_BUS_CPUS),$(call TGT_IF_TC,$(c),\
+	    $(MAKE) --no-print-directory $(foreach v,$(BENCH_BUS_CRCS),$(BENCH_OPTS:%=$(BUILD)/bench-target/bus_$(c)_$(v)_%.elf)) >/dev/null && \
+	    for o in $(BENCH_OPTS); do for v in $(BENCH_BUS_CRCS); do \
+	        echo "$(CPU_$(c)_DESC) -$$o$(BENCH_COMMA) CRC $$v ($(CPU_$(c)_QEMU)$(BENCH_COMMA) QEMU -icount shift=0)$(BENCH_COMMA) instructions per transaction:"; \
+	        $(call QEMU_BENCH,$(c),$(BUILD)/bench-target/bus_$(c)_$${v}_$$o.elf) || exit 1; \
+	    done; done))

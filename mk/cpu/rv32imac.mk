@@ -3,6 +3,7 @@
 # -misa-spec=2.2 keeps the CSR instructions (the benchmarks read minstret) in the base ISA.
 CPUS += rv32
 CPU_rv32_TOOLCHAIN := riscv
+CPU_rv32_DESC := RV32IMAC
 CPU_rv32_FLAGS := -march=rv32imac -misa-spec=2.2 -mabi=ilp32 --specs=picolibc.specs
 CPU_rv32_DEFS :=
 # QEMU's generic virt board, its RV32 core; RAM from 0x80000000 (test/target/mem_virt_rv32.ld).

@@ -1,8 +1,9 @@
 /*
- * Engine cost on Cortex-M: instructions per transaction through the library, side by side
- * with a hand-written floor doing the same work, counted under QEMU -icount shift=0 (one
- * instruction per ns) by reading SysTick around ITERATIONS transactions. The ticks-to-
- * instructions factor is measured in the same run on a loop of known length.
+ * Engine cost on Cortex-M and RISC-V: instructions per transaction through the library, side
+ * by side with a hand-written floor doing the same work, counted under QEMU -icount shift=0
+ * (one instruction per ns) by reading SysTick (or minstret) around ITERATIONS transactions
+ * (test/target/icount.h). The ticks-to-instructions factor is measured in the same run on a
+ * loop of known length.
  *
  * Library rows: the codec alone (encode, parse, unpack: what any engine pays), the same with
  * a CRC unit behind a port's crc32 op, the bus in poll mode (submit, tx done, 26 bytes, idle,
@@ -19,9 +20,7 @@
 #include <stdio.h>
 #include <string.h>
 
-#define SYST_CSR (*(volatile uint32_t *)0xE000E010u)
-#define SYST_RVR (*(volatile uint32_t *)0xE000E014u)
-#define SYST_CVR (*(volatile uint32_t *)0xE000E018u)
+#include "../target/icount.h"
 
 #ifndef ITERATIONS
 #define ITERATIONS 300u
@@ -41,34 +40,6 @@ static uint32_t done_expected;
 static j288_bus_t bus;
 static j288_sched_t sch;
 static uint8_t replies[J288_MAX_SERVOS][J288_REPLY_LEN];
-
-static void systick_start(void)
-{
-    SYST_CSR = 0u;
-    SYST_RVR = 0x00FFFFFFu;
-    SYST_CVR = 0u;
-    SYST_CSR = 5u; /* enable, processor clock, no interrupt */
-}
-
-static uint32_t systick_now(void)
-{
-    return SYST_CVR;
-}
-static uint32_t ticks_between(uint32_t a, uint32_t b)
-{
-    return (a - b) & 0x00FFFFFFu;
-}
-
-/* Instructions per SysTick tick, x1000, from a two-instruction loop. */
-static uint32_t calibrate(void)
-{
-    uint32_t n = CAL_LOOPS;
-    uint32_t t0, t1;
-    t0 = systick_now();
-    __asm volatile(".syntax unified\n1: subs %0, %0, #1\n\tbne 1b" : "+l"(n) : : "cc");
-    t1 = systick_now();
-    return (uint32_t)((2ull * CAL_LOOPS * 1000u) / ticks_between(t0, t1));
-}
 
 static uint32_t per_txn(uint32_t ticks, uint32_t ipt_milli)
 {
@@ -380,7 +351,7 @@ static uint32_t run_floor_codec(bool with_unit)
     uint32_t frame[5];
     uint32_t i, t0, t1;
     unit_next = 0u;
-    t0 = systick_now();
+    t0 = icount_now();
     for (i = 0u; i < ITERATIONS; i++) {
         if (with_unit) {
             (void)floor_encode_unit(&cmd, frame);
@@ -394,9 +365,9 @@ static uint32_t run_floor_codec(bool with_unit)
             }
         }
     }
-    t1 = systick_now();
+    t1 = icount_now();
     done_expected += ITERATIONS;
-    return ticks_between(t0, t1);
+    return icount_between(t0, t1);
 }
 
 static uint32_t run_floor_engine(void)
@@ -412,16 +383,16 @@ static uint32_t run_floor_engine(void)
     floor_next(clock_us);
     clock_us += 2u;
     floor_on_timer();
-    t0 = systick_now();
+    t0 = icount_now();
     for (i = 0u; i < ITERATIONS; i++) {
         floor_on_tx_done();
         floor_on_rx(floor_replies[last_id], J288_REPLY_LEN);
         clock_us += 90u;
         floor_on_timer(); /* the guard ends: the next command starts */
     }
-    t1 = systick_now();
+    t1 = icount_now();
     done_expected += ITERATIONS;
-    return ticks_between(t0, t1);
+    return icount_between(t0, t1);
 }
 
 static uint32_t run_codec(const j288_crc_t *crc)
@@ -433,7 +404,7 @@ static uint32_t run_codec(const j288_crc_t *crc)
     uint32_t i, t0, t1;
     (void)j288_parser_init(&parser, J288_PARSE_REPLY, crc);
     unit_next = 0u;
-    t0 = systick_now();
+    t0 = icount_now();
     for (i = 0u; i < ITERATIONS; i++) {
         size_t used;
         (void)j288_cmd_encode(&cmd, frame, crc);
@@ -442,9 +413,9 @@ static uint32_t run_codec(const j288_crc_t *crc)
             done_count++;
         }
     }
-    t1 = systick_now();
+    t1 = icount_now();
     done_expected += ITERATIONS;
-    return ticks_between(t0, t1);
+    return icount_between(t0, t1);
 }
 
 static uint32_t run_bus_poll(void)
@@ -452,7 +423,7 @@ static uint32_t run_bus_poll(void)
     j288_cmd_raw_t cmd = bench_cmd();
     uint32_t i, t0, t1;
     (void)j288_bus_init(&bus, &port, NULL, NULL);
-    t0 = systick_now();
+    t0 = icount_now();
     for (i = 0u; i < ITERATIONS; i++) {
         (void)j288_bus_submit(&bus, &cmd, clock_us, on_done, NULL);
         j288_bus_on_tx_done(&bus);
@@ -463,9 +434,9 @@ static uint32_t run_bus_poll(void)
         clock_us += 10u;
         j288_bus_poll(&bus, clock_us); /* the guard ends */
     }
-    t1 = systick_now();
+    t1 = icount_now();
     done_expected += ITERATIONS;
-    return ticks_between(t0, t1);
+    return icount_between(t0, t1);
 }
 
 static uint32_t run_sched_isr(void)
@@ -488,7 +459,7 @@ static uint32_t run_sched_isr(void)
     }
     (void)j288_sched_start_sweep(&sch, clock_us);
     before = sch.slot[14].stats.successes;
-    t0 = systick_now();
+    t0 = icount_now();
     for (i = 0u; i < ITERATIONS; i++) {
         j288_bus_on_tx_done(&bus);
         j288_bus_on_rx(&bus, replies[last_id], J288_REPLY_LEN);
@@ -497,11 +468,11 @@ static uint32_t run_sched_isr(void)
         clock_us += 2u;
         j288_bus_on_timer(&bus); /* the guard ends: the next command starts */
     }
-    t1 = systick_now();
+    t1 = icount_now();
     if (sch.slot[14].stats.successes - before != ITERATIONS / J288_MAX_SERVOS) {
         done_count = 0u; /* not every transaction succeeded */
     }
-    return ticks_between(t0, t1);
+    return icount_between(t0, t1);
 }
 
 #if J288_CONFIG_SI
@@ -525,15 +496,15 @@ static uint32_t run_joint_reply(void)
     for (i = 0u; i < J288_JOINT_DEFAULT_INIT_SAMPLES; i++) {
         (void)j288_joint_take_reply(&joint, &r, NULL);
     }
-    t0 = systick_now();
+    t0 = icount_now();
     for (i = 0u; i < ITERATIONS; i++) {
         unsigned ev;
         r.pos = 5000 + (int32_t)(i & 7u);
         joint_errors += (uint32_t)(j288_joint_take_reply(&joint, &r, &ev) != J288_OK);
     }
-    t1 = systick_now();
+    t1 = icount_now();
     joint_errors += (uint32_t)!j288_joint_state(&joint)->known;
-    return ticks_between(t0, t1);
+    return icount_between(t0, t1);
 }
 
 static uint32_t run_joint_command(void)
@@ -544,13 +515,13 @@ static uint32_t run_joint_command(void)
     j288_joint_target_init(&joint, &t);
     t.kp = (j288_real_t)20;
     t.kd = (j288_real_t)0.5;
-    t0 = systick_now();
+    t0 = icount_now();
     for (i = 0u; i < ITERATIONS; i++) {
         t.pos = (j288_real_t)(i & 7u) * (j288_real_t)0.01;
         joint_errors += (uint32_t)(j288_joint_command(&joint, &t, &cmd, NULL) != J288_OK);
     }
-    t1 = systick_now();
-    return ticks_between(t0, t1);
+    t1 = icount_now();
+    return icount_between(t0, t1);
 }
 #endif
 
@@ -601,8 +572,8 @@ int main(void)
         unit_answer[1] = j288_frame_crc_field(replies[3], J288_REPLY_LEN);
     }
     floor_tables();
-    systick_start();
-    ipt = calibrate();
+    icount_start();
+    ipt = icount_calibrate(CAL_LOOPS);
     f_codec = per_txn(RUN_ROW(1u, run_floor_codec(false)), ipt);
     f_unit = per_txn(RUN_ROW(1u, run_floor_codec(true)), ipt);
     f_engine = per_txn(RUN_ROW(1u, run_floor_engine()), ipt);

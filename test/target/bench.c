@@ -1,9 +1,10 @@
 /*
- * Instructions per host-side transaction on Cortex-M under QEMU (-icount shift=0): encode a
+ * Instructions per host-side transaction on Cortex-M and RISC-V under QEMU (-icount shift=0): encode a
  * command (with its CRC), feed the 26-byte reply through the parser (CRC check), decode it.
  * One run measures every CRC backend side by side, against the manual's bitwise crc32_core as
- * the baseline. SysTick counts processor clocks; with -icount shift=0 each instruction takes
- * 1 ns, and the factor from ticks to instructions is measured first on a loop of known length.
+ * the baseline. SysTick counts processor clocks (RISC-V: minstret counts instructions); with
+ * -icount shift=0 each instruction takes 1 ns, and the factor from ticks to instructions is
+ * measured first on a loop of known length (icount.h).
  *
  * The "hw" row is the CPU's share of the CRC unit path (j288_stm32_crc32: word assembly, the
  * lock, the HAL call writing each word to DR); QEMU has no STM32 CRC unit, so the unit's
@@ -13,12 +14,10 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "icount.h"
 #include "j288/j288.h"
 #include "j288_stm32.h"
 
-#define SYST_CSR (*(volatile uint32_t *)0xE000E010u)
-#define SYST_RVR (*(volatile uint32_t *)0xE000E014u)
-#define SYST_CVR (*(volatile uint32_t *)0xE000E018u)
 #define ITERATIONS 500u
 
 /* The spec's worked frames. */
@@ -27,17 +26,6 @@ static const uint8_t k_reply3[J288_REPLY_LEN] = {
     0x00, 0x00, 0x00, 0x00, 0x00, 0xe8, 0x03, 0x00, 0x00, 0x49, 0xc2, 0x3b, 0xee};
 #define CMD_CRC 0x3f304ba6u
 #define REPLY_CRC 0xee3bc249u
-
-static void systick_start(void)
-{
-    SYST_CSR = 0u;
-    SYST_RVR = 0x00FFFFFFu;
-    SYST_CVR = 0u;
-    SYST_CSR = 5u; /* enable, processor clock, no interrupt */
-}
-
-static uint32_t systick_now(void) { return SYST_CVR; }
-static uint32_t ticks_between(uint32_t a, uint32_t b) { return (a - b) & 0x00FFFFFFu; }
 
 /* ---- backends ---------------------------------------------------------------------------- */
 
@@ -112,13 +100,12 @@ static volatile uint32_t sink;
 
 static uint32_t calibrate(void)
 {
-    uint32_t n = 100000u, t0, t1;
-    systick_start();
-    t0 = systick_now();
-    /* 2 instructions per iteration (subs, bne) */
-    __asm volatile("1: subs %0, %0, #1\n\tbne 1b" : "+r"(n) : : "cc");
-    t1 = systick_now();
-    return ticks_between(t0, t1);
+    uint32_t t0, t1;
+    icount_start();
+    t0 = icount_now();
+    icount_loop(100000u); /* 2 instructions per iteration */
+    t1 = icount_now();
+    return icount_between(t0, t1);
 }
 
 static int one_transaction(const j288_crc_t *crc, j288_parser_t *p)
@@ -151,13 +138,13 @@ static uint32_t measure(const j288_crc_t *crc, int *err)
     uint32_t t0, t1;
     (void)j288_parser_init(&p, J288_PARSE_REPLY, crc);
     *err = 0;
-    systick_start();
-    t0 = systick_now();
+    icount_start();
+    t0 = icount_now();
     for (uint32_t i = 0; i < ITERATIONS; i++) {
         *err |= one_transaction(crc, &p);
     }
-    t1 = systick_now();
-    return ticks_between(t0, t1);
+    t1 = icount_now();
+    return icount_between(t0, t1);
 }
 
 /* The CRC alone: one command (4 words) and one reply (5 words), as a transaction needs. */
@@ -167,15 +154,15 @@ static uint32_t measure_crc_only(const j288_crc_t *crc)
                                               0x00, 0x5f, 0x14, 0x00, 0x00, 0x00, 0x05,
                                               0x00, 0x32, 0xa6, 0x4b, 0x30, 0x3f};
     uint32_t t0, t1, acc = 0;
-    systick_start();
-    t0 = systick_now();
+    icount_start();
+    t0 = icount_now();
     for (uint32_t i = 0; i < ITERATIONS; i++) {
         acc += crc->fn(crc->ctx, cmd, 4u);
         acc += crc->fn(crc->ctx, &k_reply3[2], 5u);
     }
-    t1 = systick_now();
+    t1 = icount_now();
     sink = acc;
-    return ticks_between(t0, t1);
+    return icount_between(t0, t1);
 }
 
 static uint32_t per_iteration(uint32_t ticks, uint64_t ipt_milli)
@@ -201,7 +188,7 @@ int main(void)
     uint32_t base = 0;
     int failed = 0;
 
-    printf("bench: %u transactions per backend; %lu.%03lu instructions per SysTick tick\n",
+    printf("bench: %u transactions per backend; %lu.%03lu instructions per counter tick\n",
            (unsigned)ITERATIONS, (unsigned long)(ipt_milli / 1000u), (unsigned long)(ipt_milli % 1000u));
     printf("| CRC backend | instructions per transaction | vs baseline | CRC alone (4 + 5 words) |\n");
     printf("|---|---:|---:|---:|\n");
