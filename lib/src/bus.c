@@ -671,12 +671,13 @@ static bool tx_done_fast(j288_bus_t *bus)
 }
 
 /* Exactly one reply from the addressed servo, in one piece, while it is awaited: taken as
- * take_bytes() takes it (the parser's whole-frame case, then take_frame()). Nothing changes
- * unless it is taken. */
-static bool reply_fast(j288_bus_t *bus, const uint8_t *data, size_t len)
+ * take_bytes() takes it (the parser's whole-frame case, then take_frame()), inside the
+ * machine (in_advance: a submit from the completion only queues). Nothing changes unless it
+ * is taken; then *now is the time it was taken at. */
+J288_NOINLINE static bool reply_fast(j288_bus_t *bus, const uint8_t *data, size_t len,
+                                     uint32_t *now)
 {
     uint32_t head = bus->ring_head;
-    uint32_t now;
 
     if ((len != J288_REPLY_LEN) || (bus->state != J288_BUS_WAIT_REPLY) ||
         !only_this_event(bus, 0u) || (bus->parser.len != 0u) ||
@@ -685,18 +686,15 @@ static bool reply_fast(j288_bus_t *bus, const uint8_t *data, size_t len)
         !j288_reply_crc_ok(&bus->crc, data)) {
         return false;
     }
-    now = bus->port->now_us(bus->port_ctx);
+    *now = bus->port->now_us(bus->port_ctx);
     bus->ring_head = head + J288_REPLY_LEN;
     bus->ring_tail = head + J288_REPLY_LEN;
     bus->parser.stats.frames++;
     bus->in_advance = true;
     bus->again = false;
     j288_reply_unpack(data, &bus->txn[bus->cur].reply);
-    end_attempt(bus, J288_OK, now);
+    end_attempt(bus, J288_OK, *now);
     bus->in_advance = false;
-    if (bus->again) {
-        advance(bus, now); /* what the completion asked for (an estop), as advance() would */
-    }
     return true;
 }
 
@@ -775,8 +773,12 @@ J288_NOINLINE static void take_in_place(j288_bus_t *bus, const uint8_t *data, si
 {
     uint32_t head = bus->ring_head;
     size_t n = len;
+    uint32_t now;
 
-    if (reply_fast(bus, data, len)) {
+    if (reply_fast(bus, data, len, &now)) {
+        if (bus->again) {
+            advance(bus, now); /* what the completion asked for (an estop), as advance() would */
+        }
         return;
     }
     if (n > J288_CONFIG_RX_RING_SIZE) {

@@ -75,7 +75,7 @@ def parse_ci(root):
 # The bus's step loop: entered again from inside a port call (op_start_rx -> rx_arm ->
 # j288_bus_on_error -> advance_from_event -> advance), it returns at once (in_advance), so on a
 # path that is already inside it only its own frame counts.
-REENTRY_GUARD = re.compile(r"lib/src/bus\.c:advance(\.\w+)*$")
+REENTRY_GUARD = re.compile(r"lib/src/bus\.c:(advance|reply_fast)(\.\w+)*$")
 # Indirect calls that go to the application (its clock, its event callback): on top, like the
 # completion callbacks.
 # What each indirect call site in the library calls, read from the source: port operations
@@ -92,13 +92,16 @@ INDIRECT_SITES = [
     (r"(bus|sched)\.c:j288_bus_unlock", ["unlock"]),
     (r"bus\.c:start_attempt", ["set_dir", "start_tx", "start_rx", "now_us"]),
     (r"bus\.c:advance_from_event", ["now_us"]),
-    (r"^j288_bus_on_tx_done", ["set_dir", "start_rx"]),
+    (r"bus\.c:(take_in_place|tx_done_fast)", ["now_us"]),
+    (r"bus\.c:reply_fast", ["now_us", "crc32"]),
+    (r"^j288_bus_on_tx_done", ["set_dir", "start_rx", "now_us"]),
     (r"^j288_bus_on_rx", ["now_us"]),
     (r"^j288_bus_transfer_blocking", ["wait", "now_us", "lock", "unlock"]),
     (r"^j288_crc32_run", ["crc32"]),
     (r"^j288_cmd_encode", ["crc32"]),
     (r"frame\.c:j288_crc_frame", ["crc32"]),
     (r"parser\.c:frame_crc_ok", ["crc32"]),
+    (r"(parser|bus|frame)\.c:j288_crc_frame_hot", ["crc32"]),
     (r"sched\.c:(next_slot|sched_lock|sched_unlock)", ["lock", "unlock"]),
     (r"sched\.c:(emit|sched_done|take_reply)", ["app"]),
     (r"^j288_joint_bus_on_reply|joint\.c:report", ["app"]),  # on_event
@@ -160,7 +163,10 @@ def stack_depths(nodes, edges):
         if kind != "static":
             notes.add(n.split(":")[-1] + " has " + kind + " stack")
         path.append((n, guarded))
-        inner = guarded or bool(REENTRY_GUARD.search(n))
+        # (The compiler may split the step loop into a wrapper and its .part clone: the guard
+        # turns on in the part that runs the loop, not in a wrapper calling it.)
+        inner = guarded or (bool(REENTRY_GUARD.search(n)) and
+                            not any(REENTRY_GUARD.search(t) for t in edges.get(n, ())))
         deepest, clean = 0, True
         for t in targets(n):
             d, c = depth(t, inner, path)
