@@ -768,19 +768,12 @@ void j288_bus_on_tx_done(j288_bus_t *bus)
  * are, during this call, instead of being copied into the ring first: they are given the ring
  * positions they would have had (the ring stays empty, later bytes queue behind them), and
  * what the ring could not have held is lost the same way (rx_overflows). Out of line, so that
- * the ring path of on_rx stays short. */
+ * the ring path of on_rx stays short; a whole awaited reply goes to reply_fast() first. */
 J288_NOINLINE static void take_in_place(j288_bus_t *bus, const uint8_t *data, size_t len)
 {
     uint32_t head = bus->ring_head;
     size_t n = len;
-    uint32_t now;
 
-    if (reply_fast(bus, data, len, &now)) {
-        if (bus->again) {
-            advance(bus, now); /* what the completion asked for (an estop), as advance() would */
-        }
-        return;
-    }
     if (n > J288_CONFIG_RX_RING_SIZE) {
         bus->stats.rx_overflows += (uint32_t)(n - J288_CONFIG_RX_RING_SIZE);
         n = J288_CONFIG_RX_RING_SIZE;
@@ -796,12 +789,20 @@ J288_NOINLINE static void take_in_place(j288_bus_t *bus, const uint8_t *data, si
 
 void j288_bus_on_rx(j288_bus_t *bus, const uint8_t *data, size_t len)
 {
+    uint32_t now;
+
     if ((bus == NULL) || (data == NULL) || (len == 0u)) {
         return;
     }
     if (!bus->cfg.advance_in_isr || bus->in_advance || (bus->ring_head != bus->ring_tail)) {
         ring_put(bus, data, len);
         advance_from_event(bus);
+        return;
+    }
+    if (reply_fast(bus, data, len, &now)) {
+        if (bus->again) {
+            advance(bus, now); /* what the completion asked for (an estop), as advance() would */
+        }
         return;
     }
     take_in_place(bus, data, len);
