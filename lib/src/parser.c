@@ -225,6 +225,25 @@ static bool reply_at_start(const j288_parser_t *p, const uint8_t *data, size_t l
            (j288_get_u16le(data) == J288_REPLY_HEAD16);
 }
 
+/* j288_parser_feed() when a reply at the start of data failed its CRC: what scan() does
+ * there, with one CRC per frame as there: the frame is dropped as take_whole() drops it, and
+ * the scan goes on behind it. (The good case is checked inline in j288_parser_feed(); this
+ * rare one stays out of line.) */
+J288_NOINLINE static int feed_after_bad_reply(j288_parser_t *p, const uint8_t *data, size_t len,
+                                              size_t *consumed)
+{
+    const uint8_t *f = NULL;
+    int rc;
+
+    drop_whole(p, data);
+    rc = scan(p, &data[J288_REPLY_LEN], len - J288_REPLY_LEN, consumed, &f);
+    *consumed += J288_REPLY_LEN;
+    if ((rc == J288_PARSE_FRAME) && (f != p->buf)) {
+        (void)memcpy(p->buf, f, J288_REPLY_LEN); /* a reply parser: checked where it lies */
+    }
+    return rc;
+}
+
 int j288_parser_feed(j288_parser_t *p, const uint8_t *data, size_t len, size_t *consumed)
 {
     const uint8_t *f = NULL;
@@ -237,21 +256,15 @@ int j288_parser_feed(j288_parser_t *p, const uint8_t *data, size_t len, size_t *
         return J288_ERR_NULL;
     }
     if (reply_at_start(p, data, len)) {
-        /* What scan() does there, with one CRC per frame as there: a good reply is copied
-         * into buf at once; a bad one is dropped as take_whole() drops it, and the scan
-         * goes on behind it. */
         if (j288_reply_crc_ok(p->crc, data)) {
             p->stats.frames++;
             (void)memcpy(p->buf, data, J288_REPLY_LEN);
             *consumed = J288_REPLY_LEN;
             return J288_PARSE_FRAME;
         }
-        drop_whole(p, data);
-        rc = scan(p, &data[J288_REPLY_LEN], len - J288_REPLY_LEN, consumed, &f);
-        *consumed += J288_REPLY_LEN;
-    } else {
-        rc = scan(p, data, len, consumed, &f);
+        return feed_after_bad_reply(p, data, len, consumed);
     }
+    rc = scan(p, data, len, consumed, &f);
     if ((rc == J288_PARSE_FRAME) && (f != p->buf)) {
         /* Checked in the caller's data: the parser keeps its own copy (constant lengths, so
          * that the compiler copies words). */
