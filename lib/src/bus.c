@@ -645,7 +645,7 @@ static void advance_from_event(j288_bus_t *bus)
 /* Only the event being handled is new: no other event counter moved, no byte waits. */
 static bool only_this_event(const j288_bus_t *bus, uint32_t tx_done_events)
 {
-    return (bus->ev_tx_done - bus->seen_tx_done == tx_done_events) &&
+    return ((bus->ev_tx_done - bus->seen_tx_done) == tx_done_events) &&
            (bus->ev_line == bus->seen_line) && (bus->ev_gone == bus->seen_gone) &&
            (bus->ring_head == bus->ring_tail) && (bus->direct_len == 0u);
 }
@@ -655,8 +655,8 @@ static bool tx_done_fast(j288_bus_t *bus)
 {
     uint32_t now;
 
-    if ((bus->state != J288_BUS_TX) || bus->cfg.echo || (bus->tx_id == J288_BROADCAST_ID) ||
-        !only_this_event(bus, 1u)) {
+    if ((bus->state != (uint8_t)J288_BUS_TX) || bus->cfg.echo ||
+        (bus->tx_id == J288_BROADCAST_ID) || !only_this_event(bus, 1u)) {
         return false;
     }
     now = bus->port->now_us(bus->port_ctx);
@@ -679,7 +679,7 @@ J288_NOINLINE static bool reply_fast(j288_bus_t *bus, const uint8_t *data, size_
 {
     uint32_t head = bus->ring_head;
 
-    if ((len != J288_REPLY_LEN) || (bus->state != J288_BUS_WAIT_REPLY) ||
+    if ((len != J288_REPLY_LEN) || (bus->state != (uint8_t)J288_BUS_WAIT_REPLY) ||
         !only_this_event(bus, 0u) || (bus->parser.len != 0u) ||
         (!bus->cfg.echo && (bus->txdone_mark != head)) ||
         (j288_get_u16le(data) != J288_REPLY_HEAD16) || ((data[2] & 0x0Fu) != bus->tx_id) ||

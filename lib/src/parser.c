@@ -168,7 +168,8 @@ J288_NOINLINE static size_t scan_bytes(j288_parser_t *p, const uint8_t *data, si
 /* The common case: nothing held and data starting with a whole frame, as a frame received in
  * one piece arrives. Returns the bytes taken (the frame, good or dropped; *good tells), or 0
  * when data does not start that way. */
-static J288_INLINE_HOT size_t take_first(j288_parser_t *p, const uint8_t *data, size_t len, bool *good)
+static J288_INLINE_HOT size_t take_first(j288_parser_t *p, const uint8_t *data, size_t len,
+                                         bool *good)
 {
     *good = false;
     /* (A frame is at least a command long: data holds two bytes to read.) */
