@@ -13,6 +13,8 @@ TC_arm_SIZE := arm-none-eabi-size
 TC_arm_PACKAGES := gcc-arm-none-eabi libnewlib-arm-none-eabi
 TC_arm_QEMU := qemu-system-arm
 TC_arm_QEMU_PACKAGES := qemu-system-arm
+# Options of the toolchain's QEMU before the machine's own (none here; RISC-V: -bios none).
+TC_arm_QEMU_FLAGS :=
 # The vector table and reset code of the images run under QEMU (tests, benchmarks).
 TC_arm_STARTUP := test/target/startup.c
 # Images that print through semihosting (tests, benchmarks), and images with no I/O.
