@@ -360,6 +360,24 @@ static void test_corrupted_frame(void)
     }
 }
 
+/* A corrupted reply at the start of a feed and a good one behind it, in one call: the first is
+ * dropped (one CRC error), the second comes out of the same call as the parser's own copy. */
+static void test_corrupted_then_good_in_one_feed(void)
+{
+    j288_parser_t p;
+    uint8_t buf[2 * J288_REPLY_LEN];
+    size_t used = 0u;
+    memcpy(buf, plain_reply(), J288_REPLY_LEN);
+    buf[10] = (uint8_t)(buf[10] ^ 0x01u);
+    memcpy(buf + J288_REPLY_LEN, golden_replies[9].frame, J288_REPLY_LEN);
+    j288_parser_init(&p, J288_PARSE_REPLY, NULL);
+    TEST_ASSERT_EQUAL_INT(J288_PARSE_FRAME, j288_parser_feed(&p, buf, sizeof buf, &used));
+    TEST_ASSERT_EQUAL_UINT(sizeof buf, used);
+    memset(buf, 0, sizeof buf); /* the frame must not point into the caller's data */
+    TEST_ASSERT_EQUAL_HEX8_ARRAY(golden_replies[9].frame, j288_parser_frame(&p), J288_REPLY_LEN);
+    assert_stats(&p, 1, 0, 1, 0, J288_REPLY_LEN);
+}
+
 /* A payload holding FC EE: intact it is one frame; with its real head lost, the parser locks
  * on the false head, fails the CRC, and still finds the next real frame. */
 static void test_false_head_inside_payload(void)
@@ -512,6 +530,7 @@ int main(void)
     RUN_TEST(test_truncated_then_flush);
     RUN_TEST(test_truncated_then_frame_without_flush);
     RUN_TEST(test_corrupted_frame);
+    RUN_TEST(test_corrupted_then_good_in_one_feed);
     RUN_TEST(test_false_head_inside_payload);
     RUN_TEST(test_false_head_inside_command);
     RUN_TEST(test_reset);
