@@ -833,10 +833,9 @@ void j288_bus_on_error(j288_bus_t *bus, uint32_t line_flags)
 
 void j288_bus_on_timer(j288_bus_t *bus)
 {
-    if (bus == NULL) {
-        return;
+    if (bus != NULL) {
+        advance_from_event(bus);
     }
-    advance_from_event(bus);
 }
 
 int j288_bus_estop(j288_bus_t *bus, uint32_t now_us)
