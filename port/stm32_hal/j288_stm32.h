@@ -156,6 +156,8 @@ typedef struct {
     uint32_t rx_bytes;     /* bytes handed to the bus */
     uint32_t line_errors;  /* error callbacks */
     uint32_t hal_failures; /* HAL calls that did not return HAL_OK */
+    uint32_t dma_resets;   /* transfers found still running from an earlier transaction and
+                              aborted before the next (a lost TX complete or DMA interrupt) */
     uint32_t timer_events; /* compare interrupts taken (timer_rearms included) */
     uint32_t timer_rearms; /* of those, early ones (before the deadline): re-armed for the
                               rest, the bus not called */
@@ -165,9 +167,11 @@ typedef struct {
  * registered. Private: use the functions below. */
 typedef struct j288_stm32 {
     j288_bus_t bus;
+    j288_port_t ops; /* the port's operations, as this configuration uses them */
     j288_stm32_config_t cfg;
     volatile uint16_t rx_pos;  /* bytes of the current reception already handed out */
     volatile uint8_t dir;      /* j288_dir_t last set */
+    volatile bool tx_refused;  /* the turn to transmit failed: start_tx refuses */
     uint32_t lock_saved;
     volatile uint32_t tim_deadline; /* last arm_timeout deadline (now_us clock) */
     j288_stm32_stats_t stats;
