@@ -6,12 +6,10 @@
 #ifndef J288_EXAMPLE_BOARD_H
 #define J288_EXAMPLE_BOARD_H
 
+#include <stdbool.h>
 #include <stdint.h>
 
 #include "main.h"
-
-#define ESTOP_GPIO_PORT GPIOC
-#define ESTOP_PIN ((uint16_t)0x2000u) /* PC13: the NUCLEO's blue button B1, low when pressed */
 
 extern UART_HandleTypeDef huart1;
 extern DMA_HandleTypeDef hdma_usart1_tx;
@@ -29,6 +27,8 @@ extern volatile board_fault_t board_fault;
 
 /* Clocks, pins, DMA, NVIC, UART, timer, CRC unit; board_fatal() on any failure. */
 void board_init(void);
+/* The emergency-stop button (the NUCLEO's blue button B1 on PC13) is pressed. */
+bool board_estop_pressed(void);
 /* Interrupts off, stop here (the servos lock themselves after their 1 s watchdog). */
 void board_fatal(void);
 

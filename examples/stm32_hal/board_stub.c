@@ -70,6 +70,11 @@ void board_init(void)
 
 volatile board_fault_t board_fault;
 
+bool board_estop_pressed(void)
+{
+    return HAL_GPIO_ReadPin(GPIOC, (uint16_t)0x2000u) == GPIO_PIN_RESET; /* PC13 */
+}
+
 void board_fatal(void)
 {
     __disable_irq();

@@ -159,10 +159,15 @@ static void button_init(void)
 {
     GPIO_InitTypeDef pin = {0};
     __HAL_RCC_GPIOC_CLK_ENABLE();
-    pin.Pin = ESTOP_PIN;
+    pin.Pin = GPIO_PIN_13;
     pin.Mode = GPIO_MODE_INPUT;
     pin.Pull = GPIO_NOPULL; /* B1 has its own pull-up */
-    HAL_GPIO_Init(ESTOP_GPIO_PORT, &pin);
+    HAL_GPIO_Init(GPIOC, &pin);
+}
+
+bool board_estop_pressed(void)
+{
+    return HAL_GPIO_ReadPin(GPIOC, GPIO_PIN_13) == GPIO_PIN_RESET;
 }
 
 /* The rate BRR gives with 8x oversampling: fck / (8 x USARTDIV), USARTDIV = BRR[15:4] +
