@@ -91,19 +91,31 @@ static void de_write(const j288_stm32_t *p, bool active)
     }
 }
 
-/* A transmit that never completed (a stalled stream, a lost TC interrupt) leaves the UART
- * BUSY_TX and its stream's handle BUSY. The next HAL_UART_Transmit_DMA would then fail, or on
- * the F4, whose HAL ignores HAL_DMA_Start_IT's result, return HAL_OK and send nothing. So a
- * transmit path left busy is aborted first. Returns whether it is ready. */
-static bool tx_path_ready(j288_stm32_t *p)
+/* A transfer that never completed (a stalled stream, a lost TC or DMA interrupt) leaves the
+ * UART BUSY_TX and the stream's handle BUSY. The next HAL_UART_Transmit_DMA would then fail,
+ * or on the F4, whose HAL ignores HAL_DMA_Start_IT's result, return HAL_OK and send nothing;
+ * the same goes for a reception. So a path left busy is aborted first: the UART's abort, and
+ * the stream's own when the UART's did not reach it (the HAL aborts the stream only while
+ * the UART's DMA request bit is set). Returns whether the stream is ready. */
+static bool stream_ready(j288_stm32_t *p, DMA_HandleTypeDef *hdma, bool uart_busy,
+                         HAL_StatusTypeDef (*uart_abort)(UART_HandleTypeDef *))
 {
-    UART_HandleTypeDef *h = p->cfg.huart;
-    if ((h->gState == HAL_UART_STATE_READY) && (HAL_DMA_GetState(h->hdmatx) == HAL_DMA_STATE_READY)) {
+    if (!uart_busy && (HAL_DMA_GetState(hdma) == HAL_DMA_STATE_READY)) {
         return true;
     }
     p->stats.dma_resets++;
-    return hal_ok(p, HAL_UART_AbortTransmit(h)) && (h->gState == HAL_UART_STATE_READY) &&
-           (HAL_DMA_GetState(h->hdmatx) == HAL_DMA_STATE_READY);
+    (void)hal_ok(p, uart_abort(p->cfg.huart));
+    if (HAL_DMA_GetState(hdma) != HAL_DMA_STATE_READY) {
+        (void)hal_ok(p, HAL_DMA_Abort(hdma));
+    }
+    return HAL_DMA_GetState(hdma) == HAL_DMA_STATE_READY;
+}
+
+static bool tx_path_ready(j288_stm32_t *p)
+{
+    UART_HandleTypeDef *h = p->cfg.huart;
+    return stream_ready(p, h->hdmatx, h->gState != HAL_UART_STATE_READY, HAL_UART_AbortTransmit) &&
+           (h->gState == HAL_UART_STATE_READY);
 }
 
 /* Single-wire mode: the transmitter and receiver share the pin, so the receiver is switched
@@ -153,16 +165,14 @@ static void rx_arm(j288_stm32_t *p)
 {
     UART_HandleTypeDef *h = p->cfg.huart;
     p->rx_pos = 0u;
-    /* As for transmit: a stream handle left busy would make the F4 HAL "start" a reception
-     * that never receives. */
-    if (HAL_DMA_GetState(h->hdmarx) != HAL_DMA_STATE_READY) {
-        p->stats.dma_resets++;
-        (void)hal_ok(p, HAL_UART_AbortReceive(h));
-    }
+    /* As for transmit: a stream left busy would make the F4 HAL "start" a reception that
+     * never receives; a stream that cannot be made ready is the line error reported below. */
+    bool ready = stream_ready(p, h->hdmarx, false, HAL_UART_AbortReceive);
     /* Drop cached copies before the DMA writes, so that no dirty line is evicted on top of
      * received bytes later. */
     cache_invalidate(p->cfg.dma->rx, J288_STM32_RX_BUF_SIZE);
-    if (!hal_ok(p, HAL_UARTEx_ReceiveToIdle_DMA(h, p->cfg.dma->rx, (uint16_t)J288_STM32_RX_BUF_SIZE))) {
+    if (!ready ||
+        !hal_ok(p, HAL_UARTEx_ReceiveToIdle_DMA(h, p->cfg.dma->rx, (uint16_t)J288_STM32_RX_BUF_SIZE))) {
         j288_bus_on_error(&p->bus, J288_LINE_DMA);
     }
 }

@@ -12,6 +12,7 @@ typedef struct {
     bool tx_busy;
     uint8_t tx[64];
     size_t tx_len;
+    bool dmat, dmar; /* the UART's DMA requests (CR3) */
     uint8_t *rx_buf; /* armed reception, NULL when none */
     uint16_t rx_size;
     uint16_t rx_fill;
@@ -130,6 +131,16 @@ static bool dma_start(DMA_HandleTypeDef *hdma)
 
 HAL_DMA_StateTypeDef HAL_DMA_GetState(DMA_HandleTypeDef *hdma) { return hdma->State; }
 
+HAL_StatusTypeDef HAL_DMA_Abort(DMA_HandleTypeDef *hdma)
+{
+    record(FAKE_DMA_ABORT, hdma, 0u);
+    if (hdma->State != HAL_DMA_STATE_BUSY) {
+        return HAL_ERROR; /* no transfer to abort */
+    }
+    hdma->State = HAL_DMA_STATE_READY;
+    return HAL_OK;
+}
+
 HAL_StatusTypeDef HAL_HalfDuplex_Init(UART_HandleTypeDef *huart)
 {
     dma_set_state(huart->hdmatx, HAL_DMA_STATE_READY);
@@ -175,6 +186,7 @@ HAL_StatusTypeDef HAL_UART_Transmit_DMA(UART_HandleTypeDef *huart, const uint8_t
     huart->pTxBuffPtr = pData;
     huart->TxXferSize = Size;
     huart->gState = HAL_UART_STATE_BUSY_TX;
+    u->dmat = true; /* set after the stream start, whatever its result */
     if (!dma_start(huart->hdmatx)) {
         return HAL_OK; /* the F4 HAL's silent failure: nothing goes out, ever */
     }
@@ -198,6 +210,7 @@ HAL_StatusTypeDef HAL_UARTEx_ReceiveToIdle_DMA(UART_HandleTypeDef *huart, uint8_
     huart->RxXferSize = Size;
     huart->RxState = HAL_UART_STATE_BUSY_RX;
     huart->ErrorCode = HAL_UART_ERROR_NONE;
+    u->dmar = true;
     if (!dma_start(huart->hdmarx)) {
         return HAL_OK; /* as above: the reception never receives */
     }
@@ -216,7 +229,10 @@ HAL_StatusTypeDef HAL_UART_AbortReceive(UART_HandleTypeDef *huart)
         return HAL_ERROR;
     }
     u->rx_buf = NULL;
-    dma_set_state(huart->hdmarx, HAL_DMA_STATE_READY);
+    if (u->dmar) { /* the HAL aborts the stream only when the UART's DMA request is on */
+        u->dmar = false;
+        dma_set_state(huart->hdmarx, HAL_DMA_STATE_READY);
+    }
     huart->RxState = HAL_UART_STATE_READY;
     return HAL_OK;
 }
@@ -229,7 +245,10 @@ HAL_StatusTypeDef HAL_UART_AbortTransmit(UART_HandleTypeDef *huart)
         return HAL_ERROR;
     }
     u->tx_busy = false;
-    dma_set_state(huart->hdmatx, HAL_DMA_STATE_READY);
+    if (u->dmat) {
+        u->dmat = false;
+        dma_set_state(huart->hdmatx, HAL_DMA_STATE_READY);
+    }
     huart->gState = HAL_UART_STATE_READY;
     return HAL_OK;
 }
@@ -257,6 +276,7 @@ bool fake_hal_tx_complete(UART_HandleTypeDef *huart)
         return false;
     }
     u->tx_busy = false;
+    u->dmat = false;
     dma_set_state(huart->hdmatx, HAL_DMA_STATE_READY);
     huart->gState = HAL_UART_STATE_READY; /* the HAL is ready again before the callback */
     HAL_UART_TxCpltCallback(huart);
@@ -268,6 +288,7 @@ static void rx_end(UART_HandleTypeDef *huart, fake_uart_t *u)
 {
     uint16_t fill = u->rx_fill;
     u->rx_buf = NULL;
+    u->dmar = false;
     dma_set_state(huart->hdmarx, HAL_DMA_STATE_READY);
     huart->RxState = HAL_UART_STATE_READY;
     HAL_UARTEx_RxEventCallback(huart, fill);
@@ -307,6 +328,7 @@ void fake_hal_rx_error(UART_HandleTypeDef *huart, uint32_t error_code)
 {
     fake_uart_t *u = uart_of(huart);
     u->rx_buf = NULL; /* DMA mode: the HAL treats the error as blocking and aborts */
+    u->dmar = false;
     dma_set_state(huart->hdmarx, HAL_DMA_STATE_READY);
     huart->RxState = HAL_UART_STATE_READY;
     huart->ErrorCode = error_code;

@@ -29,6 +29,11 @@ GPIO_PinState HAL_GPIO_ReadPin(GPIO_TypeDef *GPIOx, uint16_t GPIO_Pin)
 
 void HAL_DMA_IRQHandler(DMA_HandleTypeDef *hdma) { (void)hdma; }
 HAL_DMA_StateTypeDef HAL_DMA_GetState(DMA_HandleTypeDef *hdma) { return hdma->State; }
+HAL_StatusTypeDef HAL_DMA_Abort(DMA_HandleTypeDef *hdma)
+{
+    hdma->State = HAL_DMA_STATE_READY;
+    return HAL_OK;
+}
 
 HAL_StatusTypeDef HAL_HalfDuplex_Init(UART_HandleTypeDef *huart)
 {

@@ -58,6 +58,7 @@ typedef struct __DMA_HandleTypeDef {
 
 void HAL_DMA_IRQHandler(DMA_HandleTypeDef *hdma);
 HAL_DMA_StateTypeDef HAL_DMA_GetState(DMA_HandleTypeDef *hdma);
+HAL_StatusTypeDef HAL_DMA_Abort(DMA_HandleTypeDef *hdma);
 
 /* ---- UART ------------------------------------------------------------------------------ */
 typedef struct {
