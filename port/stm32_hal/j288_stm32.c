@@ -466,10 +466,24 @@ bool j288_stm32_on_tx_cplt(UART_HandleTypeDef *huart)
     return true;
 }
 
+/* Hand the bus the bytes at [from, to) of the receive buffer. */
+static void rx_deliver(j288_stm32_t *p, uint16_t from, uint16_t to)
+{
+    cache_invalidate(p->cfg.dma->rx, J288_STM32_RX_BUF_SIZE);
+    j288_bus_on_rx(&p->bus, &p->cfg.dma->rx[from], (size_t)(to - from));
+    p->stats.rx_bytes += (uint32_t)(to - from);
+}
+
 /* ReceiveToIdle reports the fill level of the buffer, not a delta: half-transfer, idle and
- * full events of one reception each give the position reached so far. The reception has
- * ended (idle or full) when the HAL's RxState is no longer BUSY_RX; in receive direction it
- * is re-armed at once, so that a reply split by a gap is still heard whole. */
+ * full events each give the position reached in the buffer so far.
+ * Normal-mode stream: the reception ends at an idle line or a full buffer (the HAL's RxState
+ * is then no longer BUSY_RX) and is re-armed at once in receive direction; a byte arriving
+ * during that re-arm (a few microseconds after the idle flag) is lost, and its reply is then
+ * TRUNCATED at the deadline.
+ * Circular-mode stream (recommended): the reception never ends, an idle line only reports
+ * the position, and the buffer wraps after a full event; a pause inside a reply loses
+ * nothing. Either way an idle line never ends the transaction (j288_bus_on_rx_idle is a
+ * no-op): the bus keeps a frame in progress until the deadline. */
 bool j288_stm32_on_rx_event(UART_HandleTypeDef *huart, uint16_t size)
 {
     j288_stm32_t *p = find_uart(huart);
@@ -485,12 +499,14 @@ bool j288_stm32_on_rx_event(UART_HandleTypeDef *huart, uint16_t size)
     if (size > J288_STM32_RX_BUF_SIZE) {
         size = (uint16_t)J288_STM32_RX_BUF_SIZE; /* never trust a count beyond the buffer */
     }
-    if (size > pos) {
-        cache_invalidate(p->cfg.dma->rx, J288_STM32_RX_BUF_SIZE);
-        j288_bus_on_rx(&p->bus, &p->cfg.dma->rx[pos], (size_t)(size - pos));
-        p->stats.rx_bytes += (uint32_t)(size - pos);
-        p->rx_pos = size;
+    if (size < pos) { /* circular: wrapped without a full event (a missed interrupt) */
+        rx_deliver(p, pos, (uint16_t)J288_STM32_RX_BUF_SIZE);
+        pos = 0u;
     }
+    if (size > pos) {
+        rx_deliver(p, pos, size);
+    }
+    p->rx_pos = (size < J288_STM32_RX_BUF_SIZE) ? size : 0u; /* full: a circular stream wraps */
     if (ended) {
         if (size < J288_STM32_RX_BUF_SIZE) {
             j288_bus_on_rx_idle(&p->bus);

@@ -35,6 +35,7 @@ static uint32_t primask;
 static unsigned irq_disables;
 static uint32_t crc_reg = 0xFFFFFFFFu;
 static bool crc_unclocked;
+static bool rx_circular;
 /* The counter-advance hook of fake_hal_tim_advance_at(). */
 static TIM_TypeDef *hook_tim;
 static unsigned hook_countdown;
@@ -55,6 +56,7 @@ void fake_hal_reset(void)
     tim_accesses = 0u;
     crc_reg = 0xFFFFFFFFu;
     crc_unclocked = false;
+    rx_circular = false;
 }
 
 static void record(fake_hal_fn_t fn, const void *handle, uint32_t arg)
@@ -304,7 +306,11 @@ size_t fake_hal_rx_bytes(UART_HandleTypeDef *huart, const uint8_t *data, size_t 
         }
         u->rx_buf[u->rx_fill++] = data[i];
         stored++;
-        if (u->rx_fill == u->rx_size) {
+        if ((u->rx_fill == u->rx_size) && rx_circular) {
+            u->rx_fill = 0u; /* the stream wraps and goes on */
+            u->half_done = false;
+            HAL_UARTEx_RxEventCallback(huart, u->rx_size);
+        } else if (u->rx_fill == u->rx_size) {
             rx_end(huart, u); /* buffer full (DMA transfer complete) */
         } else if (!u->half_done && (u->rx_fill == (uint16_t)(u->rx_size / 2u))) {
             u->half_done = true; /* half transfer: reception goes on */
@@ -314,11 +320,17 @@ size_t fake_hal_rx_bytes(UART_HandleTypeDef *huart, const uint8_t *data, size_t 
     return stored;
 }
 
+void fake_hal_rx_circular(bool on) { rx_circular = on; }
+
 bool fake_hal_rx_idle(UART_HandleTypeDef *huart)
 {
     fake_uart_t *u = uart_of(huart);
     if ((u->rx_buf == NULL) || (u->rx_fill == 0u)) {
         return false; /* the HAL reports idle only inside a reception that has data */
+    }
+    if (rx_circular) {
+        HAL_UARTEx_RxEventCallback(huart, u->rx_fill); /* the reception goes on */
+        return true;
     }
     rx_end(huart, u);
     return true;

@@ -77,7 +77,12 @@ bool fake_hal_tx_complete(UART_HandleTypeDef *huart);
  * Returns how many bytes were stored. */
 size_t fake_hal_rx_bytes(UART_HandleTypeDef *huart, const uint8_t *data, size_t len);
 
-/* The line went idle: if the armed reception holds bytes, it ends with an RxEvent. */
+/* Receive streams in circular mode (true) from now on: a full buffer wraps with an RxEvent of
+ * the full size and an idle line reports the position; the reception never ends by itself. */
+void fake_hal_rx_circular(bool on);
+
+/* The line went idle: if the armed reception holds bytes, it ends with an RxEvent (circular:
+ * it reports the position and goes on). */
 bool fake_hal_rx_idle(UART_HandleTypeDef *huart);
 
 /* A receive error (HAL_UART_ERROR_* bits) in DMA mode: the HAL aborts the reception, then

@@ -845,6 +845,37 @@ static void test_reply_split_by_a_gap_at_any_position_is_heard_whole(void)
     }
 }
 
+/* With the receive stream in circular mode a pause only reports the position: nothing is
+ * re-armed, and the reply is whole wherever it falls in the buffer, across the wrap too. */
+static void test_circular_stream_hears_a_paused_reply_across_the_wrap(void)
+{
+    static const uint8_t noise[10] = {0};
+    init_port1(NULL, false, false);
+    fake_hal_rx_circular(true);
+    for (size_t split = 1u; split < J288_REPLY_LEN; split++) {
+        int before = done_count;
+        unsigned arms;
+        send_foc3();
+        arms = fake_hal_count(FAKE_RECEIVE_TO_IDLE_DMA);
+        /* line noise first, so that the reply crosses the end of the 32-byte buffer */
+        TEST_ASSERT_EQUAL_UINT32(10u, (uint32_t)fake_hal_rx_bytes(&huart1, noise, sizeof noise));
+        TEST_ASSERT_TRUE(fake_hal_rx_idle(&huart1));
+        (void)fake_hal_rx_bytes(&huart1, k_reply3, split);
+        (void)fake_hal_rx_idle(&huart1); /* no event when the pause falls right at the wrap */
+        poll1();
+        TEST_ASSERT_EQUAL_INT(before, done_count);
+        (void)fake_hal_rx_bytes(&huart1, &k_reply3[split], J288_REPLY_LEN - split);
+        (void)fake_hal_rx_idle(&huart1);
+        TEST_ASSERT_EQUAL_UINT(arms, fake_hal_count(FAKE_RECEIVE_TO_IDLE_DMA)); /* no re-arm */
+        poll1();
+        TEST_ASSERT_EQUAL_INT(before + 1, done_count);
+        TEST_ASSERT_EQUAL_INT(J288_OK, last_txn.result);
+        TEST_ASSERT_EQUAL_INT32(5215, last_txn.reply.pos);
+        fake_now += 10u;
+        poll1();
+    }
+}
+
 /* A reply that stops at a gap and never resumes is TRUNCATED at the deadline, not at the
  * idle line. */
 static void test_reply_stopping_at_a_gap_is_truncated_at_the_deadline(void)
@@ -903,5 +934,6 @@ int main(void)
     RUN_TEST(test_echo_is_refused);
     RUN_TEST(test_reply_split_by_a_gap_at_any_position_is_heard_whole);
     RUN_TEST(test_reply_stopping_at_a_gap_is_truncated_at_the_deadline);
+    RUN_TEST(test_circular_stream_hears_a_paused_reply_across_the_wrap);
     return UNITY_END();
 }

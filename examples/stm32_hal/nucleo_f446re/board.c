@@ -12,7 +12,8 @@
  *
  * Bus: USART1 single-wire half-duplex on PA9 (Arduino D8), alternate function 7, push-pull
  * with the internal pull-up (the USART releases the pin whenever it is not transmitting);
- * TX DMA2 Stream7 channel 4, RX DMA2 Stream2 channel 4, both normal mode, bytes. TIM2 (32
+ * TX DMA2 Stream7 channel 4 in normal mode, RX DMA2 Stream2 channel 4 in circular mode (a
+ * pause inside a reply then loses nothing), bytes. TIM2 (32
  * bits, on APB1: 90 MHz timer clock) counts at 1 MHz: the tick and, on channel 1, the reply
  * timeout. USART1, both streams and TIM2 share NVIC priority 5 (SysTick 15). The blue user
  * button B1 (PC13, low when pressed) is the emergency stop.
@@ -91,7 +92,7 @@ void HAL_MspInit(void)
     __HAL_RCC_PWR_CLK_ENABLE();
 }
 
-static void dma_stream_init(DMA_HandleTypeDef *h, DMA_Stream_TypeDef *stream, uint32_t direction)
+static void dma_stream_init(DMA_HandleTypeDef *h, DMA_Stream_TypeDef *stream, uint32_t direction, uint32_t mode)
 {
     h->Instance = stream;
     h->Init.Channel = DMA_CHANNEL_4;
@@ -100,7 +101,7 @@ static void dma_stream_init(DMA_HandleTypeDef *h, DMA_Stream_TypeDef *stream, ui
     h->Init.MemInc = DMA_MINC_ENABLE;
     h->Init.PeriphDataAlignment = DMA_PDATAALIGN_BYTE;
     h->Init.MemDataAlignment = DMA_MDATAALIGN_BYTE;
-    h->Init.Mode = DMA_NORMAL;
+    h->Init.Mode = mode;
     h->Init.Priority = DMA_PRIORITY_HIGH;
     h->Init.FIFOMode = DMA_FIFOMODE_DISABLE;
     if (HAL_DMA_Init(h) != HAL_OK) {
@@ -125,9 +126,9 @@ void HAL_UART_MspInit(UART_HandleTypeDef *huart)
     pin.Alternate = GPIO_AF7_USART1;
     HAL_GPIO_Init(GPIOA, &pin);
 
-    dma_stream_init(&hdma_usart1_tx, DMA2_Stream7, DMA_MEMORY_TO_PERIPH);
+    dma_stream_init(&hdma_usart1_tx, DMA2_Stream7, DMA_MEMORY_TO_PERIPH, DMA_NORMAL);
     __HAL_LINKDMA(huart, hdmatx, hdma_usart1_tx);
-    dma_stream_init(&hdma_usart1_rx, DMA2_Stream2, DMA_PERIPH_TO_MEMORY);
+    dma_stream_init(&hdma_usart1_rx, DMA2_Stream2, DMA_PERIPH_TO_MEMORY, DMA_CIRCULAR);
     __HAL_LINKDMA(huart, hdmarx, hdma_usart1_rx);
 
     HAL_NVIC_SetPriority(USART1_IRQn, BUS_IRQ_PRIORITY, 0u);

@@ -10,9 +10,9 @@
  * cannot, and 16x sampling tolerates more noise.)
  *
  * Bus: USART1 single-wire half-duplex on PA9 (Arduino D8, as on the F446RE board), AF7,
- * push-pull with pull-up; TX on DMA1 channel 1, RX on DMA1 channel 2 (DMAMUX requests
- * USART1_TX/RX), normal mode, bytes. TIM2 (32 bits, 168 MHz) counts at 1 MHz: tick and
- * timeout on channel 1. USART1, both channels and TIM2 share NVIC priority 5 (SysTick 15).
+ * push-pull with pull-up; TX on DMA1 channel 1 (normal mode), RX on DMA1 channel 2
+ * (circular mode), DMAMUX requests USART1_TX/RX, bytes. TIM2 (32 bits, 168 MHz) counts at
+ * 1 MHz: tick and timeout on channel 1. USART1, both channels and TIM2 share NVIC priority 5 (SysTick 15).
  * CRC unit in its reset configuration, spelled out in the handle (the port checks it).
  * The blue user button B1 (PC13, high when pressed on this board) is the emergency stop.
  */
@@ -89,7 +89,7 @@ void HAL_MspInit(void)
 }
 
 static void dma_channel_init(DMA_HandleTypeDef *h, DMA_Channel_TypeDef *channel, uint32_t request,
-                             uint32_t direction)
+                             uint32_t direction, uint32_t mode)
 {
     h->Instance = channel;
     h->Init.Request = request;
@@ -98,7 +98,7 @@ static void dma_channel_init(DMA_HandleTypeDef *h, DMA_Channel_TypeDef *channel,
     h->Init.MemInc = DMA_MINC_ENABLE;
     h->Init.PeriphDataAlignment = DMA_PDATAALIGN_BYTE;
     h->Init.MemDataAlignment = DMA_MDATAALIGN_BYTE;
-    h->Init.Mode = DMA_NORMAL;
+    h->Init.Mode = mode;
     h->Init.Priority = DMA_PRIORITY_HIGH;
     if (HAL_DMA_Init(h) != HAL_OK) {
         board_fatal();
@@ -129,9 +129,11 @@ void HAL_UART_MspInit(UART_HandleTypeDef *huart)
     pin.Alternate = GPIO_AF7_USART1;
     HAL_GPIO_Init(GPIOA, &pin);
 
-    dma_channel_init(&hdma_usart1_tx, DMA1_Channel1, DMA_REQUEST_USART1_TX, DMA_MEMORY_TO_PERIPH);
+    dma_channel_init(&hdma_usart1_tx, DMA1_Channel1, DMA_REQUEST_USART1_TX, DMA_MEMORY_TO_PERIPH,
+                     DMA_NORMAL);
     __HAL_LINKDMA(huart, hdmatx, hdma_usart1_tx);
-    dma_channel_init(&hdma_usart1_rx, DMA1_Channel2, DMA_REQUEST_USART1_RX, DMA_PERIPH_TO_MEMORY);
+    dma_channel_init(&hdma_usart1_rx, DMA1_Channel2, DMA_REQUEST_USART1_RX, DMA_PERIPH_TO_MEMORY,
+                     DMA_CIRCULAR);
     __HAL_LINKDMA(huart, hdmarx, hdma_usart1_rx);
 
     HAL_NVIC_SetPriority(USART1_IRQn, BUS_IRQ_PRIORITY, 0u);
