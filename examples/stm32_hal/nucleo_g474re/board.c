@@ -12,8 +12,9 @@
  * Bus: USART1 single-wire half-duplex on PA9 (Arduino D8, as on the F446RE board), AF7,
  * push-pull with pull-up; TX on DMA1 channel 1 (normal mode), RX on DMA1 channel 2
  * (circular mode), DMAMUX requests USART1_TX/RX, bytes. TIM2 (32 bits, 168 MHz) counts at
- * 1 MHz: tick and timeout on channel 1. USART1, both channels and TIM2 share NVIC priority 5 (SysTick 15).
- * CRC unit in its reset configuration, spelled out in the handle (the port checks it).
+ * 1 MHz: tick and timeout on channel 1. USART1, both channels and TIM2 share NVIC priority
+ * 5 (SysTick 15). CRC unit in its reset configuration, spelled out in the handle (the port
+ * checks it).
  * The blue user button B1 (PC13, high when pressed on this board) is the emergency stop.
  */
 #include "board.h"
