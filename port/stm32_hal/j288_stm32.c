@@ -164,10 +164,11 @@ static int op_start_tx(void *ctx, const uint8_t *data, size_t len)
 static void rx_arm(j288_stm32_t *p)
 {
     UART_HandleTypeDef *h = p->cfg.huart;
-    p->rx_pos = 0u;
     /* As for transmit: a stream left busy would make the F4 HAL "start" a reception that
      * never receives; a stream that cannot be made ready is the line error reported below. */
     bool ready = stream_ready(p, h->hdmarx, false, HAL_UART_AbortReceive);
+
+    p->rx_pos = 0u;
     /* Drop cached copies before the DMA writes, so that no dirty line is evicted on top of
      * received bytes later. */
     cache_invalidate(p->cfg.dma->rx, J288_STM32_RX_BUF_SIZE);
