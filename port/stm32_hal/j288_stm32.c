@@ -419,7 +419,11 @@ int j288_stm32_init(j288_stm32_t *p, const j288_stm32_config_t *cfg,
     if (cfg->htim != NULL) {
         __HAL_TIM_DISABLE_IT(cfg->htim, channel_it(cfg->tim_channel));
     }
-    op_set_dir(p, J288_DIR_RX);
+    p->dir = (uint8_t)J288_DIR_RX;
+    de_write(p, false);
+    if (!hal_ok(p, HAL_HalfDuplex_EnableReceiver(cfg->huart))) {
+        return J288_ERR_PORT;
+    }
     registry[free_slot] = p;
     return J288_OK;
 }

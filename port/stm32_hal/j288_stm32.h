@@ -206,7 +206,8 @@ typedef struct j288_stm32 {
  *   - the CRC unit does not compute the servo's CRC: a handle in another configuration (see
  *     hcrc above), or a unit that fails a known-answer check (its clock not enabled,
  *     HAL_CRC_Init not called, registers reprogrammed by other code);
- * or j288_bus_init()'s codes. Thread only. */
+ * J288_ERR_PORT (the HAL refused to turn the line to receive), or j288_bus_init()'s codes.
+ * Thread only. */
 int j288_stm32_init(j288_stm32_t *p, const j288_stm32_config_t *cfg,
                     const j288_bus_config_t *bus_cfg);
 

@@ -11,8 +11,7 @@ fail=0
 if ! "$cc" "${flags[@]}" -DJ288_STM32_DCACHE=1 -D__DCACHE_PRESENT=1U port/stm32_hal/j288_stm32.c; then
     echo "FAIL: J288_STM32_DCACHE=1 on a core with a data cache does not build"; fail=1
 fi
-out=$("$cc" "${flags[@]}" -DJ288_STM32_DCACHE=1 -D__DCACHE_PRESENT=0U port/stm32_hal/j288_stm32.c 2>&1)
-if [ $? -eq 0 ]; then
+if out=$("$cc" "${flags[@]}" -DJ288_STM32_DCACHE=1 -D__DCACHE_PRESENT=0U port/stm32_hal/j288_stm32.c 2>&1); then
     echo "FAIL: J288_STM32_DCACHE=1 on a core without a data cache builds"; fail=1
 elif ! grep -q 'J288_STM32_DCACHE=1 needs a core with a data cache' <<<"$out"; then
     echo "FAIL: the build stops without saying why:"; echo "$out" | head -n 5; fail=1

@@ -681,6 +681,15 @@ static void test_init_rejects_crc_unit_that_computes_wrong(void)
     TEST_ASSERT_EQUAL_INT(J288_OK, j288_stm32_init(&port1, &c, NULL));
 }
 
+static void test_init_fails_when_the_line_cannot_receive(void)
+{
+    j288_stm32_config_t c = base_config(&huart1, &dma1);
+    fake_hal_fail_next(FAKE_HALFDUPLEX_RX);
+    TEST_ASSERT_EQUAL_INT(J288_ERR_PORT, j288_stm32_init(&port1, &c, NULL));
+    TEST_ASSERT_FALSE(j288_stm32_on_tx_cplt(&huart1)); /* not registered */
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_stm32_init(&port1, &c, NULL));
+}
+
 static void test_init_rejects_uart_without_dma_streams(void)
 {
     j288_stm32_config_t c = base_config(&huart1, &dma1);
@@ -926,6 +935,7 @@ int main(void)
     RUN_TEST(test_init_rejects_crc_unit_not_in_the_servo_configuration);
     RUN_TEST(test_init_rejects_crc_unit_that_computes_wrong);
     RUN_TEST(test_init_rejects_uart_without_dma_streams);
+    RUN_TEST(test_init_fails_when_the_line_cannot_receive);
     RUN_TEST(test_stalled_transmit_is_aborted_and_the_next_transaction_works);
     RUN_TEST(test_transmit_stream_left_busy_is_recovered);
     RUN_TEST(test_receive_stream_left_busy_is_recovered);
