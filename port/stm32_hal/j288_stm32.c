@@ -97,14 +97,17 @@ static void de_write(const j288_stm32_t *p, bool active)
  * the same goes for a reception. So a path left busy is aborted first: the UART's abort, and
  * the stream's own when the UART's did not reach it (the HAL aborts the stream only while
  * the UART's DMA request bit is set). Returns whether the stream is ready. */
-static bool stream_ready(j288_stm32_t *p, DMA_HandleTypeDef *hdma, bool uart_busy,
-                         HAL_StatusTypeDef (*uart_abort)(UART_HandleTypeDef *))
+static bool stream_ready(j288_stm32_t *p, j288_dir_t dir)
 {
+    UART_HandleTypeDef *h = p->cfg.huart;
+    DMA_HandleTypeDef *hdma = (dir == J288_DIR_TX) ? h->hdmatx : h->hdmarx;
+    bool uart_busy = (dir == J288_DIR_TX) && (h->gState != HAL_UART_STATE_READY);
+
     if (!uart_busy && (HAL_DMA_GetState(hdma) == HAL_DMA_STATE_READY)) {
         return true;
     }
     p->stats.dma_resets++;
-    (void)hal_ok(p, uart_abort(p->cfg.huart));
+    (void)hal_ok(p, (dir == J288_DIR_TX) ? HAL_UART_AbortTransmit(h) : HAL_UART_AbortReceive(h));
     if (HAL_DMA_GetState(hdma) != HAL_DMA_STATE_READY) {
         (void)hal_ok(p, HAL_DMA_Abort(hdma));
     }
@@ -114,8 +117,7 @@ static bool stream_ready(j288_stm32_t *p, DMA_HandleTypeDef *hdma, bool uart_bus
 static bool tx_path_ready(j288_stm32_t *p)
 {
     UART_HandleTypeDef *h = p->cfg.huart;
-    return stream_ready(p, h->hdmatx, h->gState != HAL_UART_STATE_READY, HAL_UART_AbortTransmit) &&
-           (h->gState == HAL_UART_STATE_READY);
+    return stream_ready(p, J288_DIR_TX) && (h->gState == HAL_UART_STATE_READY);
 }
 
 /* Single-wire mode: the transmitter and receiver share the pin, so the receiver is switched
@@ -166,7 +168,7 @@ static void rx_arm(j288_stm32_t *p)
     UART_HandleTypeDef *h = p->cfg.huart;
     /* As for transmit: a stream left busy would make the F4 HAL "start" a reception that
      * never receives; a stream that cannot be made ready is the line error reported below. */
-    bool ready = stream_ready(p, h->hdmarx, false, HAL_UART_AbortReceive);
+    bool ready = stream_ready(p, J288_DIR_RX);
 
     p->rx_pos = 0u;
     /* Drop cached copies before the DMA writes, so that no dirty line is evicted on top of
