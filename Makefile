@@ -140,6 +140,7 @@ help:
 	@echo "make demo           the CLI against the built-in servo simulator"
 	@echo "make install        library, headers, CMake package, j288, j288-sim (PREFIX, DESTDIR)"
 	@echo "make arm            lib/ for each Cortex-M, size table, STM32 example, port template"
+	@echo "make firmware       STM32 firmware per board against ST's HAL (bash scripts/fetch-st.sh first)"
 	@echo "make test-target    unit tests on each CPU under QEMU ($(CPUS))"
 	@echo "make size           flash, RAM and stack per module on Cortex-M0 and M4F"
 	@echo "make bench          bus timing model and instruction counts (bench-* for one)"
