@@ -74,3 +74,40 @@ firmware:
 	 $(MAKE) --no-print-directory firmware-build
 
 firmware-build: $(FW_ELFS)
+
+# ---- make bench-stm32-hal: what the port adds per transaction, ST's F4 HAL included --------
+# test/stm32/hal_bench.c on Cortex-M4 under QEMU (-icount), against ST's HAL in ST_DIR, with
+# the NUCLEO-F446RE's HAL configuration; skipped with a notice without the sources.
+HB_HAL := $(FW_nucleo_f446re_HAL:%=$(ST_DIR)/stm32f4xx_hal_driver/Src/stm32f4xx_%.c) \
+    $(ST_DIR)/cmsis_device_f4/Source/Templates/system_stm32f4xx.c
+HB_APP := test/stm32/hal_bench.c port/stm32_hal/j288_stm32.c $(LIB_SRC) $(call TC,m4f,STARTUP)
+HB_CC = $(call CPU_CC,m4f) -DSTM32F446xx -DUSE_HAL_DRIVER -Iexamples/stm32_hal/nucleo_f446re \
+    -Iport/stm32_hal $(CPPFLAGS_LIB) -isystem $(ST_DIR)/stm32f4xx_hal_driver/Inc \
+    -isystem $(ST_DIR)/cmsis_device_f4/Include -isystem $(ST_DIR)/cmsis_core/Include \
+    -ffunction-sections -fdata-sections -g
+
+define HB_RULES
+$(BUILD)/bench-stm32-hal/$(1)/app/%.o: %.c $(LIB_HDR) $(wildcard port/stm32_hal/*.h)
+	@mkdir -p $$(@D)
+	$(HB_CC) -$(1) $(CSTD) $(WARN) -c $$< -o $$@
+$(BUILD)/bench-stm32-hal/$(1)/st/%.o: $(ST_DIR)/%.c
+	@mkdir -p $$(@D)
+	$(HB_CC) -$(1) -std=gnu11 -w -c $$< -o $$@
+$(BUILD)/bench-stm32-hal/hal_bench_$(1).elf: $(HB_APP:%.c=$(BUILD)/bench-stm32-hal/$(1)/app/%.o) \
+    $(patsubst $(ST_DIR)/%.c,$(BUILD)/bench-stm32-hal/$(1)/st/%.o,$(HB_HAL))
+	$(call TC,m4f,CC) $(call TGT_LINK_FLAGS,m4f,SEMIHOST,$(CPU_m4f_LD)) $$^ -o $$@ -lm
+endef
+$(foreach o,O2 Os,$(eval $(call HB_RULES,$(o))))
+
+.PHONY: bench-stm32-hal
+bench-stm32-hal:
+	@$(call REQUIRE_TC,m4f,QEMU); \
+	 if [ ! -f $(ST_DIR)/stm32f4xx_hal_driver/.tag ] || [ ! -f $(ST_DIR)/cmsis_device_f4/.tag ] || \
+	    [ ! -f $(ST_DIR)/cmsis_core/.tag ]; then \
+	     echo "bench-stm32-hal: skipped: ST's F4 sources are not in $(ST_DIR) (bash scripts/fetch-st.sh f4)"; \
+	     exit 0; fi; \
+	 $(MAKE) --no-print-directory $(BUILD)/bench-stm32-hal/hal_bench_O2.elf $(BUILD)/bench-stm32-hal/hal_bench_Os.elf && \
+	 for o in O2 Os; do \
+	    echo "Cortex-M4F ($(CPU_m4f_QEMU), QEMU -icount shift=0), -$$o:"; \
+	    $(call QEMU_BENCH,m4f,$(BUILD)/bench-stm32-hal/hal_bench_$$o.elf) || exit 1; echo; \
+	 done
