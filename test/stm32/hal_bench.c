@@ -36,6 +36,19 @@ static const uint8_t k_reply3[J288_REPLY_LEN] = {
 static uint32_t clock_us = 1000u;
 static uint32_t done_ok;
 
+/* Per-phase SysTick ticks: 0 submit and transmit start, 1 transmit complete and turn to
+ * receive, 2 the reply and the idle line, 3 the polls that finish and end the guard. */
+#define PHASES 4u
+static uint32_t phase_ticks[PHASES];
+static uint32_t phase_t;
+static void phase_begin(void) { phase_t = SYST_CVR; }
+static void phase_end(unsigned i)
+{
+    uint32_t t = SYST_CVR;
+    phase_ticks[i] += (phase_t - t) & 0x00FFFFFFu;
+    phase_t = t;
+}
+
 static void systick_start(void)
 {
     SYST_CSR = 0u;
@@ -120,15 +133,20 @@ static const j288_port_t nop_port = {
 static void plain_transaction(void)
 {
     j288_cmd_raw_t cmd = foc3_cmd();
+    phase_begin();
     (void)j288_bus_submit(&plain_bus, &cmd, clock_us, on_done, NULL);
     j288_bus_poll(&plain_bus, clock_us);
+    phase_end(0u);
     j288_bus_on_tx_done(&plain_bus);
+    phase_end(1u);
     j288_bus_on_rx(&plain_bus, k_reply3, J288_REPLY_LEN);
     j288_bus_on_rx_idle(&plain_bus);
+    phase_end(2u);
     clock_us += 100u;
     j288_bus_poll(&plain_bus, clock_us);
     clock_us += 10u;
     j288_bus_poll(&plain_bus, clock_us);
+    phase_end(3u);
 }
 
 /* ---- the STM32 port on the real HAL, peripherals in RAM --------------------------------- */
@@ -233,34 +251,65 @@ static void port_transaction(void)
 {
     j288_cmd_raw_t cmd = foc3_cmd();
     j288_bus_t *bus = j288_stm32_bus(&port);
+    phase_begin();
     (void)j288_bus_submit(bus, &cmd, clock_us, on_done, NULL);
     j288_bus_poll(bus, clock_us);
+    phase_end(0u);
     hw_transmit_done();
+    phase_end(1u);
     hw_reply_then_idle();
+    phase_end(2u);
     clock_us += 100u;
     j288_bus_poll(bus, clock_us);
     clock_us += 10u;
     j288_bus_poll(bus, clock_us);
+    phase_end(3u);
 }
 
 /* ---- the run ------------------------------------------------------------------------------ */
 
-static uint32_t run(void (*txn)(void), uint32_t ipt)
+typedef struct {
+    uint32_t total;
+    uint32_t phase[PHASES];
+} result_t;
+
+static result_t run(void (*txn)(void), uint32_t ipt)
 {
+    result_t r;
     uint32_t t0, t1;
     txn(); /* warm: the first transaction, then measure */
     done_ok = 0u;
+    memset(phase_ticks, 0, sizeof phase_ticks);
     t0 = systick_now();
     for (uint32_t i = 0; i < ITERATIONS; i++) {
         txn();
     }
     t1 = systick_now();
-    return (done_ok == ITERATIONS) ? per_txn(ticks_between(t0, t1), ipt) : 0u;
+    r.total = (done_ok == ITERATIONS) ? per_txn(ticks_between(t0, t1), ipt) : 0u;
+    for (unsigned i = 0; i < PHASES; i++) {
+        r.phase[i] = per_txn(phase_ticks[i], ipt);
+    }
+    return r;
+}
+
+static void print_row(const char *name, const result_t *r, const result_t *base)
+{
+    printf("| %s | %u", name, (unsigned)r->total);
+    if (base == NULL) {
+        printf(" | -");
+    } else {
+        printf(" | %u", (unsigned)(r->total - base->total));
+    }
+    for (unsigned i = 0; i < PHASES; i++) {
+        printf(" | %u", (unsigned)r->phase[i]);
+    }
+    printf(" |\n");
 }
 
 int main(void)
 {
-    uint32_t ipt, plain, normal, circular;
+    uint32_t ipt;
+    result_t plain, normal, circular;
 
     systick_start();
     ipt = calibrate();
@@ -280,19 +329,17 @@ int main(void)
         return 1;
     }
     circular = run(port_transaction, ipt);
-    if ((plain == 0u) || (normal == 0u) || (circular == 0u)) {
-        printf("a transaction did not end J288_OK: lib %u, normal %u, circular %u\n",
-               (unsigned)plain, (unsigned)normal, (unsigned)circular);
+    if ((plain.total == 0u) || (normal.total == 0u) || (circular.total == 0u)) {
+        printf("a transaction did not end J288_OK\n");
         return 1;
     }
     printf("bench: %u transactions each; %u.%03u instructions per SysTick tick\n",
            (unsigned)ITERATIONS, (unsigned)(ipt / 1000u), (unsigned)(ipt % 1000u));
-    printf("| path | instructions per transaction | the port and HAL add |\n");
-    printf("|---|---:|---:|\n");
-    printf("| lib/ alone (port operations empty) | %u | - |\n", (unsigned)plain);
-    printf("| STM32 port + F4 HAL, RX stream normal mode | %u | %u |\n", (unsigned)normal,
-           (unsigned)(normal - plain));
-    printf("| STM32 port + F4 HAL, RX stream circular mode | %u | %u |\n", (unsigned)circular,
-           (unsigned)(circular - plain));
+    printf("| path | per transaction | added | submit + TX start | TX complete + turn | "
+           "reply + idle | polls to the end |\n");
+    printf("|---|---:|---:|---:|---:|---:|---:|\n");
+    print_row("lib/ alone (port operations empty)", &plain, NULL);
+    print_row("STM32 port + F4 HAL, RX stream normal", &normal, &plain);
+    print_row("STM32 port + F4 HAL, RX stream circular", &circular, &plain);
     return 0;
 }
