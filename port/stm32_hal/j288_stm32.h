@@ -143,7 +143,7 @@ typedef struct {
     bool de_active_low;
 
     /* Time. now_us: the application's monotonic microsecond tick (any context, wraps at
-     * 2^32). When NULL, htim's counter is the tick; it must then count at 1 MHz with a 32-bit
+     * 2^32); pass the same clock to submit and poll (j288_stm32_now_us()). When NULL, htim's counter is the tick; it must then count at 1 MHz with a 32-bit
      * reload of 0xFFFFFFFF (TIM2/TIM5 on the F4), which init checks. */
     uint32_t (*now_us)(void);
 
@@ -217,7 +217,9 @@ void j288_stm32_deinit(j288_stm32_t *p);
 /* The bus driven by p, for j288_bus_* and j288_sched_*. */
 j288_bus_t *j288_stm32_bus(j288_stm32_t *p);
 
-/* The microsecond tick p uses (its now_us, or the timer counter). Any context. */
+/* The microsecond tick p uses (its now_us, or the timer counter). Any context. This is the
+ * clock the bus reads in its event calls (advance_in_isr), so the now_us the application
+ * passes to j288_bus_submit/poll/estop and j288_sched_* must come from it too (bus.h). */
 uint32_t j288_stm32_now_us(const j288_stm32_t *p);
 
 const j288_stm32_stats_t *j288_stm32_stats(const j288_stm32_t *p);
