@@ -9,8 +9,13 @@
 
 /* Cache maintenance needs a core with a data cache: CMSIS declares SCB_CleanDCache_by_Addr()
  * and friends only where the device header sets __DCACHE_PRESENT (Cortex-M7). */
-#if J288_STM32_DCACHE && !(defined(__DCACHE_PRESENT) && (__DCACHE_PRESENT == 1U))
+#if defined(__DCACHE_PRESENT) && (__DCACHE_PRESENT == 1U)
+#define J288_STM32_CACHE_OPS J288_STM32_DCACHE
+#else
+#define J288_STM32_CACHE_OPS 0
+#if J288_STM32_DCACHE
 #error "J288_STM32_DCACHE=1 needs a core with a data cache (Cortex-M7: __DCACHE_PRESENT = 1 in the device header); this device has none, so set J288_STM32_DCACHE=0"
+#endif
 #endif
 
 /* Compile-time checks (C99: a negative array size fails the build). */
@@ -48,7 +53,7 @@ static bool hal_ok(j288_stm32_t *p, HAL_StatusTypeDef st)
 
 static void cache_clean(void *buf, size_t len)
 {
-#if J288_STM32_DCACHE
+#if J288_STM32_CACHE_OPS
     SCB_CleanDCache_by_Addr(buf, (int32_t)len);
 #else
     (void)buf;
@@ -58,7 +63,7 @@ static void cache_clean(void *buf, size_t len)
 
 static void cache_invalidate(void *buf, size_t len)
 {
-#if J288_STM32_DCACHE
+#if J288_STM32_CACHE_OPS
     SCB_InvalidateDCache_by_Addr(buf, (int32_t)len);
 #else
     (void)buf;
