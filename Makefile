@@ -70,7 +70,7 @@ ALL_TARGETS := $(LIB_A) $(UNIT_TESTS)
 
 # Each fragment may use what the ones before it define.
 include $(sort $(wildcard mk/cpu/*.mk))
-include mk/tools.mk mk/tests.mk mk/target.mk mk/bench.mk mk/hardening.mk
+include mk/tools.mk mk/tests.mk mk/target.mk mk/bench.mk mk/hardening.mk mk/firmware.mk
 
 all: $(ALL_TARGETS)
 
@@ -140,6 +140,7 @@ help:
 	@echo "make demo           the CLI against the built-in servo simulator"
 	@echo "make install        library, headers, CMake package, j288, j288-sim (PREFIX, DESTDIR)"
 	@echo "make arm            lib/ for each Cortex-M, size table, STM32 example, port template"
+	@echo "make firmware       STM32 firmware per board against ST's HAL (bash scripts/fetch-st.sh first)"
 	@echo "make test-target    unit tests on each CPU under QEMU ($(CPUS))"
 	@echo "make size           flash, RAM and stack per module on Cortex-M0 and M4F"
 	@echo "make bench          bus timing model and instruction counts (bench-* for one)"

@@ -1,12 +1,15 @@
-/* board.h - the board bring-up that STM32CubeMX generates in a real project (handles,
- * MX_*_Init, interrupt handlers); here written by hand against the HAL stub. */
+/* board.h - what the example's main.c needs from a board: the HAL handles of the bus, the
+ * emergency-stop button, board_init() and board_fatal(). Boards: nucleo_f446re/board.c and
+ * nucleo_g474re/board.c (firmware against ST's HAL, `make firmware`), board_stub.c (the link
+ * check against the HAL stub, `make arm`). In a CubeMX project the generated code provides
+ * the same handles. */
 #ifndef J288_EXAMPLE_BOARD_H
 #define J288_EXAMPLE_BOARD_H
 
-#include "main.h"
+#include <stdbool.h>
+#include <stdint.h>
 
-#define ESTOP_GPIO_PORT GPIOC
-#define ESTOP_PIN ((uint16_t)0x2000u) /* PC13 */
+#include "main.h"
 
 extern UART_HandleTypeDef huart1;
 extern DMA_HandleTypeDef hdma_usart1_tx;
@@ -14,7 +17,19 @@ extern DMA_HandleTypeDef hdma_usart1_rx;
 extern TIM_HandleTypeDef htim2;
 extern CRC_HandleTypeDef hcrc;
 
+/* What the fault handler records (read it with a debugger: `p board_fault`). */
+typedef struct {
+    uint32_t cfsr, hfsr, mmfar, bfar; /* SCB fault status and address registers */
+    uint32_t pc, lr;                  /* where the fault happened */
+    uint32_t count;
+} board_fault_t;
+extern volatile board_fault_t board_fault;
+
+/* Clocks, pins, DMA, NVIC, UART, timer, CRC unit; board_fatal() on any failure. */
 void board_init(void);
+/* The emergency-stop button (the NUCLEO's blue button B1 on PC13) is pressed. */
+bool board_estop_pressed(void);
+/* Interrupts off, stop here (the servos lock themselves after their 1 s watchdog). */
 void board_fatal(void);
 
 #endif /* J288_EXAMPLE_BOARD_H */

@@ -1,14 +1,14 @@
 /*
- * j288 firmware example for an STM32F4-class board (STM32F405/407 at 168 MHz):
- * a 1 kHz control loop over four servos (ids 0-3) on one bus, with the cycle scheduler,
- * the CRC unit as the frame CRC, and a safe stop.
+ * j288 firmware example: a 1 kHz control loop over four servos (ids 0-3) on one bus, with the
+ * cycle scheduler, the CRC unit as the frame CRC, and a safe stop. The same file runs on each
+ * board (board.h): NUCLEO-F446RE (nucleo_f446re/board.c, the reference board), NUCLEO-G474RE
+ * (nucleo_g474re/board.c); `make firmware` builds both against ST's HAL.
  *
- * Hardware (as configured in board.c, the part CubeMX would generate):
- *   USART1 in single-wire half-duplex mode on PA9, 6 Mbps (8x oversampling from the 84 MHz
- *   APB2 clock), DMA2 Stream7 (TX) and Stream2 (RX), normal mode, byte width;
- *   TIM2 free running at 1 MHz (32 bits): the microsecond tick and, on channel 1, the reply
- *   timeout; the CRC unit in its reset configuration; an emergency-stop button on PC13
- *   (active low).
+ * Hardware (as configured in the board file, the part CubeMX would generate):
+ *   USART1 in single-wire half-duplex mode on PA9 (Arduino D8) at exactly 6 Mbps, a DMA
+ *   stream/channel each way, normal mode, byte width; TIM2 free running at 1 MHz (32 bits):
+ *   the microsecond tick and, on channel 1, the reply timeout; the CRC unit in its reset
+ *   configuration; the blue user button B1 (PC13) as emergency stop.
  *
  * Loop: every 1000 us the main loop writes the four commands (a slow 0.5 Hz sweep of +-0.2 rad
  * at the output shaft around each servo's starting position) and starts a sweep; the sweep
@@ -126,11 +126,6 @@ static int write_commands(uint32_t now_us)
     return rc;
 }
 
-static bool estop_button_pressed(void)
-{
-    return HAL_GPIO_ReadPin(ESTOP_GPIO_PORT, ESTOP_PIN) == GPIO_PIN_RESET;
-}
-
 /* Broadcast lock now, and again every STOP_REPEAT_US, forever. */
 static void safe_stop_forever(void)
 {
@@ -184,7 +179,7 @@ int main(void)
     for (;;) {
         uint32_t now = j288_stm32_now_us(&bus1);
 
-        if (stop_requested || estop_button_pressed()) {
+        if (stop_requested || board_estop_pressed()) {
             safe_stop_forever();
         }
         j288_sched_poll(&sched, now);

@@ -7,6 +7,17 @@
 #include "j288/crc32.h"
 #include "j288/frame.h"
 
+/* Cache maintenance needs a core with a data cache: CMSIS declares SCB_CleanDCache_by_Addr()
+ * and friends only where the device header sets __DCACHE_PRESENT (Cortex-M7). */
+#if defined(__DCACHE_PRESENT) && (__DCACHE_PRESENT == 1U)
+#define J288_STM32_CACHE_OPS J288_STM32_DCACHE
+#else
+#define J288_STM32_CACHE_OPS 0
+#if J288_STM32_DCACHE
+#error "J288_STM32_DCACHE=1 needs a core with a data cache (Cortex-M7: __DCACHE_PRESENT = 1 in the device header); this device has none, so set J288_STM32_DCACHE=0"
+#endif
+#endif
+
 /* Compile-time checks (C99: a negative array size fails the build). */
 typedef char j288_stm32_rx_holds_reply[(J288_STM32_RX_BUF_SIZE > J288_REPLY_LEN) ? 1 : -1];
 typedef char j288_stm32_rx_whole_lines[(J288_STM32_RX_BUF_SIZE % J288_STM32_DCACHE_LINE) == 0u ? 1 : -1];
@@ -28,18 +39,21 @@ static j288_stm32_t *find_uart(const UART_HandleTypeDef *huart)
     return NULL;
 }
 
-static void hal_check(j288_stm32_t *p, HAL_StatusTypeDef st)
+/* Counts a failure; returns whether the call succeeded. */
+static bool hal_ok(j288_stm32_t *p, HAL_StatusTypeDef st)
 {
     if (st != HAL_OK) {
         p->stats.hal_failures++;
+        return false;
     }
+    return true;
 }
 
 /* ---- cache maintenance (Cortex-M7 D-cache) ---------------------------------------------- */
 
 static void cache_clean(void *buf, size_t len)
 {
-#if J288_STM32_DCACHE
+#if J288_STM32_CACHE_OPS
     SCB_CleanDCache_by_Addr(buf, (int32_t)len);
 #else
     (void)buf;
@@ -49,7 +63,7 @@ static void cache_clean(void *buf, size_t len)
 
 static void cache_invalidate(void *buf, size_t len)
 {
-#if J288_STM32_DCACHE
+#if J288_STM32_CACHE_OPS
     SCB_InvalidateDCache_by_Addr(buf, (int32_t)len);
 #else
     (void)buf;
@@ -82,20 +96,56 @@ static void de_write(const j288_stm32_t *p, bool active)
     }
 }
 
+/* A transfer that never completed (a stalled stream, a lost TC or DMA interrupt) leaves the
+ * UART BUSY_TX and the stream's handle BUSY. The next HAL_UART_Transmit_DMA would then fail,
+ * or on the F4, whose HAL ignores HAL_DMA_Start_IT's result, return HAL_OK and send nothing;
+ * the same goes for a reception. So a path left busy is aborted first: the UART's abort, and
+ * the stream's own when the UART's did not reach it (the HAL aborts the stream only while
+ * the UART's DMA request bit is set). Returns whether the stream is ready. */
+static bool stream_ready(j288_stm32_t *p, j288_dir_t dir)
+{
+    UART_HandleTypeDef *h = p->cfg.huart;
+    DMA_HandleTypeDef *hdma = (dir == J288_DIR_TX) ? h->hdmatx : h->hdmarx;
+    bool uart_busy = (dir == J288_DIR_TX) && (h->gState != HAL_UART_STATE_READY);
+
+    if (!uart_busy && (HAL_DMA_GetState(hdma) == HAL_DMA_STATE_READY)) {
+        return true;
+    }
+    p->stats.dma_resets++;
+    (void)hal_ok(p, (dir == J288_DIR_TX) ? HAL_UART_AbortTransmit(h) : HAL_UART_AbortReceive(h));
+    if (HAL_DMA_GetState(hdma) != HAL_DMA_STATE_READY) {
+        (void)hal_ok(p, HAL_DMA_Abort(hdma));
+    }
+    return HAL_DMA_GetState(hdma) == HAL_DMA_STATE_READY;
+}
+
+static bool tx_path_ready(j288_stm32_t *p)
+{
+    UART_HandleTypeDef *h = p->cfg.huart;
+    return stream_ready(p, J288_DIR_TX) && (h->gState == HAL_UART_STATE_READY);
+}
+
 /* Single-wire mode: the transmitter and receiver share the pin, so the receiver is switched
- * off while we talk (no echo to discard) and the reception still armed from the last
- * transaction is abandoned first: anything it would still deliver is stale. */
+ * off while we talk (no echo: init refuses config.echo) and the reception still armed from
+ * the last transaction is abandoned first: anything it would still deliver is stale. A HAL
+ * failure here cannot be returned (set_dir has no result): the following start_tx refuses,
+ * so the attempt fails as J288_ERR_PORT; on the way to receive it is reported as a line
+ * error (J288_LINE_DMA), so the attempt fails as J288_ERR_LINE instead of timing out
+ * silently. */
 static void op_set_dir(void *ctx, j288_dir_t dir)
 {
     j288_stm32_t *p = ctx;
     p->dir = (uint8_t)dir;
     if (dir == J288_DIR_TX) {
-        hal_check(p, HAL_UART_AbortReceive(p->cfg.huart));
-        hal_check(p, HAL_HalfDuplex_EnableTransmitter(p->cfg.huart));
-        de_write(p, true);
+        bool ok = hal_ok(p, HAL_UART_AbortReceive(p->cfg.huart));
+        ok = ok && hal_ok(p, HAL_HalfDuplex_EnableTransmitter(p->cfg.huart));
+        p->tx_refused = !ok;
+        de_write(p, ok);
     } else {
         de_write(p, false);
-        hal_check(p, HAL_HalfDuplex_EnableReceiver(p->cfg.huart));
+        if (!hal_ok(p, HAL_HalfDuplex_EnableReceiver(p->cfg.huart))) {
+            j288_bus_on_error(&p->bus, J288_LINE_DMA);
+        }
     }
 }
 
@@ -105,12 +155,14 @@ static int op_start_tx(void *ctx, const uint8_t *data, size_t len)
     if ((data == NULL) || (len == 0u) || (len > J288_STM32_TX_BUF_SIZE)) {
         return J288_ERR_BAD_ARG;
     }
+    if (p->tx_refused || !tx_path_ready(p)) {
+        return J288_ERR_PORT; /* counted in hal_failures where it failed */
+    }
     /* Copy into the DMA buffer: the bus object may sit where the DMA cannot read. */
     memcpy(p->cfg.dma->tx, data, len);
     cache_clean(p->cfg.dma->tx, J288_STM32_TX_BUF_SIZE);
     p->stats.tx_frames++;
-    if (HAL_UART_Transmit_DMA(p->cfg.huart, p->cfg.dma->tx, (uint16_t)len) != HAL_OK) {
-        p->stats.hal_failures++;
+    if (!hal_ok(p, HAL_UART_Transmit_DMA(p->cfg.huart, p->cfg.dma->tx, (uint16_t)len))) {
         return J288_ERR_PORT;
     }
     return J288_OK;
@@ -118,13 +170,17 @@ static int op_start_tx(void *ctx, const uint8_t *data, size_t len)
 
 static void rx_arm(j288_stm32_t *p)
 {
+    UART_HandleTypeDef *h = p->cfg.huart;
+    /* As for transmit: a stream left busy would make the F4 HAL "start" a reception that
+     * never receives; a stream that cannot be made ready is the line error reported below. */
+    bool ready = stream_ready(p, J288_DIR_RX);
+
     p->rx_pos = 0u;
     /* Drop cached copies before the DMA writes, so that no dirty line is evicted on top of
      * received bytes later. */
     cache_invalidate(p->cfg.dma->rx, J288_STM32_RX_BUF_SIZE);
-    if (HAL_UARTEx_ReceiveToIdle_DMA(p->cfg.huart, p->cfg.dma->rx,
-                                     (uint16_t)J288_STM32_RX_BUF_SIZE) != HAL_OK) {
-        p->stats.hal_failures++;
+    if (!ready ||
+        !hal_ok(p, HAL_UARTEx_ReceiveToIdle_DMA(h, p->cfg.dma->rx, (uint16_t)J288_STM32_RX_BUF_SIZE))) {
         j288_bus_on_error(&p->bus, J288_LINE_DMA);
     }
 }
@@ -145,6 +201,17 @@ static uint32_t channel_it(uint32_t channel)
     }
 }
 
+static uint32_t channel_egr(uint32_t channel)
+{
+    switch (channel) {
+    case TIM_CHANNEL_1: return TIM_EGR_CC1G;
+    case TIM_CHANNEL_2: return TIM_EGR_CC2G;
+    case TIM_CHANNEL_3: return TIM_EGR_CC3G;
+    case TIM_CHANNEL_4: return TIM_EGR_CC4G;
+    default: return 0u;
+    }
+}
+
 static HAL_TIM_ActiveChannel channel_active(uint32_t channel)
 {
     switch (channel) {
@@ -156,30 +223,51 @@ static HAL_TIM_ActiveChannel channel_active(uint32_t channel)
     }
 }
 
+/* Ticks from `from` to `to` on a counter that wraps after arr. */
+static uint32_t ticks_between(uint32_t from, uint32_t to, uint32_t arr)
+{
+    uint32_t d = to - from;
+    return ((arr == 0xFFFFFFFFu) || (to >= from)) ? d : d + arr + 1u;
+}
+
 /* The timer counts at 1 MHz, free running (maybe 16 bits): the compare goes delay ticks
  * ahead of the counter, modulo its period, whatever clock now_us comes from. A delay longer
  * than the period is cut to one period; on_timer then sees that the deadline has not passed
- * and sets the compare again for the rest. */
+ * and sets the compare again for the rest.
+ * The counter runs on while this executes (1 us is a few hundred instructions, and delays of
+ * 1-2 us happen: the default guard is 2 us). So the old flag is cleared BEFORE the compare is
+ * written (a match after the write then stays seen), and once armed the counter is read again:
+ * if it may have passed the compare before the write took effect, or the deadline is already
+ * due, the compare event is generated by software (EGR) rather than waiting a whole timer
+ * period (65.5 ms at 16 bits, 71.6 minutes at 32) for the next match. An extra event only
+ * costs a re-arm in on_timer. */
 static void timer_set(j288_stm32_t *p, uint32_t deadline_us)
 {
     TIM_HandleTypeDef *htim = p->cfg.htim;
     uint32_t it = channel_it(p->cfg.tim_channel);
-    int32_t delay = (int32_t)(deadline_us - now_of(p));
     uint32_t arr = (uint32_t)__HAL_TIM_GET_AUTORELOAD(htim);
-    uint32_t ticks = (delay < 1) ? 1u : (uint32_t)delay;
-    uint32_t cmp;
+    int32_t delay;
+    uint32_t ticks, start, cmp;
 
-    if ((arr != 0xFFFFFFFFu) && (ticks > arr)) {
-        ticks = arr;
+    __HAL_TIM_DISABLE_IT(htim, it);
+    __HAL_TIM_CLEAR_FLAG(htim, it); /* TIM_FLAG_CCn has the same bit as TIM_IT_CCn */
+    delay = (int32_t)(deadline_us - now_of(p));
+    if (delay < 1) {
+        htim->Instance->EGR = channel_egr(p->cfg.tim_channel); /* due already */
+        __HAL_TIM_ENABLE_IT(htim, it);
+        return;
     }
-    cmp = (uint32_t)__HAL_TIM_GET_COUNTER(htim) + ticks;
-    if ((arr != 0xFFFFFFFFu) && (cmp > arr)) {
+    ticks = ((arr != 0xFFFFFFFFu) && ((uint32_t)delay > arr)) ? arr : (uint32_t)delay;
+    start = (uint32_t)__HAL_TIM_GET_COUNTER(htim);
+    cmp = start + ticks;
+    if ((arr != 0xFFFFFFFFu) && ((cmp > arr) || (cmp < start))) {
         cmp -= arr + 1u;
     }
-    __HAL_TIM_DISABLE_IT(htim, it);
     __HAL_TIM_SET_COMPARE(htim, p->cfg.tim_channel, cmp);
-    __HAL_TIM_CLEAR_FLAG(htim, it); /* TIM_FLAG_CCn has the same bit as TIM_IT_CCn */
     __HAL_TIM_ENABLE_IT(htim, it);
+    if (ticks_between(start, (uint32_t)__HAL_TIM_GET_COUNTER(htim), arr) >= ticks) {
+        htim->Instance->EGR = channel_egr(p->cfg.tim_channel);
+    }
 }
 
 /* The deadline is stored before the compare is written, so a compare interrupt taken in
@@ -215,69 +303,85 @@ static void op_unlock(void *ctx)
     __set_PRIMASK(p->lock_saved);
 }
 
-static const j288_port_t port_plain = {
-    .start_tx = op_start_tx,
-    .now_us = op_now_us,
-    .start_rx = op_start_rx,
-    .set_dir = op_set_dir,
-    .lock = op_lock,
-    .unlock = op_unlock,
-};
-
-static const j288_port_t port_timer = {
+/* The one operations table. Each bus gets a copy (j288_stm32_t.ops) without the optional
+ * operations its configuration lacks: no timer, no arm_timeout (the application polls); no
+ * CRC unit, no crc32 (the library's compile-time backend). */
+static const j288_port_t port_ops = {
     .start_tx = op_start_tx,
     .now_us = op_now_us,
     .start_rx = op_start_rx,
     .set_dir = op_set_dir,
     .arm_timeout = op_arm_timeout,
-    .lock = op_lock,
-    .unlock = op_unlock,
-};
-
 #if J288_STM32_HW_CRC
-static const j288_port_t port_plain_crc = {
-    .start_tx = op_start_tx,
-    .now_us = op_now_us,
-    .start_rx = op_start_rx,
-    .set_dir = op_set_dir,
     .crc32 = op_crc32,
-    .lock = op_lock,
-    .unlock = op_unlock,
-};
-
-static const j288_port_t port_timer_crc = {
-    .start_tx = op_start_tx,
-    .now_us = op_now_us,
-    .start_rx = op_start_rx,
-    .set_dir = op_set_dir,
-    .arm_timeout = op_arm_timeout,
-    .crc32 = op_crc32,
-    .lock = op_lock,
-    .unlock = op_unlock,
-};
 #endif
+    .lock = op_lock,
+    .unlock = op_unlock,
+};
 
-static const j288_port_t *pick_ops(const j288_stm32_config_t *cfg)
+static void pick_ops(j288_stm32_t *p)
 {
-    bool timer = cfg->htim != NULL;
+    p->ops = port_ops;
+    if (p->cfg.htim == NULL) {
+        p->ops.arm_timeout = NULL;
+    }
 #if J288_STM32_HW_CRC
-    if (cfg->hcrc != NULL) {
-        return timer ? &port_timer_crc : &port_plain_crc;
+    if (p->cfg.hcrc == NULL) {
+        p->ops.crc32 = NULL;
     }
 #endif
-    return timer ? &port_timer : &port_plain;
 }
 
 /* ---- lifecycle -------------------------------------------------------------------------- */
 
-static int check_config(const j288_stm32_config_t *cfg)
+#if J288_STM32_HW_CRC
+/* Families with a configurable unit (G4, H7, F7, L4, ...; their HAL defines the input
+ * formats) compute whatever the handle says: it must say the unit's reset configuration. */
+static bool crc_handle_is_servo_crc(const CRC_HandleTypeDef *hcrc)
+{
+#if defined(CRC_INPUTDATA_FORMAT_WORDS)
+    const CRC_InitTypeDef *in = &hcrc->Init;
+    bool poly = (in->DefaultPolynomialUse == DEFAULT_POLYNOMIAL_ENABLE) ||
+                ((in->GeneratingPolynomial == 0x04C11DB7u) && (in->CRCLength == CRC_POLYLENGTH_32B));
+    bool init = (in->DefaultInitValueUse == DEFAULT_INIT_VALUE_ENABLE) || (in->InitValue == 0xFFFFFFFFu);
+    return poly && init && (hcrc->InputDataFormat == CRC_INPUTDATA_FORMAT_WORDS) &&
+           (in->InputDataInversionMode == CRC_INPUTDATA_INVERSION_NONE) &&
+           (in->OutputDataInversionMode == CRC_OUTPUTDATA_INVERSION_DISABLE);
+#else
+    (void)hcrc; /* the F4-class unit has one fixed configuration */
+    return true;
+#endif
+}
+
+/* A known answer from the unit itself: catches what no handle field shows (the unit's clock
+ * off, HAL_CRC_Init never called, registers reprogrammed by other code). */
+static bool crc_unit_is_servo_crc(CRC_HandleTypeDef *hcrc)
+{
+    static const uint8_t probe[8] = {0x6a, 0x32, 0x38, 0x38, 0xfe, 0xee, 0x00, 0x5a};
+    return crc_handle_is_servo_crc(hcrc) &&
+           (j288_stm32_crc32(hcrc, probe, 2u) == j288_crc32_update_bitwise(J288_CRC32_INIT, probe, 2u));
+}
+#endif
+
+static int check_config(const j288_stm32_config_t *cfg, const j288_bus_config_t *bus_cfg)
 {
     if ((cfg->huart == NULL) || (cfg->dma == NULL)) {
         return J288_ERR_NULL;
     }
+    if ((cfg->huart->hdmatx == NULL) || (cfg->huart->hdmarx == NULL)) {
+        return J288_ERR_BAD_CONFIG; /* the UART has no DMA streams linked */
+    }
+    if ((bus_cfg != NULL) && bus_cfg->echo) {
+        return J288_ERR_BAD_CONFIG; /* the receiver is off while we transmit */
+    }
     if ((cfg->htim != NULL) && (channel_it(cfg->tim_channel) == 0u)) {
         return J288_ERR_BAD_CONFIG;
     }
+#if J288_STM32_HW_CRC
+    if ((cfg->hcrc != NULL) && !crc_unit_is_servo_crc(cfg->hcrc)) {
+        return J288_ERR_BAD_CONFIG;
+    }
+#endif
     if (cfg->now_us == NULL) {
         if ((cfg->htim == NULL) || (__HAL_TIM_GET_AUTORELOAD(cfg->htim) != 0xFFFFFFFFu)) {
             return J288_ERR_BAD_CONFIG;
@@ -295,7 +399,7 @@ int j288_stm32_init(j288_stm32_t *p, const j288_stm32_config_t *cfg,
     if ((p == NULL) || (cfg == NULL)) {
         return J288_ERR_NULL;
     }
-    rc = check_config(cfg);
+    rc = check_config(cfg, bus_cfg);
     if (rc != J288_OK) {
         return rc;
     }
@@ -314,14 +418,19 @@ int j288_stm32_init(j288_stm32_t *p, const j288_stm32_config_t *cfg,
 
     memset(p, 0, sizeof *p);
     p->cfg = *cfg;
-    rc = j288_bus_init(&p->bus, pick_ops(cfg), p, bus_cfg);
+    pick_ops(p);
+    rc = j288_bus_init(&p->bus, &p->ops, p, bus_cfg);
     if (rc != J288_OK) {
         return rc;
     }
     if (cfg->htim != NULL) {
         __HAL_TIM_DISABLE_IT(cfg->htim, channel_it(cfg->tim_channel));
     }
-    op_set_dir(p, J288_DIR_RX);
+    p->dir = (uint8_t)J288_DIR_RX;
+    de_write(p, false);
+    if (!hal_ok(p, HAL_HalfDuplex_EnableReceiver(cfg->huart))) {
+        return J288_ERR_PORT;
+    }
     registry[free_slot] = p;
     return J288_OK;
 }
@@ -369,10 +478,24 @@ bool j288_stm32_on_tx_cplt(UART_HandleTypeDef *huart)
     return true;
 }
 
+/* Hand the bus the bytes at [from, to) of the receive buffer. */
+static void rx_deliver(j288_stm32_t *p, uint16_t from, uint16_t to)
+{
+    cache_invalidate(p->cfg.dma->rx, J288_STM32_RX_BUF_SIZE);
+    j288_bus_on_rx(&p->bus, &p->cfg.dma->rx[from], (size_t)(to - from));
+    p->stats.rx_bytes += (uint32_t)(to - from);
+}
+
 /* ReceiveToIdle reports the fill level of the buffer, not a delta: half-transfer, idle and
- * full events of one reception each give the position reached so far. The reception has
- * ended (idle or full) when the HAL's RxState is no longer BUSY_RX; in receive direction it
- * is re-armed at once, so that a reply split by a gap is still heard whole. */
+ * full events each give the position reached in the buffer so far.
+ * Normal-mode stream: the reception ends at an idle line or a full buffer (the HAL's RxState
+ * is then no longer BUSY_RX) and is re-armed at once in receive direction; a byte arriving
+ * during that re-arm (a few microseconds after the idle flag) is lost, and its reply is then
+ * TRUNCATED at the deadline.
+ * Circular-mode stream (recommended): the reception never ends, an idle line only reports
+ * the position, and the buffer wraps after a full event; a pause inside a reply loses
+ * nothing. Either way an idle line never ends the transaction (j288_bus_on_rx_idle is a
+ * no-op): the bus keeps a frame in progress until the deadline. */
 bool j288_stm32_on_rx_event(UART_HandleTypeDef *huart, uint16_t size)
 {
     j288_stm32_t *p = find_uart(huart);
@@ -388,12 +511,14 @@ bool j288_stm32_on_rx_event(UART_HandleTypeDef *huart, uint16_t size)
     if (size > J288_STM32_RX_BUF_SIZE) {
         size = (uint16_t)J288_STM32_RX_BUF_SIZE; /* never trust a count beyond the buffer */
     }
-    if (size > pos) {
-        cache_invalidate(p->cfg.dma->rx, J288_STM32_RX_BUF_SIZE);
-        j288_bus_on_rx(&p->bus, &p->cfg.dma->rx[pos], (size_t)(size - pos));
-        p->stats.rx_bytes += (uint32_t)(size - pos);
-        p->rx_pos = size;
+    if (size < pos) { /* circular: wrapped without a full event (a missed interrupt) */
+        rx_deliver(p, pos, (uint16_t)J288_STM32_RX_BUF_SIZE);
+        pos = 0u;
     }
+    if (size > pos) {
+        rx_deliver(p, pos, size);
+    }
+    p->rx_pos = (size < J288_STM32_RX_BUF_SIZE) ? size : 0u; /* full: a circular stream wraps */
     if (ended) {
         if (size < J288_STM32_RX_BUF_SIZE) {
             j288_bus_on_rx_idle(&p->bus);

@@ -3,10 +3,13 @@
  * half-duplex mode, DMA both ways, idle-line reception, optional DE pin, response timeout
  * from a timer compare channel, and the CRC unit as the frame CRC.
  *
- * What the application does (see examples/stm32_hal/ and docs/porting.md):
+ * What the application does (see examples/stm32_hal/, docs/stm32.md and docs/porting.md):
  *  - configures each UART with HAL_HalfDuplex_Init() at the bus baud (6 Mbps), 8N1, with a
- *    DMA stream for TX and one for RX (both normal mode, byte width), and enables the UART
- *    and both DMA stream interrupts at ONE priority (also the timer's, when advance_in_isr);
+ *    DMA stream for TX (normal mode) and one for RX (circular mode recommended: a pause
+ *    inside a reply then loses nothing; normal mode works, but a byte arriving while the
+ *    port re-arms after an idle line, a few microseconds, is lost), byte width, both linked
+ *    to the UART handle (hdmatx, hdmarx), and enables the UART and both DMA stream
+ *    interrupts at ONE priority (also the timer's, when advance_in_isr);
  *  - declares the DMA buffers with J288_STM32_DMA_BUFFER() in RAM the DMA can reach;
  *  - calls j288_stm32_init() per bus, then forwards from its own HAL callbacks (the port
  *    never defines the HAL's weak callbacks):
@@ -22,6 +25,15 @@
  *
  * Interrupt context: every j288_stm32_on_* function is ISR-safe and is meant to be called from
  * the HAL callbacks above (i.e. from the UART/DMA/timer IRQ). init/deinit are thread only.
+ *
+ * Pauses: an idle line inside a reply never ends the transaction (bus.h): the port keeps
+ * receiving, and a frame still incomplete at the deadline is J288_ERR_TRUNCATED.
+ * HAL failures: every one is counted (hal_failures) and ends the attempt with an error the
+ * application sees: J288_ERR_PORT when the line could not be turned to transmit or the
+ * transmit not started, J288_ERR_LINE (flag J288_LINE_DMA) when the turn to receive or the
+ * reception could not be started. A transfer left running by an earlier transaction (a lost
+ * completion interrupt) is aborted before the next one (dma_resets), so the next
+ * transaction works.
  */
 #ifndef J288_STM32_H
 #define J288_STM32_H
@@ -131,21 +143,26 @@ typedef struct {
     bool de_active_low;
 
     /* Time. now_us: the application's monotonic microsecond tick (any context, wraps at
-     * 2^32). When NULL, htim's counter is the tick; it must then count at 1 MHz with a 32-bit
+     * 2^32); pass the same clock to submit and poll (j288_stm32_now_us()). When NULL, htim's counter is the tick; it must then count at 1 MHz with a 32-bit
      * reload of 0xFFFFFFFF (TIM2/TIM5 on the F4), which init checks. */
     uint32_t (*now_us)(void);
 
     /* Optional response timeout: a timer counting at 1 MHz, started by the application
      * (HAL_TIM_Base_Start), whose capture/compare channel tim_channel (TIM_CHANNEL_1..4) is
-     * free and in its reset (frozen output compare) mode. The port writes the compare value
-     * and enables that channel's interrupt; forward HAL_TIM_OC_DelayElapsedCallback to
+     * free and in its reset (frozen output compare) mode. The port writes the compare value,
+     * enables that channel's interrupt and, for a deadline already due, raises the channel's
+     * event through the timer's EGR; forward HAL_TIM_OC_DelayElapsedCallback to
      * j288_stm32_on_timer(). Several buses may share one timer on different channels. NULL:
      * no timer; call j288_bus_poll() (or j288_sched_poll()) often enough yourself. */
     TIM_HandleTypeDef *htim;
     uint32_t tim_channel;
 
     /* Optional CRC unit in its reset configuration (J288_STM32_HW_CRC = 1): polynomial
-     * 0x04C11DB7, initial value 0xFFFFFFFF, no reversal, 32-bit input. NULL: software CRC. */
+     * 0x04C11DB7, initial value 0xFFFFFFFF, no reversal, 32-bit input; on families with a
+     * configurable unit (G4, H7, F7, L4...) the handle must say so: InputDataFormat =
+     * CRC_INPUTDATA_FORMAT_WORDS, default polynomial and initial value (or the same values
+     * spelled out), no input or output inversion. Initialised (HAL_CRC_Init) before
+     * j288_stm32_init(). NULL: software CRC. */
     CRC_HandleTypeDef *hcrc;
 } j288_stm32_config_t;
 
@@ -156,6 +173,8 @@ typedef struct {
     uint32_t rx_bytes;     /* bytes handed to the bus */
     uint32_t line_errors;  /* error callbacks */
     uint32_t hal_failures; /* HAL calls that did not return HAL_OK */
+    uint32_t dma_resets;   /* transfers found still running from an earlier transaction and
+                              aborted before the next (a lost TX complete or DMA interrupt) */
     uint32_t timer_events; /* compare interrupts taken (timer_rearms included) */
     uint32_t timer_rearms; /* of those, early ones (before the deadline): re-armed for the
                               rest, the bus not called */
@@ -165,9 +184,11 @@ typedef struct {
  * registered. Private: use the functions below. */
 typedef struct j288_stm32 {
     j288_bus_t bus;
+    j288_port_t ops; /* the port's operations, as this configuration uses them */
     j288_stm32_config_t cfg;
     volatile uint16_t rx_pos;  /* bytes of the current reception already handed out */
     volatile uint8_t dir;      /* j288_dir_t last set */
+    volatile bool tx_refused;  /* the turn to transmit failed: start_tx refuses */
     uint32_t lock_saved;
     volatile uint32_t tim_deadline; /* last arm_timeout deadline (now_us clock) */
     j288_stm32_stats_t stats;
@@ -178,8 +199,15 @@ typedef struct j288_stm32 {
 /* Set up p, register it and initialise its bus (j288_bus_init with bus_cfg, which may be
  * NULL for defaults). Leaves the line in receive direction with the DE pin inactive.
  * Errors: J288_ERR_NULL (p, cfg, huart or dma), J288_ERR_BUSY (this UART is registered
- * already, or J288_STM32_MAX_BUSES are), J288_ERR_BAD_CONFIG (no now_us and no 32-bit 1 MHz
- * timer; a bad tim_channel), or j288_bus_init()'s codes. Thread only. */
+ * already, or J288_STM32_MAX_BUSES are), J288_ERR_BAD_CONFIG for any of:
+ *   - no now_us and no 32-bit 1 MHz timer, or a tim_channel that is no TIM_CHANNEL_n;
+ *   - the UART handle has no DMA stream linked (hdmatx or hdmarx NULL);
+ *   - bus_cfg->echo: the receiver is off while the port transmits, so no echo can come;
+ *   - the CRC unit does not compute the servo's CRC: a handle in another configuration (see
+ *     hcrc above), or a unit that fails a known-answer check (its clock not enabled,
+ *     HAL_CRC_Init not called, registers reprogrammed by other code);
+ * J288_ERR_PORT (the HAL refused to turn the line to receive), or j288_bus_init()'s codes.
+ * Thread only. */
 int j288_stm32_init(j288_stm32_t *p, const j288_stm32_config_t *cfg,
                     const j288_bus_config_t *bus_cfg);
 
@@ -189,7 +217,9 @@ void j288_stm32_deinit(j288_stm32_t *p);
 /* The bus driven by p, for j288_bus_* and j288_sched_*. */
 j288_bus_t *j288_stm32_bus(j288_stm32_t *p);
 
-/* The microsecond tick p uses (its now_us, or the timer counter). Any context. */
+/* The microsecond tick p uses (its now_us, or the timer counter). Any context. This is the
+ * clock the bus reads in its event calls (advance_in_isr), so the now_us the application
+ * passes to j288_bus_submit/poll/estop and j288_sched_* must come from it too (bus.h). */
 uint32_t j288_stm32_now_us(const j288_stm32_t *p);
 
 const j288_stm32_stats_t *j288_stm32_stats(const j288_stm32_t *p);

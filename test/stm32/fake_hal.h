@@ -8,7 +8,10 @@
  *              ... fake_hal_rx_idle() -> HAL_UARTEx_RxEventCallback(fill level), reception ends
  *   error:     fake_hal_rx_error() -> reception aborted, ErrorCode set, HAL_UART_ErrorCallback
  *   timer:     fake_hal_tim_fire() -> HAL_TIM_OC_DelayElapsedCallback when the CC interrupt
- *              is enabled
+ *              is enabled; fake_hal_tim_run() runs the counter with compare matches, and
+ *              fake_hal_tim_advance_at() lets it run between any two register accesses
+ *   DMA:       a stream whose handle is not READY does not start, and (as the F4 HAL does)
+ *              the UART call still returns HAL_OK
  * The test defines the weak callbacks itself (as an application does) and forwards them to
  * the port. Bytes sent while the receiver is off (TX direction, or no reception armed) are
  * lost, as on the wire.
@@ -28,6 +31,8 @@ typedef enum {
     FAKE_TRANSMIT_DMA,
     FAKE_RECEIVE_TO_IDLE_DMA,
     FAKE_ABORT_RECEIVE,
+    FAKE_ABORT_TRANSMIT,
+    FAKE_DMA_ABORT,
     FAKE_GPIO_WRITE,
     FAKE_CRC_CALCULATE,
     FAKE_CRC_ACCUMULATE,
@@ -55,7 +60,7 @@ void fake_hal_log_clear(void);
 long fake_hal_log_find(fake_hal_fn_t fn, const void *handle, size_t from);
 unsigned fake_hal_count(fake_hal_fn_t fn);
 
-/* Make the next call of fn (TRANSMIT_DMA, RECEIVE_TO_IDLE_DMA, HALFDUPLEX_*) return
+/* Make the next call of fn (TRANSMIT_DMA, RECEIVE_TO_IDLE_DMA, HALFDUPLEX_*, ABORT_*) return
  * HAL_ERROR. */
 void fake_hal_fail_next(fake_hal_fn_t fn);
 
@@ -72,7 +77,12 @@ bool fake_hal_tx_complete(UART_HandleTypeDef *huart);
  * Returns how many bytes were stored. */
 size_t fake_hal_rx_bytes(UART_HandleTypeDef *huart, const uint8_t *data, size_t len);
 
-/* The line went idle: if the armed reception holds bytes, it ends with an RxEvent. */
+/* Receive streams in circular mode (true) from now on: a full buffer wraps with an RxEvent of
+ * the full size and an idle line reports the position; the reception never ends by itself. */
+void fake_hal_rx_circular(bool on);
+
+/* The line went idle: if the armed reception holds bytes, it ends with an RxEvent (circular:
+ * it reports the position and goes on). */
 bool fake_hal_rx_idle(UART_HandleTypeDef *huart);
 
 /* A receive error (HAL_UART_ERROR_* bits) in DMA mode: the HAL aborts the reception, then
@@ -86,6 +96,21 @@ bool fake_hal_transmitter_on(const UART_HandleTypeDef *huart);
 /* Capture/compare channel ch (TIM_CHANNEL_n) matched: fires the OC callback if its interrupt
  * is enabled. Returns whether it fired. */
 bool fake_hal_tim_fire(TIM_HandleTypeDef *htim, uint32_t ch);
+
+/* The timer as the silicon runs it: every register access the port makes goes through the
+ * HAL macros (stub_tim_read/stub_tim_write); before access number `access` from now
+ * (0 = the next one) the counter runs `ticks` ticks, raising the flag of each channel whose
+ * compare value it reaches. One shot. */
+void fake_hal_tim_advance_at(TIM_HandleTypeDef *htim, unsigned access, uint32_t ticks);
+/* Timer register accesses since the last reset. */
+unsigned fake_hal_tim_accesses(void);
+/* Run the counter ticks ticks; whenever a compare flag is up with its interrupt enabled (also
+ * before the first tick), do what HAL_TIM_IRQHandler does: clear it, call the OC callback.
+ * Returns the callbacks made. */
+unsigned fake_hal_tim_run(TIM_HandleTypeDef *htim, uint32_t ticks);
+
+/* The CRC unit's clock off (true): it reads as zeros, as an unclocked peripheral does. */
+void fake_hal_crc_unclocked(bool off);
 
 /* Level last written to a GPIO pin (0/1), or -1 if never written. */
 int fake_hal_gpio_level(const GPIO_TypeDef *port, uint16_t pin);

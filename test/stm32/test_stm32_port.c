@@ -8,6 +8,7 @@
  */
 #include "unity.h"
 
+#include <stdio.h>
 #include <string.h>
 
 #include "fake_hal.h"
@@ -37,6 +38,7 @@ static const uint8_t k_lock_broadcast_head[3] = {0xfe, 0xee, 0x8f};
 
 static USART_TypeDef usart1_regs, usart2_regs;
 static UART_HandleTypeDef huart1, huart2, huart_other;
+static DMA_HandleTypeDef hdma1_tx, hdma1_rx, hdma2_tx, hdma2_rx;
 static TIM_TypeDef tim2_regs;
 static TIM_HandleTypeDef htim2;
 static CRC_TypeDef crc_regs;
@@ -95,12 +97,18 @@ void setUp(void)
     huart1.Instance = &usart1_regs;
     huart2.Instance = &usart2_regs;
     huart_other.Instance = &usart2_regs;
+    huart1.hdmatx = &hdma1_tx;
+    huart1.hdmarx = &hdma1_rx;
+    huart2.hdmatx = &hdma2_tx;
+    huart2.hdmarx = &hdma2_rx;
     (void)HAL_HalfDuplex_Init(&huart1);
     (void)HAL_HalfDuplex_Init(&huart2);
     (void)HAL_HalfDuplex_Init(&huart_other);
     htim2.Instance = &tim2_regs;
     tim2_regs.ARR = 0xFFFFFFFFu;
+    memset(&hcrc, 0, sizeof hcrc);
     hcrc.Instance = &crc_regs;
+    hcrc.InputDataFormat = CRC_INPUTDATA_FORMAT_WORDS; /* what CubeMX sets: the reset unit */
     fake_now = 1000u;
     done_count = 0;
     memset(&last_txn, 0, sizeof last_txn);
@@ -185,9 +193,12 @@ static void test_registry_is_bounded(void)
     static j288_stm32_t extra[J288_STM32_MAX_BUSES + 1u];
     static UART_HandleTypeDef uarts[J288_STM32_MAX_BUSES + 1u];
     static j288_stm32_dma_t J288_STM32_DMA_ALIGN bufs[J288_STM32_MAX_BUSES + 1u];
+    static DMA_HandleTypeDef streams[2u * (J288_STM32_MAX_BUSES + 1u)];
     for (size_t i = 0; i <= J288_STM32_MAX_BUSES; i++) {
         j288_stm32_config_t c = base_config(&uarts[i], &bufs[i]);
         uarts[i].Instance = &usart1_regs;
+        uarts[i].hdmatx = &streams[2u * i];
+        uarts[i].hdmarx = &streams[2u * i + 1u];
         (void)HAL_HalfDuplex_Init(&uarts[i]);
         TEST_ASSERT_EQUAL_INT(i < J288_STM32_MAX_BUSES ? J288_OK : J288_ERR_BUSY,
                               j288_stm32_init(&extra[i], &c, NULL));
@@ -572,6 +583,328 @@ static void test_bus_lock_masks_and_restores(void)
     TEST_ASSERT_EQUAL_UINT32(0u, fake_hal_primask());
 }
 
+
+/* ---- silicon races and HAL failures ----------------------------------------------------- */
+
+/* The timer is the tick (now_us NULL), so that the counter the test runs is the port's clock. */
+static void init_port1_timer_tick(const j288_bus_config_t *bus_cfg)
+{
+    j288_stm32_config_t c = base_config(&huart1, &dma1);
+    c.now_us = NULL;
+    c.htim = &htim2;
+    c.tim_channel = TIM_CHANNEL_1;
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_stm32_init(&port1, &c, bus_cfg));
+}
+
+static uint32_t timeouts_delivered(void)
+{
+    const j288_stm32_stats_t *st = j288_stm32_stats(&port1);
+    return st->timer_events - st->timer_rearms;
+}
+
+/* Arming a deadline a few ticks away while the counter runs: wherever between two register
+ * accesses the counter passes the new compare value, the timeout must still come, and soon
+ * (not one timer period later, which is 71 minutes on a 32-bit timer at 1 MHz). */
+static void test_timer_arm_races_the_counter_at_every_access(void)
+{
+    const j288_port_t *ops;
+    init_port1_timer_tick(NULL);
+    ops = j288_stm32_bus(&port1)->port;
+    for (uint32_t delay = 1u; delay <= 3u; delay++) {
+        for (uint32_t run = 1u; run <= 4u; run++) {
+            for (unsigned access = 0u; access < 24u; access++) {
+                char msg[64];
+                uint32_t before = timeouts_delivered();
+                tim2_regs.CNT = 5000u;
+                tim2_regs.SR = 0u;
+                fake_hal_tim_advance_at(&htim2, access, run);
+                ops->arm_timeout(&port1, 5000u + delay);
+                (void)fake_hal_tim_run(&htim2, delay + run + 2u);
+                snprintf(msg, sizeof msg, "delay %u, %u ticks before access %u", (unsigned)delay,
+                         (unsigned)run, access);
+                TEST_ASSERT_EQUAL_UINT32_MESSAGE(before + 1u, timeouts_delivered(), msg);
+            }
+        }
+    }
+}
+
+static void test_timer_deadline_already_passed_fires_at_once(void)
+{
+    init_port1_timer_tick(NULL);
+    tim2_regs.CNT = 5000u;
+    j288_stm32_bus(&port1)->port->arm_timeout(&port1, 4990u);
+    TEST_ASSERT_EQUAL_UINT(1u, fake_hal_tim_run(&htim2, 0u));
+    TEST_ASSERT_EQUAL_UINT32(1u, timeouts_delivered());
+}
+
+/* A CRC handle in another configuration would fail every frame as "bad CRC" with no hint. */
+static void test_init_rejects_crc_unit_not_in_the_servo_configuration(void)
+{
+    j288_stm32_config_t c = base_config(&huart1, &dma1);
+    static const uint32_t bad_formats[] = {CRC_INPUTDATA_FORMAT_UNDEFINED, CRC_INPUTDATA_FORMAT_BYTES,
+                                           CRC_INPUTDATA_FORMAT_HALFWORDS};
+    for (size_t i = 0; i < sizeof bad_formats / sizeof bad_formats[0]; i++) {
+        hcrc.InputDataFormat = bad_formats[i];
+        TEST_ASSERT_EQUAL_INT(J288_ERR_BAD_CONFIG, j288_stm32_init(&port1, &c, NULL));
+    }
+    hcrc.InputDataFormat = CRC_INPUTDATA_FORMAT_WORDS;
+    hcrc.Init.OutputDataInversionMode = CRC_OUTPUTDATA_INVERSION_ENABLE;
+    TEST_ASSERT_EQUAL_INT(J288_ERR_BAD_CONFIG, j288_stm32_init(&port1, &c, NULL));
+    hcrc.Init.OutputDataInversionMode = CRC_OUTPUTDATA_INVERSION_DISABLE;
+    hcrc.Init.InputDataInversionMode = CRC_INPUTDATA_INVERSION_BYTE;
+    TEST_ASSERT_EQUAL_INT(J288_ERR_BAD_CONFIG, j288_stm32_init(&port1, &c, NULL));
+    hcrc.Init.InputDataInversionMode = CRC_INPUTDATA_INVERSION_NONE;
+    hcrc.Init.DefaultPolynomialUse = DEFAULT_POLYNOMIAL_DISABLE;
+    hcrc.Init.GeneratingPolynomial = 0x1EDC6F41u; /* CRC-32C */
+    hcrc.Init.CRCLength = CRC_POLYLENGTH_32B;
+    TEST_ASSERT_EQUAL_INT(J288_ERR_BAD_CONFIG, j288_stm32_init(&port1, &c, NULL));
+    hcrc.Init.DefaultPolynomialUse = DEFAULT_POLYNOMIAL_ENABLE;
+    hcrc.Init.DefaultInitValueUse = DEFAULT_INIT_VALUE_DISABLE;
+    hcrc.Init.InitValue = 0u;
+    TEST_ASSERT_EQUAL_INT(J288_ERR_BAD_CONFIG, j288_stm32_init(&port1, &c, NULL));
+
+    /* the same CRC spelled out instead of by default is fine */
+    hcrc.Init.InitValue = 0xFFFFFFFFu;
+    hcrc.Init.DefaultPolynomialUse = DEFAULT_POLYNOMIAL_DISABLE;
+    hcrc.Init.GeneratingPolynomial = 0x04C11DB7u;
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_stm32_init(&port1, &c, NULL));
+}
+
+/* The handle may be right and the unit still not: e.g. its clock never enabled (the F4's
+ * handle has no fields to check). A known-answer check at init catches it. */
+static void test_init_rejects_crc_unit_that_computes_wrong(void)
+{
+    j288_stm32_config_t c = base_config(&huart1, &dma1);
+    fake_hal_crc_unclocked(true);
+    TEST_ASSERT_EQUAL_INT(J288_ERR_BAD_CONFIG, j288_stm32_init(&port1, &c, NULL));
+    fake_hal_crc_unclocked(false);
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_stm32_init(&port1, &c, NULL));
+}
+
+static void test_init_fails_when_the_line_cannot_receive(void)
+{
+    j288_stm32_config_t c = base_config(&huart1, &dma1);
+    fake_hal_fail_next(FAKE_HALFDUPLEX_RX);
+    TEST_ASSERT_EQUAL_INT(J288_ERR_PORT, j288_stm32_init(&port1, &c, NULL));
+    TEST_ASSERT_FALSE(j288_stm32_on_tx_cplt(&huart1)); /* not registered */
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_stm32_init(&port1, &c, NULL));
+}
+
+static void test_init_rejects_uart_without_dma_streams(void)
+{
+    j288_stm32_config_t c = base_config(&huart1, &dma1);
+    huart1.hdmarx = NULL;
+    TEST_ASSERT_EQUAL_INT(J288_ERR_BAD_CONFIG, j288_stm32_init(&port1, &c, NULL));
+    huart1.hdmarx = &hdma1_rx;
+    huart1.hdmatx = NULL;
+    TEST_ASSERT_EQUAL_INT(J288_ERR_BAD_CONFIG, j288_stm32_init(&port1, &c, NULL));
+}
+
+/* Reply to the transaction in flight on port1 and finish it. */
+static void reply_and_finish(void)
+{
+    TEST_ASSERT_EQUAL_UINT32((uint32_t)J288_REPLY_LEN,
+                             (uint32_t)fake_hal_rx_bytes(&huart1, k_reply3, J288_REPLY_LEN));
+    TEST_ASSERT_TRUE(fake_hal_rx_idle(&huart1));
+    poll1();
+    fake_now += 10u;
+    poll1();
+}
+
+/* Past a failed attempt and its guard. */
+static void wait_out_failure(void)
+{
+    fake_now += 3u * j288_bus_reply_budget_us(j288_stm32_bus(&port1)) + 10u;
+    poll1();
+    fake_now += 3u * j288_bus_reply_budget_us(j288_stm32_bus(&port1)) + 10u;
+    poll1();
+}
+
+/* A transmit whose completion never comes (DMA stalled) fails its transaction; the next one
+ * must not find the UART still busy transmitting. */
+static void test_stalled_transmit_is_aborted_and_the_next_transaction_works(void)
+{
+    j288_cmd_raw_t cmd = foc3_cmd();
+    init_port1(NULL, false, false);
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_bus_submit(j288_stm32_bus(&port1), &cmd, fake_now, on_done, NULL));
+    poll1();
+    TEST_ASSERT_TRUE(fake_hal_tx_busy(&huart1)); /* ... and never completes */
+    wait_out_failure();
+    TEST_ASSERT_EQUAL_INT(1, done_count);
+    TEST_ASSERT_TRUE(last_txn.result != J288_OK);
+
+    send_foc3();
+    reply_and_finish();
+    TEST_ASSERT_EQUAL_INT(2, done_count);
+    TEST_ASSERT_EQUAL_INT(J288_OK, last_txn.result);
+}
+
+/* The F4 HAL returns HAL_OK from HAL_UART_Transmit_DMA even when the stream did not start
+ * (its handle left busy): the port must not wait for a transmit that never began. */
+static void test_transmit_stream_left_busy_is_recovered(void)
+{
+    init_port1(NULL, false, false);
+    hdma1_tx.State = HAL_DMA_STATE_BUSY;
+    send_foc3(); /* asserts that the frame went out */
+    reply_and_finish();
+    TEST_ASSERT_EQUAL_INT(1, done_count);
+    TEST_ASSERT_EQUAL_INT(J288_OK, last_txn.result);
+}
+
+static void test_receive_stream_left_busy_is_recovered(void)
+{
+    j288_cmd_raw_t cmd = foc3_cmd();
+    init_port1(NULL, false, false);
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_bus_submit(j288_stm32_bus(&port1), &cmd, fake_now, on_done, NULL));
+    poll1();
+    hdma1_rx.State = HAL_DMA_STATE_BUSY;
+    fake_now += 40u;
+    TEST_ASSERT_TRUE(fake_hal_tx_complete(&huart1));
+    TEST_ASSERT_TRUE(fake_hal_rx_armed(&huart1));
+    reply_and_finish();
+    TEST_ASSERT_EQUAL_INT(1, done_count);
+    TEST_ASSERT_EQUAL_INT(J288_OK, last_txn.result);
+}
+
+/* A HAL failure while turning the line to transmit: nothing is sent, the application sees
+ * J288_ERR_PORT, and the next transaction works. */
+static void test_turnaround_to_transmit_failure_is_a_port_error(void)
+{
+    static const fake_hal_fn_t fails[] = {FAKE_HALFDUPLEX_TX, FAKE_ABORT_RECEIVE};
+    j288_bus_config_t bc;
+    memset(&bc, 0, sizeof bc);
+    init_port1(&bc, false, false);
+    for (size_t i = 0; i < sizeof fails / sizeof fails[0]; i++) {
+        j288_cmd_raw_t cmd = foc3_cmd();
+        unsigned sent = fake_hal_count(FAKE_TRANSMIT_DMA);
+        int before = done_count;
+        fake_hal_fail_next(fails[i]);
+        TEST_ASSERT_EQUAL_INT(J288_OK, j288_bus_submit(j288_stm32_bus(&port1), &cmd, fake_now, on_done, NULL));
+        poll1();
+        TEST_ASSERT_EQUAL_UINT(sent, fake_hal_count(FAKE_TRANSMIT_DMA));
+        wait_out_failure();
+        TEST_ASSERT_EQUAL_INT(before + 1, done_count);
+        TEST_ASSERT_EQUAL_INT(J288_ERR_PORT, last_txn.result);
+
+        send_foc3();
+        reply_and_finish();
+        TEST_ASSERT_EQUAL_INT(before + 2, done_count);
+        TEST_ASSERT_EQUAL_INT(J288_OK, last_txn.result);
+    }
+    TEST_ASSERT_EQUAL_UINT32(2u, j288_stm32_stats(&port1)->hal_failures);
+}
+
+/* A HAL failure while turning the line to receive: the attempt fails as a line error (DMA
+ * flag) at once rather than as a silent timeout, and the next transaction works. */
+static void test_turnaround_to_receive_failure_is_a_line_error(void)
+{
+    j288_bus_config_t bc;
+    memset(&bc, 0, sizeof bc);
+    init_port1(&bc, false, false);
+    fake_hal_fail_next(FAKE_HALFDUPLEX_RX);
+    send_foc3();
+    wait_out_failure();
+    TEST_ASSERT_EQUAL_INT(1, done_count);
+    TEST_ASSERT_EQUAL_INT(J288_ERR_LINE, last_txn.result);
+    TEST_ASSERT_EQUAL_UINT32(1u, j288_stm32_stats(&port1)->hal_failures);
+
+    send_foc3();
+    reply_and_finish();
+    TEST_ASSERT_EQUAL_INT(2, done_count);
+    TEST_ASSERT_EQUAL_INT(J288_OK, last_txn.result);
+}
+
+/* The receiver is off while we transmit, so no echo can come: the port refuses echo. */
+static void test_echo_is_refused(void)
+{
+    j288_stm32_config_t c = base_config(&huart1, &dma1);
+    j288_bus_config_t bc;
+    memset(&bc, 0, sizeof bc);
+    bc.echo = true;
+    TEST_ASSERT_EQUAL_INT(J288_ERR_BAD_CONFIG, j288_stm32_init(&port1, &c, &bc));
+    TEST_ASSERT_FALSE(j288_stm32_on_tx_cplt(&huart1)); /* not registered */
+}
+
+/* ---- pauses inside a reply ---------------------------------------------------------------- */
+
+/* An idle line inside a reply (a servo or adapter pausing) ends the HAL's reception, not the
+ * transaction: wherever the gap falls (before or after the half-transfer point, after the
+ * first byte or before the last), the port re-arms and the reply is heard whole. */
+static void test_reply_split_by_a_gap_at_any_position_is_heard_whole(void)
+{
+    init_port1(NULL, false, false);
+    for (size_t split = 1u; split < J288_REPLY_LEN; split++) {
+        int before = done_count;
+        send_foc3();
+        TEST_ASSERT_EQUAL_UINT32((uint32_t)split, (uint32_t)fake_hal_rx_bytes(&huart1, k_reply3, split));
+        TEST_ASSERT_TRUE(fake_hal_rx_idle(&huart1));
+        poll1();
+        TEST_ASSERT_EQUAL_INT(before, done_count); /* the pause ended nothing */
+        TEST_ASSERT_TRUE(fake_hal_rx_armed(&huart1));
+        fake_now += 20u;
+        TEST_ASSERT_EQUAL_UINT32((uint32_t)(J288_REPLY_LEN - split),
+                                 (uint32_t)fake_hal_rx_bytes(&huart1, &k_reply3[split], J288_REPLY_LEN - split));
+        TEST_ASSERT_TRUE(fake_hal_rx_idle(&huart1));
+        poll1();
+        TEST_ASSERT_EQUAL_INT(before + 1, done_count);
+        TEST_ASSERT_EQUAL_INT(J288_OK, last_txn.result);
+        TEST_ASSERT_EQUAL_INT32(5215, last_txn.reply.pos);
+        fake_now += 10u;
+        poll1(); /* the guard */
+    }
+}
+
+/* With the receive stream in circular mode a pause only reports the position: nothing is
+ * re-armed, and the reply is whole wherever it falls in the buffer, across the wrap too. */
+static void test_circular_stream_hears_a_paused_reply_across_the_wrap(void)
+{
+    static const uint8_t noise[10] = {0};
+    init_port1(NULL, false, false);
+    fake_hal_rx_circular(true);
+    for (size_t split = 1u; split < J288_REPLY_LEN; split++) {
+        int before = done_count;
+        unsigned arms;
+        send_foc3();
+        arms = fake_hal_count(FAKE_RECEIVE_TO_IDLE_DMA);
+        /* line noise first, so that the reply crosses the end of the 32-byte buffer */
+        TEST_ASSERT_EQUAL_UINT32(10u, (uint32_t)fake_hal_rx_bytes(&huart1, noise, sizeof noise));
+        TEST_ASSERT_TRUE(fake_hal_rx_idle(&huart1));
+        (void)fake_hal_rx_bytes(&huart1, k_reply3, split);
+        (void)fake_hal_rx_idle(&huart1); /* no event when the pause falls right at the wrap */
+        poll1();
+        TEST_ASSERT_EQUAL_INT(before, done_count);
+        (void)fake_hal_rx_bytes(&huart1, &k_reply3[split], J288_REPLY_LEN - split);
+        (void)fake_hal_rx_idle(&huart1);
+        TEST_ASSERT_EQUAL_UINT(arms, fake_hal_count(FAKE_RECEIVE_TO_IDLE_DMA)); /* no re-arm */
+        poll1();
+        TEST_ASSERT_EQUAL_INT(before + 1, done_count);
+        TEST_ASSERT_EQUAL_INT(J288_OK, last_txn.result);
+        TEST_ASSERT_EQUAL_INT32(5215, last_txn.reply.pos);
+        fake_now += 10u;
+        poll1();
+    }
+}
+
+/* A reply that stops at a gap and never resumes is TRUNCATED at the deadline, not at the
+ * idle line. */
+static void test_reply_stopping_at_a_gap_is_truncated_at_the_deadline(void)
+{
+    uint32_t start = fake_now;
+    init_port1(NULL, false, false);
+    send_foc3();
+    (void)fake_hal_rx_bytes(&huart1, k_reply3, 20u);
+    TEST_ASSERT_TRUE(fake_hal_rx_idle(&huart1));
+    poll1();
+    TEST_ASSERT_EQUAL_INT(0, done_count);
+    fake_now = start + j288_bus_reply_budget_us(j288_stm32_bus(&port1)) - 1u;
+    poll1();
+    TEST_ASSERT_EQUAL_INT(0, done_count);
+    fake_now += 2u;
+    poll1();
+    TEST_ASSERT_EQUAL_INT(1, done_count);
+    TEST_ASSERT_EQUAL_INT(J288_ERR_TRUNCATED, last_txn.result);
+}
+
 int main(void)
 {
     UNITY_BEGIN();
@@ -597,5 +930,20 @@ int main(void)
     RUN_TEST(test_hw_crc_long_input_chunks_and_matches_software);
     RUN_TEST(test_default_crc_falls_back_to_software_until_attached);
     RUN_TEST(test_bus_lock_masks_and_restores);
+    RUN_TEST(test_timer_arm_races_the_counter_at_every_access);
+    RUN_TEST(test_timer_deadline_already_passed_fires_at_once);
+    RUN_TEST(test_init_rejects_crc_unit_not_in_the_servo_configuration);
+    RUN_TEST(test_init_rejects_crc_unit_that_computes_wrong);
+    RUN_TEST(test_init_rejects_uart_without_dma_streams);
+    RUN_TEST(test_init_fails_when_the_line_cannot_receive);
+    RUN_TEST(test_stalled_transmit_is_aborted_and_the_next_transaction_works);
+    RUN_TEST(test_transmit_stream_left_busy_is_recovered);
+    RUN_TEST(test_receive_stream_left_busy_is_recovered);
+    RUN_TEST(test_turnaround_to_transmit_failure_is_a_port_error);
+    RUN_TEST(test_turnaround_to_receive_failure_is_a_line_error);
+    RUN_TEST(test_echo_is_refused);
+    RUN_TEST(test_reply_split_by_a_gap_at_any_position_is_heard_whole);
+    RUN_TEST(test_reply_stopping_at_a_gap_is_truncated_at_the_deadline);
+    RUN_TEST(test_circular_stream_hears_a_paused_reply_across_the_wrap);
     return UNITY_END();
 }

@@ -73,7 +73,7 @@ static uint32_t be_manual(void *ctx, const uint8_t *d, size_t n)
 /* A stand-in CRC unit: the words go to a data register as the HAL writes them; the answer
  * the silicon would compute comes from a table keyed by the word count. */
 static CRC_TypeDef fake_unit;
-static CRC_HandleTypeDef hcrc = {&fake_unit};
+static CRC_HandleTypeDef hcrc = {.Instance = &fake_unit};
 
 uint32_t HAL_CRC_Accumulate(CRC_HandleTypeDef *h, uint32_t pBuffer[], uint32_t BufferLength)
 {

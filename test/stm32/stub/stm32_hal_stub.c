@@ -28,6 +28,12 @@ GPIO_PinState HAL_GPIO_ReadPin(GPIO_TypeDef *GPIOx, uint16_t GPIO_Pin)
 }
 
 void HAL_DMA_IRQHandler(DMA_HandleTypeDef *hdma) { (void)hdma; }
+HAL_DMA_StateTypeDef HAL_DMA_GetState(DMA_HandleTypeDef *hdma) { return hdma->State; }
+HAL_StatusTypeDef HAL_DMA_Abort(DMA_HandleTypeDef *hdma)
+{
+    hdma->State = HAL_DMA_STATE_READY;
+    return HAL_OK;
+}
 
 HAL_StatusTypeDef HAL_HalfDuplex_Init(UART_HandleTypeDef *huart)
 {
@@ -50,11 +56,24 @@ HAL_StatusTypeDef HAL_UARTEx_ReceiveToIdle_DMA(UART_HandleTypeDef *huart, uint8_
     return HAL_OK;
 }
 HAL_StatusTypeDef HAL_UART_AbortReceive(UART_HandleTypeDef *huart) { (void)huart; return HAL_OK; }
+HAL_StatusTypeDef HAL_UART_AbortTransmit(UART_HandleTypeDef *huart) { (void)huart; return HAL_OK; }
 void HAL_UART_IRQHandler(UART_HandleTypeDef *huart) { (void)huart; }
 
 HAL_StatusTypeDef HAL_TIM_Base_Init(TIM_HandleTypeDef *htim) { (void)htim; return HAL_OK; }
 HAL_StatusTypeDef HAL_TIM_Base_Start(TIM_HandleTypeDef *htim) { (void)htim; return HAL_OK; }
 void HAL_TIM_IRQHandler(TIM_HandleTypeDef *htim) { (void)htim; }
+
+uint32_t stub_tim_read(TIM_TypeDef *tim, volatile uint32_t *reg)
+{
+    (void)tim;
+    return *reg;
+}
+
+void stub_tim_write(TIM_TypeDef *tim, volatile uint32_t *reg, uint32_t value)
+{
+    (void)tim;
+    *reg = value;
+}
 
 HAL_StatusTypeDef HAL_CRC_Init(CRC_HandleTypeDef *hcrc) { (void)hcrc; return HAL_OK; }
 
@@ -92,6 +111,7 @@ void __set_PRIMASK(uint32_t priMask) { primask_shadow = priMask; }
 void __disable_irq(void) { primask_shadow = 1u; }
 #endif
 
+#if __DCACHE_PRESENT
 void SCB_CleanDCache_by_Addr(volatile void *addr, int32_t dsize)
 {
     (void)addr;
@@ -102,3 +122,4 @@ void SCB_InvalidateDCache_by_Addr(volatile void *addr, int32_t dsize)
     (void)addr;
     (void)dsize;
 }
+#endif

@@ -41,12 +41,24 @@ typedef struct {
     volatile uint32_t NDTR;
 } DMA_Stream_TypeDef;
 
+typedef enum {
+    HAL_DMA_STATE_RESET = 0x00u,
+    HAL_DMA_STATE_READY = 0x01u,
+    HAL_DMA_STATE_BUSY = 0x02u,
+    HAL_DMA_STATE_TIMEOUT = 0x03u,
+    HAL_DMA_STATE_ERROR = 0x04u,
+    HAL_DMA_STATE_ABORT = 0x05u
+} HAL_DMA_StateTypeDef;
+
 typedef struct __DMA_HandleTypeDef {
     DMA_Stream_TypeDef *Instance;
     void *Parent;
+    volatile HAL_DMA_StateTypeDef State;
 } DMA_HandleTypeDef;
 
 void HAL_DMA_IRQHandler(DMA_HandleTypeDef *hdma);
+HAL_DMA_StateTypeDef HAL_DMA_GetState(DMA_HandleTypeDef *hdma);
+HAL_StatusTypeDef HAL_DMA_Abort(DMA_HandleTypeDef *hdma);
 
 /* ---- UART ------------------------------------------------------------------------------ */
 typedef struct {
@@ -105,6 +117,7 @@ HAL_StatusTypeDef HAL_HalfDuplex_EnableReceiver(UART_HandleTypeDef *huart);
 HAL_StatusTypeDef HAL_UART_Transmit_DMA(UART_HandleTypeDef *huart, const uint8_t *pData, uint16_t Size);
 HAL_StatusTypeDef HAL_UARTEx_ReceiveToIdle_DMA(UART_HandleTypeDef *huart, uint8_t *pData, uint16_t Size);
 HAL_StatusTypeDef HAL_UART_AbortReceive(UART_HandleTypeDef *huart);
+HAL_StatusTypeDef HAL_UART_AbortTransmit(UART_HandleTypeDef *huart);
 void HAL_UART_IRQHandler(UART_HandleTypeDef *huart);
 
 /* Weak in the HAL; the application defines them (the port never does). */
@@ -117,6 +130,7 @@ typedef struct {
     volatile uint32_t CR1;
     volatile uint32_t DIER;
     volatile uint32_t SR;
+    volatile uint32_t EGR;
     volatile uint32_t CNT;
     volatile uint32_t PSC;
     volatile uint32_t ARR;
@@ -163,17 +177,35 @@ typedef struct __TIM_HandleTypeDef {
 #define TIM_FLAG_CC3 0x00000008u
 #define TIM_FLAG_CC4 0x00000010u
 
-#define __HAL_TIM_GET_COUNTER(h) ((h)->Instance->CNT)
-#define __HAL_TIM_GET_AUTORELOAD(h) ((h)->Instance->ARR)
-#define __HAL_TIM_ENABLE_IT(h, it) ((h)->Instance->DIER |= (it))
-#define __HAL_TIM_DISABLE_IT(h, it) ((h)->Instance->DIER &= ~(it))
+/* Software event generation (EGR): bit n makes channel n's compare flag rise at once. */
+#define TIM_EGR_CC1G 0x00000002u
+#define TIM_EGR_CC2G 0x00000004u
+#define TIM_EGR_CC3G 0x00000008u
+#define TIM_EGR_CC4G 0x00000010u
+
+/* The HAL's register macros, each register access made through stub_tim_read/stub_tim_write
+ * (plain loads and stores in stm32_hal_stub.c) so that the fake HAL can let the counter run
+ * between any two accesses, as the silicon's does. A read-modify-write is two accesses, as
+ * on the silicon. */
+uint32_t stub_tim_read(TIM_TypeDef *tim, volatile uint32_t *reg);
+void stub_tim_write(TIM_TypeDef *tim, volatile uint32_t *reg, uint32_t value);
+#define __HAL_TIM_GET_COUNTER(h) stub_tim_read((h)->Instance, &(h)->Instance->CNT)
+#define __HAL_TIM_GET_AUTORELOAD(h) stub_tim_read((h)->Instance, &(h)->Instance->ARR)
+#define __HAL_TIM_ENABLE_IT(h, it)                                                             \
+    stub_tim_write((h)->Instance, &(h)->Instance->DIER,                                        \
+                   stub_tim_read((h)->Instance, &(h)->Instance->DIER) | (it))
+#define __HAL_TIM_DISABLE_IT(h, it)                                                            \
+    stub_tim_write((h)->Instance, &(h)->Instance->DIER,                                        \
+                   stub_tim_read((h)->Instance, &(h)->Instance->DIER) & ~(it))
 /* SR bits are cleared by writing 0 (rc_w0), others written as 1 stay untouched. */
-#define __HAL_TIM_CLEAR_FLAG(h, f) ((h)->Instance->SR = ~(f))
+#define __HAL_TIM_CLEAR_FLAG(h, f) stub_tim_write((h)->Instance, &(h)->Instance->SR, ~(f))
 #define __HAL_TIM_SET_COMPARE(h, ch, v)                                                        \
-    (*((ch) == TIM_CHANNEL_1   ? &(h)->Instance->CCR1                                          \
-       : (ch) == TIM_CHANNEL_2 ? &(h)->Instance->CCR2                                          \
-       : (ch) == TIM_CHANNEL_3 ? &(h)->Instance->CCR3                                          \
-                               : &(h)->Instance->CCR4) = (v))
+    stub_tim_write((h)->Instance,                                                              \
+                   (ch) == TIM_CHANNEL_1   ? &(h)->Instance->CCR1                              \
+                   : (ch) == TIM_CHANNEL_2 ? &(h)->Instance->CCR2                              \
+                   : (ch) == TIM_CHANNEL_3 ? &(h)->Instance->CCR3                              \
+                                           : &(h)->Instance->CCR4,                             \
+                   (v))
 
 HAL_StatusTypeDef HAL_TIM_Base_Init(TIM_HandleTypeDef *htim);
 HAL_StatusTypeDef HAL_TIM_Base_Start(TIM_HandleTypeDef *htim);
@@ -187,11 +219,43 @@ typedef struct {
     volatile uint32_t CR;
 } CRC_TypeDef;
 
+/* The handle of the configurable unit (G4, H7, F7, L4...; the F4's has only Instance): the
+ * port checks these fields at init. */
+typedef struct {
+    uint8_t DefaultPolynomialUse;
+    uint8_t DefaultInitValueUse;
+    uint32_t GeneratingPolynomial;
+    uint32_t CRCLength;
+    uint32_t InitValue;
+    uint32_t InputDataInversionMode;
+    uint32_t OutputDataInversionMode;
+} CRC_InitTypeDef;
+
 typedef struct {
     CRC_TypeDef *Instance;
+    CRC_InitTypeDef Init;
+    uint32_t InputDataFormat;
 } CRC_HandleTypeDef;
 
-/* Resets the unit to its initial value, feeds BufferLength words, returns the result. */
+#define DEFAULT_CRC32_POLY 0x04C11DB7u
+#define DEFAULT_CRC_INITVALUE 0xFFFFFFFFu
+#define DEFAULT_POLYNOMIAL_ENABLE ((uint8_t)0x00u)
+#define DEFAULT_POLYNOMIAL_DISABLE ((uint8_t)0x01u)
+#define DEFAULT_INIT_VALUE_ENABLE ((uint8_t)0x00u)
+#define DEFAULT_INIT_VALUE_DISABLE ((uint8_t)0x01u)
+#define CRC_POLYLENGTH_32B 0x00000000u
+#define CRC_POLYLENGTH_16B 0x00000008u
+#define CRC_INPUTDATA_FORMAT_UNDEFINED 0x00000000u
+#define CRC_INPUTDATA_FORMAT_BYTES 0x00000001u
+#define CRC_INPUTDATA_FORMAT_HALFWORDS 0x00000002u
+#define CRC_INPUTDATA_FORMAT_WORDS 0x00000003u
+#define CRC_INPUTDATA_INVERSION_NONE 0x00000000u
+#define CRC_INPUTDATA_INVERSION_BYTE 0x00000020u
+#define CRC_OUTPUTDATA_INVERSION_DISABLE 0x00000000u
+#define CRC_OUTPUTDATA_INVERSION_ENABLE 0x00000080u
+
+/* Resets the unit to its initial value, feeds BufferLength units of InputDataFormat (words in
+ * the servo's configuration), returns the result. */
 HAL_StatusTypeDef HAL_CRC_Init(CRC_HandleTypeDef *hcrc);
 uint32_t HAL_CRC_Calculate(CRC_HandleTypeDef *hcrc, uint32_t pBuffer[], uint32_t BufferLength);
 /* Feeds BufferLength more words without resetting, returns the running result. */
@@ -231,8 +295,16 @@ uint32_t HAL_GetTick(void);
 uint32_t __get_PRIMASK(void);
 void __set_PRIMASK(uint32_t priMask);
 void __disable_irq(void);
+/* Cache maintenance exists only on a core with a data cache (CMSIS: the device header sets
+ * __DCACHE_PRESENT, core_cm7.h declares the functions). The stub models such a core unless
+ * told otherwise with -D__DCACHE_PRESENT=0U, which models a Cortex-M4. */
+#ifndef __DCACHE_PRESENT
+#define __DCACHE_PRESENT 1U
+#endif
+#if __DCACHE_PRESENT
 void SCB_CleanDCache_by_Addr(volatile void *addr, int32_t dsize);
 void SCB_InvalidateDCache_by_Addr(volatile void *addr, int32_t dsize);
+#endif
 
 #ifdef __cplusplus
 }

@@ -1,8 +1,8 @@
 /*
- * board.c - stands in for the CubeMX-generated initialisation (MX_USART1_UART_Init,
- * MX_DMA_Init, MX_TIM2_Init, MX_CRC_Init, the stm32f4xx_it.c handlers). In a CubeMX project
- * delete this file: the generated code provides the same handles, and README.md lists the
- * settings to enter in CubeMX.
+ * board_stub.c - the board for the link check against the HAL stub (`make arm`, with
+ * startup_stm32f4.c and stm32f407.ld): the same handles and settings as a real board, no
+ * clock tree or MSP (the stub has no RCC). The firmware to flash is nucleo_f446re/ (`make
+ * firmware`); in a CubeMX project the generated code replaces both.
  */
 #include "board.h"
 
@@ -66,6 +66,13 @@ void board_init(void)
     HAL_NVIC_EnableIRQ(DMA2_Stream7_IRQn);
     HAL_NVIC_EnableIRQ(DMA2_Stream2_IRQn);
     HAL_NVIC_EnableIRQ(TIM2_IRQn);
+}
+
+volatile board_fault_t board_fault;
+
+bool board_estop_pressed(void)
+{
+    return HAL_GPIO_ReadPin(GPIOC, (uint16_t)0x2000u) == GPIO_PIN_RESET; /* PC13 */
 }
 
 void board_fatal(void)

@@ -1,0 +1,268 @@
+/*
+ * board.c - NUCLEO-F446RE bring-up for the j288 example, against ST's real STM32F4 HAL:
+ * clock tree, MSP init (clocks, GPIO alternate function and pull-up, DMA streams, NVIC),
+ * interrupt handlers, SysTick, and a fault handler that leaves its diagnosis in RAM.
+ *
+ * Clock tree (exact 6 Mbps): HSE 8 MHz from the ST-LINK's MCO (bypass; -DBOARD_CLOCK_HSI=1
+ * for the internal 16 MHz RC instead), PLL M=4 (HSI: 8), N=180, P=2 -> SYSCLK 180 MHz
+ * (over-drive on, voltage scale 1, 5 flash wait states); AHB 180, APB1 45, APB2 90 MHz.
+ * USART1 on APB2 with 8x oversampling: USARTDIV = 90 MHz / (8 x 6 Mbps) = 1.875 = 1 + 7/8,
+ * which BRR holds exactly (mantissa 1, fraction 7: BRR 0x17), so the line runs at 6 000 000
+ * bit/s with no rounding error; board_init() checks BRR against it.
+ *
+ * Bus: USART1 single-wire half-duplex on PA9 (Arduino D8), alternate function 7, push-pull
+ * with the internal pull-up (the USART releases the pin whenever it is not transmitting);
+ * TX DMA2 Stream7 channel 4 in normal mode, RX DMA2 Stream2 channel 4 in circular mode (a
+ * pause inside a reply then loses nothing), bytes. TIM2 (32
+ * bits, on APB1: 90 MHz timer clock) counts at 1 MHz: the tick and, on channel 1, the reply
+ * timeout. USART1, both streams and TIM2 share NVIC priority 5 (SysTick 15). The blue user
+ * button B1 (PC13, low when pressed) is the emergency stop.
+ */
+#include "board.h"
+
+UART_HandleTypeDef huart1;
+DMA_HandleTypeDef hdma_usart1_tx;
+DMA_HandleTypeDef hdma_usart1_rx;
+TIM_HandleTypeDef htim2;
+CRC_HandleTypeDef hcrc;
+
+#define BUS_BAUD 6000000u
+#define BUS_IRQ_PRIORITY 5u
+#define TICK_HZ 1000000u
+
+#ifndef BOARD_CLOCK_HSI
+#define BOARD_CLOCK_HSI 0
+#endif
+
+/* What the fault handler saw, for a debugger (volatile: kept however the code optimises). */
+volatile board_fault_t board_fault;
+
+void board_fatal(void)
+{
+    __disable_irq();
+    for (;;) {
+    }
+}
+
+static void clock_init(void)
+{
+    RCC_OscInitTypeDef osc = {0};
+    RCC_ClkInitTypeDef clk = {0};
+
+    __HAL_RCC_PWR_CLK_ENABLE();
+    __HAL_PWR_VOLTAGESCALING_CONFIG(PWR_REGULATOR_VOLTAGE_SCALE1);
+#if BOARD_CLOCK_HSI
+    osc.OscillatorType = RCC_OSCILLATORTYPE_HSI;
+    osc.HSIState = RCC_HSI_ON;
+    osc.HSICalibrationValue = RCC_HSICALIBRATION_DEFAULT;
+    osc.PLL.PLLSource = RCC_PLLSOURCE_HSI;
+    osc.PLL.PLLM = 8u;
+#else
+    osc.OscillatorType = RCC_OSCILLATORTYPE_HSE;
+    osc.HSEState = RCC_HSE_BYPASS;
+    osc.PLL.PLLSource = RCC_PLLSOURCE_HSE;
+    osc.PLL.PLLM = 4u;
+#endif
+    osc.PLL.PLLState = RCC_PLL_ON;
+    osc.PLL.PLLN = 180u; /* VCO 360 MHz */
+    osc.PLL.PLLP = RCC_PLLP_DIV2;
+    osc.PLL.PLLQ = 8u;
+    osc.PLL.PLLR = 2u;
+    if (HAL_RCC_OscConfig(&osc) != HAL_OK) {
+        board_fatal(); /* no HSE: see BOARD_CLOCK_HSI */
+    }
+    if (HAL_PWREx_EnableOverDrive() != HAL_OK) {
+        board_fatal();
+    }
+    clk.ClockType = RCC_CLOCKTYPE_HCLK | RCC_CLOCKTYPE_SYSCLK | RCC_CLOCKTYPE_PCLK1 | RCC_CLOCKTYPE_PCLK2;
+    clk.SYSCLKSource = RCC_SYSCLKSOURCE_PLLCLK;
+    clk.AHBCLKDivider = RCC_SYSCLK_DIV1;
+    clk.APB1CLKDivider = RCC_HCLK_DIV4;
+    clk.APB2CLKDivider = RCC_HCLK_DIV2;
+    if (HAL_RCC_ClockConfig(&clk, FLASH_LATENCY_5) != HAL_OK) {
+        board_fatal();
+    }
+}
+
+/* ---- MSP: what the HAL's *_Init functions call back for the pins, clocks and streams --- */
+
+void HAL_MspInit(void)
+{
+    __HAL_RCC_SYSCFG_CLK_ENABLE();
+    __HAL_RCC_PWR_CLK_ENABLE();
+}
+
+static void dma_stream_init(DMA_HandleTypeDef *h, DMA_Stream_TypeDef *stream, uint32_t direction, uint32_t mode)
+{
+    h->Instance = stream;
+    h->Init.Channel = DMA_CHANNEL_4;
+    h->Init.Direction = direction;
+    h->Init.PeriphInc = DMA_PINC_DISABLE;
+    h->Init.MemInc = DMA_MINC_ENABLE;
+    h->Init.PeriphDataAlignment = DMA_PDATAALIGN_BYTE;
+    h->Init.MemDataAlignment = DMA_MDATAALIGN_BYTE;
+    h->Init.Mode = mode;
+    h->Init.Priority = DMA_PRIORITY_HIGH;
+    h->Init.FIFOMode = DMA_FIFOMODE_DISABLE;
+    if (HAL_DMA_Init(h) != HAL_OK) {
+        board_fatal();
+    }
+}
+
+void HAL_UART_MspInit(UART_HandleTypeDef *huart)
+{
+    GPIO_InitTypeDef pin = {0};
+    if (huart->Instance != USART1) {
+        return;
+    }
+    __HAL_RCC_USART1_CLK_ENABLE();
+    __HAL_RCC_GPIOA_CLK_ENABLE();
+    __HAL_RCC_DMA2_CLK_ENABLE();
+
+    pin.Pin = GPIO_PIN_9; /* USART1_TX: the single wire */
+    pin.Mode = GPIO_MODE_AF_PP;
+    pin.Pull = GPIO_PULLUP; /* idle high while nobody drives (add 1-4.7k outside: see docs) */
+    pin.Speed = GPIO_SPEED_FREQ_VERY_HIGH;
+    pin.Alternate = GPIO_AF7_USART1;
+    HAL_GPIO_Init(GPIOA, &pin);
+
+    dma_stream_init(&hdma_usart1_tx, DMA2_Stream7, DMA_MEMORY_TO_PERIPH, DMA_NORMAL);
+    __HAL_LINKDMA(huart, hdmatx, hdma_usart1_tx);
+    dma_stream_init(&hdma_usart1_rx, DMA2_Stream2, DMA_PERIPH_TO_MEMORY, DMA_CIRCULAR);
+    __HAL_LINKDMA(huart, hdmarx, hdma_usart1_rx);
+
+    HAL_NVIC_SetPriority(USART1_IRQn, BUS_IRQ_PRIORITY, 0u);
+    HAL_NVIC_SetPriority(DMA2_Stream7_IRQn, BUS_IRQ_PRIORITY, 0u);
+    HAL_NVIC_SetPriority(DMA2_Stream2_IRQn, BUS_IRQ_PRIORITY, 0u);
+    HAL_NVIC_EnableIRQ(USART1_IRQn);
+    HAL_NVIC_EnableIRQ(DMA2_Stream7_IRQn);
+    HAL_NVIC_EnableIRQ(DMA2_Stream2_IRQn);
+}
+
+void HAL_TIM_Base_MspInit(TIM_HandleTypeDef *htim)
+{
+    if (htim->Instance == TIM2) {
+        __HAL_RCC_TIM2_CLK_ENABLE();
+        HAL_NVIC_SetPriority(TIM2_IRQn, BUS_IRQ_PRIORITY, 0u);
+        HAL_NVIC_EnableIRQ(TIM2_IRQn);
+    }
+}
+
+void HAL_CRC_MspInit(CRC_HandleTypeDef *h)
+{
+    (void)h;
+    __HAL_RCC_CRC_CLK_ENABLE();
+}
+
+/* ---- peripherals ------------------------------------------------------------------------ */
+
+static void button_init(void)
+{
+    GPIO_InitTypeDef pin = {0};
+    __HAL_RCC_GPIOC_CLK_ENABLE();
+    pin.Pin = GPIO_PIN_13;
+    pin.Mode = GPIO_MODE_INPUT;
+    pin.Pull = GPIO_NOPULL; /* B1 has its own pull-up */
+    HAL_GPIO_Init(GPIOC, &pin);
+}
+
+bool board_estop_pressed(void)
+{
+    return HAL_GPIO_ReadPin(GPIOC, GPIO_PIN_13) == GPIO_PIN_RESET;
+}
+
+/* The rate BRR gives with 8x oversampling: fck / (8 x USARTDIV), USARTDIV = BRR[15:4] +
+ * BRR[2:0] / 8. */
+static uint32_t uart_actual_baud(void)
+{
+    uint32_t brr = huart1.Instance->BRR;
+    uint32_t div8 = ((brr >> 4) * 8u) + (brr & 7u);
+    return (div8 != 0u) ? HAL_RCC_GetPCLK2Freq() / div8 : 0u;
+}
+
+static void uart_init(void)
+{
+    huart1.Instance = USART1;
+    huart1.Init.BaudRate = BUS_BAUD;
+    huart1.Init.WordLength = UART_WORDLENGTH_8B;
+    huart1.Init.StopBits = UART_STOPBITS_1;
+    huart1.Init.Parity = UART_PARITY_NONE;
+    huart1.Init.Mode = UART_MODE_TX_RX;
+    huart1.Init.HwFlowCtl = UART_HWCONTROL_NONE;
+    huart1.Init.OverSampling = UART_OVERSAMPLING_8;
+    if (HAL_HalfDuplex_Init(&huart1) != HAL_OK) {
+        board_fatal();
+    }
+    if ((uart_actual_baud() != BUS_BAUD) || ((HAL_RCC_GetPCLK2Freq() % BUS_BAUD) != 0u)) {
+        board_fatal(); /* the clock tree does not give 6 Mbps exactly */
+    }
+}
+
+static void timer_init(void)
+{
+    /* APB1 runs at HCLK/4, so its timers get twice PCLK1: 90 MHz. */
+    htim2.Instance = TIM2;
+    htim2.Init.Prescaler = ((2u * HAL_RCC_GetPCLK1Freq()) / TICK_HZ) - 1u;
+    htim2.Init.CounterMode = TIM_COUNTERMODE_UP;
+    htim2.Init.Period = 0xFFFFFFFFu;
+    htim2.Init.ClockDivision = TIM_CLOCKDIVISION_DIV1;
+    htim2.Init.AutoReloadPreload = TIM_AUTORELOAD_PRELOAD_DISABLE;
+    if ((HAL_TIM_Base_Init(&htim2) != HAL_OK) || (HAL_TIM_Base_Start(&htim2) != HAL_OK)) {
+        board_fatal();
+    }
+}
+
+static void crc_init(void)
+{
+    hcrc.Instance = CRC; /* the F4's unit has one configuration: the servo's CRC */
+    if (HAL_CRC_Init(&hcrc) != HAL_OK) {
+        board_fatal();
+    }
+}
+
+void board_init(void)
+{
+    if (HAL_Init() != HAL_OK) { /* flash prefetch and caches, NVIC groups, SysTick at 1 kHz */
+        board_fatal();
+    }
+    clock_init();
+    button_init();
+    uart_init();
+    timer_init();
+    crc_init();
+}
+
+/* ---- interrupt handlers (the names of ST's startup_stm32f446xx.s vector table) ---------- */
+
+void SysTick_Handler(void) { HAL_IncTick(); }
+void USART1_IRQHandler(void) { HAL_UART_IRQHandler(&huart1); }
+void DMA2_Stream7_IRQHandler(void) { HAL_DMA_IRQHandler(&hdma_usart1_tx); }
+void DMA2_Stream2_IRQHandler(void) { HAL_DMA_IRQHandler(&hdma_usart1_rx); }
+void TIM2_IRQHandler(void) { HAL_TIM_IRQHandler(&htim2); }
+
+/* Faults: record the fault status registers and the stacked PC, then stop. The firmware
+ * falls silent, and every servo locks itself when its watchdog (enabled in every command)
+ * sees no frame for a second. */
+void board_fault_record(const uint32_t *frame);
+void board_fault_record(const uint32_t *frame)
+{
+    board_fault.cfsr = SCB->CFSR;
+    board_fault.hfsr = SCB->HFSR;
+    board_fault.mmfar = SCB->MMFAR;
+    board_fault.bfar = SCB->BFAR;
+    board_fault.pc = frame[6];
+    board_fault.lr = frame[5];
+    board_fault.count++;
+    board_fatal();
+}
+
+/* Naked: pick the stack the fault frame was pushed on (MSP or PSP, bit 2 of EXC_RETURN). */
+__attribute__((naked)) void HardFault_Handler(void)
+{
+    __asm volatile("tst lr, #4\n\t"
+                   "ite eq\n\t"
+                   "mrseq r0, msp\n\t"
+                   "mrsne r0, psp\n\t"
+                   "b board_fault_record\n\t");
+}
+/* MemManage, BusFault and UsageFault are not enabled (SHCSR), so they escalate to HardFault. */

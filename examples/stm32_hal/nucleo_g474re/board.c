@@ -1,0 +1,272 @@
+/*
+ * board.c - NUCLEO-G474RE bring-up for the j288 example, against ST's real STM32G4 HAL: the
+ * second family (a configurable CRC unit, DMAMUX, a USART with its own baud formula).
+ *
+ * Clock tree (exact 6 Mbps): HSE 24 MHz crystal (-DBOARD_CLOCK_HSI=1: the internal 16 MHz),
+ * PLL M=6 (HSI: 4), N=84, R=2 -> SYSCLK 168 MHz (range 1 boost, 4 flash wait states; 168
+ * rather than the 170 maximum because 170 MHz gives no exact 6 Mbps); AHB, APB1, APB2 168 MHz.
+ * USART1 on PCLK2 with 16x oversampling: USARTDIV = 168 MHz / 6 Mbps = 28 exactly (BRR 28),
+ * checked at init. (The G4's USART reaches 6 Mbps with OVER16 where the F4's at 90 MHz
+ * cannot, and 16x sampling tolerates more noise.)
+ *
+ * Bus: USART1 single-wire half-duplex on PA9 (Arduino D8, as on the F446RE board), AF7,
+ * push-pull with pull-up; TX on DMA1 channel 1 (normal mode), RX on DMA1 channel 2
+ * (circular mode), DMAMUX requests USART1_TX/RX, bytes. TIM2 (32 bits, 168 MHz) counts at
+ * 1 MHz: tick and timeout on channel 1. USART1, both channels and TIM2 share NVIC priority
+ * 5 (SysTick 15). CRC unit in its reset configuration, spelled out in the handle (the port
+ * checks it).
+ * The blue user button B1 (PC13, high when pressed on this board) is the emergency stop.
+ */
+#include "board.h"
+
+UART_HandleTypeDef huart1;
+DMA_HandleTypeDef hdma_usart1_tx;
+DMA_HandleTypeDef hdma_usart1_rx;
+TIM_HandleTypeDef htim2;
+CRC_HandleTypeDef hcrc;
+
+#define BUS_BAUD 6000000u
+#define BUS_IRQ_PRIORITY 5u
+#define TICK_HZ 1000000u
+
+#ifndef BOARD_CLOCK_HSI
+#define BOARD_CLOCK_HSI 0
+#endif
+
+volatile board_fault_t board_fault;
+
+void board_fatal(void)
+{
+    __disable_irq();
+    for (;;) {
+    }
+}
+
+static void clock_init(void)
+{
+    RCC_OscInitTypeDef osc = {0};
+    RCC_ClkInitTypeDef clk = {0};
+
+    if (HAL_PWREx_ControlVoltageScaling(PWR_REGULATOR_VOLTAGE_SCALE1_BOOST) != HAL_OK) {
+        board_fatal();
+    }
+#if BOARD_CLOCK_HSI
+    osc.OscillatorType = RCC_OSCILLATORTYPE_HSI;
+    osc.HSIState = RCC_HSI_ON;
+    osc.HSICalibrationValue = RCC_HSICALIBRATION_DEFAULT;
+    osc.PLL.PLLSource = RCC_PLLSOURCE_HSI;
+    osc.PLL.PLLM = RCC_PLLM_DIV4;
+#else
+    osc.OscillatorType = RCC_OSCILLATORTYPE_HSE;
+    osc.HSEState = RCC_HSE_ON;
+    osc.PLL.PLLSource = RCC_PLLSOURCE_HSE;
+    osc.PLL.PLLM = RCC_PLLM_DIV6;
+#endif
+    osc.PLL.PLLState = RCC_PLL_ON;
+    osc.PLL.PLLN = 84u; /* VCO 336 MHz */
+    osc.PLL.PLLP = RCC_PLLP_DIV2;
+    osc.PLL.PLLQ = RCC_PLLQ_DIV2;
+    osc.PLL.PLLR = RCC_PLLR_DIV2;
+    if (HAL_RCC_OscConfig(&osc) != HAL_OK) {
+        board_fatal();
+    }
+    clk.ClockType = RCC_CLOCKTYPE_HCLK | RCC_CLOCKTYPE_SYSCLK | RCC_CLOCKTYPE_PCLK1 | RCC_CLOCKTYPE_PCLK2;
+    clk.SYSCLKSource = RCC_SYSCLKSOURCE_PLLCLK;
+    clk.AHBCLKDivider = RCC_SYSCLK_DIV1;
+    clk.APB1CLKDivider = RCC_HCLK_DIV1;
+    clk.APB2CLKDivider = RCC_HCLK_DIV1;
+    if (HAL_RCC_ClockConfig(&clk, FLASH_LATENCY_4) != HAL_OK) {
+        board_fatal();
+    }
+}
+
+/* ---- MSP: what the HAL's *_Init functions call back for the pins, clocks and channels --- */
+
+void HAL_MspInit(void)
+{
+    __HAL_RCC_SYSCFG_CLK_ENABLE();
+    __HAL_RCC_PWR_CLK_ENABLE();
+    HAL_PWREx_DisableUCPDDeadBattery(); /* as CubeMX does: frees the UCPD pins' pull-downs */
+}
+
+static void dma_channel_init(DMA_HandleTypeDef *h, DMA_Channel_TypeDef *channel, uint32_t request,
+                             uint32_t direction, uint32_t mode)
+{
+    h->Instance = channel;
+    h->Init.Request = request;
+    h->Init.Direction = direction;
+    h->Init.PeriphInc = DMA_PINC_DISABLE;
+    h->Init.MemInc = DMA_MINC_ENABLE;
+    h->Init.PeriphDataAlignment = DMA_PDATAALIGN_BYTE;
+    h->Init.MemDataAlignment = DMA_MDATAALIGN_BYTE;
+    h->Init.Mode = mode;
+    h->Init.Priority = DMA_PRIORITY_HIGH;
+    if (HAL_DMA_Init(h) != HAL_OK) {
+        board_fatal();
+    }
+}
+
+void HAL_UART_MspInit(UART_HandleTypeDef *huart)
+{
+    GPIO_InitTypeDef pin = {0};
+    RCC_PeriphCLKInitTypeDef pclk = {0};
+    if (huart->Instance != USART1) {
+        return;
+    }
+    pclk.PeriphClockSelection = RCC_PERIPHCLK_USART1;
+    pclk.Usart1ClockSelection = RCC_USART1CLKSOURCE_PCLK2;
+    if (HAL_RCCEx_PeriphCLKConfig(&pclk) != HAL_OK) {
+        board_fatal();
+    }
+    __HAL_RCC_USART1_CLK_ENABLE();
+    __HAL_RCC_GPIOA_CLK_ENABLE();
+    __HAL_RCC_DMAMUX1_CLK_ENABLE();
+    __HAL_RCC_DMA1_CLK_ENABLE();
+
+    pin.Pin = GPIO_PIN_9; /* USART1_TX: the single wire */
+    pin.Mode = GPIO_MODE_AF_PP;
+    pin.Pull = GPIO_PULLUP; /* idle high while nobody drives (add 1-4.7k outside: see docs) */
+    pin.Speed = GPIO_SPEED_FREQ_VERY_HIGH;
+    pin.Alternate = GPIO_AF7_USART1;
+    HAL_GPIO_Init(GPIOA, &pin);
+
+    dma_channel_init(&hdma_usart1_tx, DMA1_Channel1, DMA_REQUEST_USART1_TX, DMA_MEMORY_TO_PERIPH,
+                     DMA_NORMAL);
+    __HAL_LINKDMA(huart, hdmatx, hdma_usart1_tx);
+    dma_channel_init(&hdma_usart1_rx, DMA1_Channel2, DMA_REQUEST_USART1_RX, DMA_PERIPH_TO_MEMORY,
+                     DMA_CIRCULAR);
+    __HAL_LINKDMA(huart, hdmarx, hdma_usart1_rx);
+
+    HAL_NVIC_SetPriority(USART1_IRQn, BUS_IRQ_PRIORITY, 0u);
+    HAL_NVIC_SetPriority(DMA1_Channel1_IRQn, BUS_IRQ_PRIORITY, 0u);
+    HAL_NVIC_SetPriority(DMA1_Channel2_IRQn, BUS_IRQ_PRIORITY, 0u);
+    HAL_NVIC_EnableIRQ(USART1_IRQn);
+    HAL_NVIC_EnableIRQ(DMA1_Channel1_IRQn);
+    HAL_NVIC_EnableIRQ(DMA1_Channel2_IRQn);
+}
+
+void HAL_TIM_Base_MspInit(TIM_HandleTypeDef *htim)
+{
+    if (htim->Instance == TIM2) {
+        __HAL_RCC_TIM2_CLK_ENABLE();
+        HAL_NVIC_SetPriority(TIM2_IRQn, BUS_IRQ_PRIORITY, 0u);
+        HAL_NVIC_EnableIRQ(TIM2_IRQn);
+    }
+}
+
+void HAL_CRC_MspInit(CRC_HandleTypeDef *h)
+{
+    (void)h;
+    __HAL_RCC_CRC_CLK_ENABLE();
+}
+
+/* ---- peripherals ------------------------------------------------------------------------ */
+
+static void button_init(void)
+{
+    GPIO_InitTypeDef pin = {0};
+    __HAL_RCC_GPIOC_CLK_ENABLE();
+    pin.Pin = GPIO_PIN_13;
+    pin.Mode = GPIO_MODE_INPUT;
+    pin.Pull = GPIO_NOPULL; /* B1 has its own resistor */
+    HAL_GPIO_Init(GPIOC, &pin);
+}
+
+bool board_estop_pressed(void)
+{
+    return HAL_GPIO_ReadPin(GPIOC, GPIO_PIN_13) == GPIO_PIN_SET;
+}
+
+static void uart_init(void)
+{
+    huart1.Instance = USART1;
+    huart1.Init.BaudRate = BUS_BAUD;
+    huart1.Init.WordLength = UART_WORDLENGTH_8B;
+    huart1.Init.StopBits = UART_STOPBITS_1;
+    huart1.Init.Parity = UART_PARITY_NONE;
+    huart1.Init.Mode = UART_MODE_TX_RX;
+    huart1.Init.HwFlowCtl = UART_HWCONTROL_NONE;
+    huart1.Init.OverSampling = UART_OVERSAMPLING_16;
+    huart1.Init.OneBitSampling = UART_ONE_BIT_SAMPLE_DISABLE;
+    huart1.Init.ClockPrescaler = UART_PRESCALER_DIV1;
+    huart1.AdvancedInit.AdvFeatureInit = UART_ADVFEATURE_NO_INIT;
+    if ((HAL_HalfDuplex_Init(&huart1) != HAL_OK) || (HAL_UARTEx_DisableFifoMode(&huart1) != HAL_OK)) {
+        board_fatal();
+    }
+    /* 16x oversampling: baud = fck / BRR. */
+    if ((huart1.Instance->BRR == 0u) || ((HAL_RCC_GetPCLK2Freq() % BUS_BAUD) != 0u) ||
+        ((HAL_RCC_GetPCLK2Freq() / huart1.Instance->BRR) != BUS_BAUD)) {
+        board_fatal(); /* the clock tree does not give 6 Mbps exactly */
+    }
+}
+
+static void timer_init(void)
+{
+    htim2.Instance = TIM2;
+    htim2.Init.Prescaler = (HAL_RCC_GetPCLK1Freq() / TICK_HZ) - 1u; /* APB1 undivided */
+    htim2.Init.CounterMode = TIM_COUNTERMODE_UP;
+    htim2.Init.Period = 0xFFFFFFFFu;
+    htim2.Init.ClockDivision = TIM_CLOCKDIVISION_DIV1;
+    htim2.Init.AutoReloadPreload = TIM_AUTORELOAD_PRELOAD_DISABLE;
+    if ((HAL_TIM_Base_Init(&htim2) != HAL_OK) || (HAL_TIM_Base_Start(&htim2) != HAL_OK)) {
+        board_fatal();
+    }
+}
+
+/* The servo's CRC is the unit's reset configuration; a CubeMX project must keep these
+ * (j288_stm32_init refuses anything else). */
+static void crc_init(void)
+{
+    hcrc.Instance = CRC;
+    hcrc.Init.DefaultPolynomialUse = DEFAULT_POLYNOMIAL_ENABLE;
+    hcrc.Init.DefaultInitValueUse = DEFAULT_INIT_VALUE_ENABLE;
+    hcrc.Init.InputDataInversionMode = CRC_INPUTDATA_INVERSION_NONE;
+    hcrc.Init.OutputDataInversionMode = CRC_OUTPUTDATA_INVERSION_DISABLE;
+    hcrc.InputDataFormat = CRC_INPUTDATA_FORMAT_WORDS;
+    if (HAL_CRC_Init(&hcrc) != HAL_OK) {
+        board_fatal();
+    }
+}
+
+void board_init(void)
+{
+    if (HAL_Init() != HAL_OK) {
+        board_fatal();
+    }
+    clock_init();
+    button_init();
+    uart_init();
+    timer_init();
+    crc_init();
+}
+
+/* ---- interrupt handlers (the names of ST's startup_stm32g474xx.s vector table) ---------- */
+
+void SysTick_Handler(void) { HAL_IncTick(); }
+void USART1_IRQHandler(void) { HAL_UART_IRQHandler(&huart1); }
+void DMA1_Channel1_IRQHandler(void) { HAL_DMA_IRQHandler(&hdma_usart1_tx); }
+void DMA1_Channel2_IRQHandler(void) { HAL_DMA_IRQHandler(&hdma_usart1_rx); }
+void TIM2_IRQHandler(void) { HAL_TIM_IRQHandler(&htim2); }
+
+/* Faults: as on the F446RE board. */
+void board_fault_record(const uint32_t *frame);
+void board_fault_record(const uint32_t *frame)
+{
+    board_fault.cfsr = SCB->CFSR;
+    board_fault.hfsr = SCB->HFSR;
+    board_fault.mmfar = SCB->MMFAR;
+    board_fault.bfar = SCB->BFAR;
+    board_fault.pc = frame[6];
+    board_fault.lr = frame[5];
+    board_fault.count++;
+    board_fatal();
+}
+
+__attribute__((naked)) void HardFault_Handler(void)
+{
+    __asm volatile("tst lr, #4\n\t"
+                   "ite eq\n\t"
+                   "mrseq r0, msp\n\t"
+                   "mrsne r0, psp\n\t"
+                   "b board_fault_record\n\t");
+}

@@ -1,0 +1,116 @@
+# The STM32 port's build checks and the flashable firmware against ST's real HAL:
+#   make firmware      examples/stm32_hal for its boards, against ST's sources fetched by
+#                      scripts/fetch-st.sh into build/st/ (skipped with a notice without them)
+# CI builds the port and the example against the HAL stub only (`make arm`, mk/target.mk).
+
+# J288_STM32_DCACHE=1 on a core without a data cache stops with an #error that says why.
+TEST_SCRIPTS += test/stm32/dcache_needs_a_cache.sh
+
+# ---- make firmware: examples/stm32_hal per board, against ST's HAL in ST_DIR ---------------
+# Per board <b> (examples/stm32_hal/<b>/ holds board.c, main.h, the HAL configuration and the
+# linker script): FW_<b>_FAMILY (f4, g4: the fetch-st.sh family), FW_<b>_DEVICE (ST's device
+# define; its lower case names ST's startup file), FW_<b>_HAL (the HAL modules compiled).
+ST_DIR ?= build/st
+FW_BOARDS := nucleo_f446re nucleo_g474re
+FW_nucleo_f446re_FAMILY := f4
+FW_nucleo_f446re_DEVICE := STM32F446xx
+FW_nucleo_f446re_LD := stm32f446re.ld
+FW_nucleo_f446re_HAL := hal hal_cortex hal_rcc hal_rcc_ex hal_gpio hal_dma hal_dma_ex hal_uart \
+    hal_tim hal_tim_ex hal_crc hal_pwr hal_pwr_ex hal_flash hal_flash_ex
+FW_nucleo_g474re_FAMILY := g4
+FW_nucleo_g474re_DEVICE := STM32G474xx
+FW_nucleo_g474re_LD := stm32g474re.ld
+FW_nucleo_g474re_HAL := hal hal_cortex hal_rcc hal_rcc_ex hal_gpio hal_dma hal_dma_ex hal_uart \
+    hal_uart_ex hal_tim hal_tim_ex hal_crc hal_crc_ex hal_pwr hal_pwr_ex hal_flash hal_flash_ex
+# Our code keeps every warning (ST's headers are system headers); ST's sources get none.
+FW_APP_SRC := examples/stm32_hal/main.c port/stm32_hal/j288_stm32.c $(LIB_SRC)
+FW_ELFS := $(foreach b,$(FW_BOARDS),$(BUILD)/firmware/$(b)/j288_$(b).elf)
+
+# $(call FW_RULES,board)
+define FW_RULES
+FW_$(1)_HALDIR := $(ST_DIR)/stm32$(FW_$(1)_FAMILY)xx_hal_driver
+FW_$(1)_DEVDIR := $(ST_DIR)/cmsis_device_$(FW_$(1)_FAMILY)
+FW_$(1)_ST_SRC := $$(FW_$(1)_HAL:%=$$(FW_$(1)_HALDIR)/Src/stm32$(FW_$(1)_FAMILY)xx_%.c) \
+    $$(FW_$(1)_DEVDIR)/Source/Templates/system_stm32$(FW_$(1)_FAMILY)xx.c
+FW_$(1)_STARTUP := $$(FW_$(1)_DEVDIR)/Source/Templates/gcc/startup_$(shell echo $(FW_$(1)_DEVICE) | tr A-Z a-z).s
+FW_$(1)_CC := $(call TC,m4f,CC) $(CPU_m4f_FLAGS) $(CPU_m4f_DEFS) -D$(FW_$(1)_DEVICE) -DUSE_HAL_DRIVER \
+    -Iexamples/stm32_hal/$(1) -Iexamples/stm32_hal -Iport/stm32_hal $(CPPFLAGS_LIB) \
+    -isystem $$(FW_$(1)_HALDIR)/Inc -isystem $$(FW_$(1)_DEVDIR)/Include -isystem $(ST_DIR)/cmsis_core/Include \
+    -Os -g -ffunction-sections -fdata-sections
+FW_$(1)_OBJ := $(FW_APP_SRC:%.c=$(BUILD)/firmware/$(1)/obj/%.o) $(BUILD)/firmware/$(1)/obj/board.o \
+    $$(patsubst $(ST_DIR)/%.c,$(BUILD)/firmware/$(1)/st/%.o,$$(FW_$(1)_ST_SRC)) $(BUILD)/firmware/$(1)/st/startup.o
+
+$(BUILD)/firmware/$(1)/obj/%.o: %.c $(LIB_HDR) $(wildcard port/stm32_hal/*.h examples/stm32_hal/*.h examples/stm32_hal/$(1)/*.h)
+	@mkdir -p $$(@D)
+	$$(FW_$(1)_CC) $(CSTD) $(WARN) -c $$< -o $$@
+$(BUILD)/firmware/$(1)/obj/board.o: examples/stm32_hal/$(1)/board.c $(wildcard examples/stm32_hal/*.h examples/stm32_hal/$(1)/*.h)
+	@mkdir -p $$(@D)
+	$$(FW_$(1)_CC) $(CSTD) $(WARN) -c $$< -o $$@
+$(BUILD)/firmware/$(1)/st/%.o: $(ST_DIR)/%.c $(wildcard examples/stm32_hal/$(1)/*.h)
+	@mkdir -p $$(@D)
+	$$(FW_$(1)_CC) -std=gnu11 -w -c $$< -o $$@
+$(BUILD)/firmware/$(1)/st/startup.o: $$(FW_$(1)_STARTUP)
+	@mkdir -p $$(@D)
+	$$(FW_$(1)_CC) -x assembler-with-cpp -c $$< -o $$@
+$(BUILD)/firmware/$(1)/j288_$(1).elf: $$(FW_$(1)_OBJ) examples/stm32_hal/$(1)/$(FW_$(1)_LD)
+	$(call TC,m4f,CC) $(CPU_m4f_FLAGS) --specs=nano.specs --specs=nosys.specs -Wl,--gc-sections \
+	    -Wl,-Map=$$(@:.elf=.map) -T examples/stm32_hal/$(1)/$(FW_$(1)_LD) $$(FW_$(1)_OBJ) -o $$@ -lm
+	arm-none-eabi-objcopy -O binary $$@ $$(@:.elf=.bin)
+	@$(call TC,m4f,SIZE) $$@ | awk 'NR==2 { printf "$(1): flash %d bytes (text+data), RAM %d bytes (data+bss, stack reserve included)\n", $$$$1+$$$$2, $$$$2+$$$$3 }'
+endef
+$(foreach b,$(FW_BOARDS),$(eval $(call FW_RULES,$(b))))
+
+.PHONY: firmware firmware-build
+# Skips with a notice when ST's sources are not in ST_DIR (CI never fetches them).
+firmware:
+	@$(call REQUIRE_TC,m4f); \
+	 missing=; for f in $(sort $(foreach b,$(FW_BOARDS),$(FW_$(b)_FAMILY))); do \
+	     for r in stm32$${f}xx_hal_driver cmsis_device_$$f; do [ -f $(ST_DIR)/$$r/.tag ] || missing="$$missing $$r"; done; done; \
+	 [ -f $(ST_DIR)/cmsis_core/.tag ] || missing="$$missing cmsis_core"; \
+	 if [ -n "$$missing" ]; then \
+	     echo "firmware: skipped: ST's sources are not in $(ST_DIR) (missing:$$missing)."; \
+	     echo "          Fetch them with: bash scripts/fetch-st.sh   (ST_MIRROR=dir for a local mirror)"; \
+	     exit 0; fi; \
+	 $(MAKE) --no-print-directory firmware-build
+
+# Then the port against ST's headers where the stub cannot stand in: J288_STM32_DCACHE=1
+# stops with its #error on the F4 and builds on the H7 (when fetched).
+firmware-build: $(FW_ELFS)
+	@ST_DIR=$(ST_DIR) ARM_CC=$(call TC,m4f,CC) CC="$(CC)" bash test/stm32/dcache_needs_a_cache.sh
+
+# ---- make bench-stm32-hal: what the port adds per transaction, ST's F4 HAL included --------
+# test/stm32/hal_bench.c on Cortex-M4 under QEMU (-icount), against ST's HAL in ST_DIR, with
+# the NUCLEO-F446RE's HAL configuration; skipped with a notice without the sources.
+HB_HAL := $(FW_nucleo_f446re_HAL:%=$(ST_DIR)/stm32f4xx_hal_driver/Src/stm32f4xx_%.c) \
+    $(ST_DIR)/cmsis_device_f4/Source/Templates/system_stm32f4xx.c
+HB_APP := test/stm32/hal_bench.c port/stm32_hal/j288_stm32.c $(LIB_SRC) $(call TC,m4f,STARTUP)
+HB_CC = $(call CPU_CC,m4f) -DSTM32F446xx -DUSE_HAL_DRIVER -Iexamples/stm32_hal/nucleo_f446re \
+    -Iport/stm32_hal $(CPPFLAGS_LIB) -isystem $(ST_DIR)/stm32f4xx_hal_driver/Inc \
+    -isystem $(ST_DIR)/cmsis_device_f4/Include -isystem $(ST_DIR)/cmsis_core/Include \
+    -ffunction-sections -fdata-sections -g
+
+define HB_RULES
+$(BUILD)/bench-stm32-hal/$(1)/app/%.o: %.c $(LIB_HDR) $(wildcard port/stm32_hal/*.h)
+	@mkdir -p $$(@D)
+	$(HB_CC) -$(1) $(CSTD) $(WARN) -c $$< -o $$@
+$(BUILD)/bench-stm32-hal/$(1)/st/%.o: $(ST_DIR)/%.c
+	@mkdir -p $$(@D)
+	$(HB_CC) -$(1) -std=gnu11 -w -c $$< -o $$@
+$(BUILD)/bench-stm32-hal/hal_bench_$(1).elf: $(HB_APP:%.c=$(BUILD)/bench-stm32-hal/$(1)/app/%.o) \
+    $(patsubst $(ST_DIR)/%.c,$(BUILD)/bench-stm32-hal/$(1)/st/%.o,$(HB_HAL))
+	$(call TC,m4f,CC) $(call TGT_LINK_FLAGS,m4f,SEMIHOST,$(CPU_m4f_LD)) $$^ -o $$@ -lm
+endef
+$(foreach o,O2 Os,$(eval $(call HB_RULES,$(o))))
+
+.PHONY: bench-stm32-hal
+bench-stm32-hal:
+	@$(call REQUIRE_TC,m4f,QEMU); \
+	 if [ ! -f $(ST_DIR)/stm32f4xx_hal_driver/.tag ] || [ ! -f $(ST_DIR)/cmsis_device_f4/.tag ] || \
+	    [ ! -f $(ST_DIR)/cmsis_core/.tag ]; then \
+	     echo "bench-stm32-hal: skipped: ST's F4 sources are not in $(ST_DIR) (bash scripts/fetch-st.sh f4)"; \
+	     exit 0; fi; \
+	 $(MAKE) --no-print-directory $(BUILD)/bench-stm32-hal/hal_bench_O2.elf $(BUILD)/bench-stm32-hal/hal_bench_Os.elf && \
+	 for o in O2 Os; do \
+	    echo "Cortex-M4F ($(CPU_m4f_QEMU), QEMU -icount shift=0), -$$o:"; \
+	    $(call QEMU_BENCH,m4f,$(BUILD)/bench-stm32-hal/hal_bench_$$o.elf) || exit 1; echo; \
+	 done

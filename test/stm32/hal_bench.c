@@ -1,0 +1,345 @@
+/*
+ * Instructions per transaction that the STM32 port adds on top of lib/, HAL calls included,
+ * on Cortex-M4 under QEMU (-icount shift=0: SysTick counts instructions once calibrated on a
+ * loop of known length). Built against ST's real STM32F4 HAL (`make bench-stm32-hal`, after
+ * scripts/fetch-st.sh): the port, the HAL's UART and DMA drivers and the library run as on an
+ * F446, on peripherals played in RAM (QEMU's mps2 board has no STM32 USART or DMA): the HAL
+ * reaches its registers through the handles' Instance pointers, so RAM register blocks laid
+ * out as the silicon's (a DMA controller on a 1 KiB boundary, its streams at their offsets)
+ * serve. The bench raises the hardware's flags and calls the HAL's interrupt handlers where
+ * the NVIC would; those few stores are counted with the port. The reply stays in the DMA
+ * buffer between transactions (the DMA's writes cost the CPU nothing on silicon).
+ *
+ * Rows, per transaction (submit, poll, transmit, TX complete, turn to receive, 26-byte reply
+ * ended by an idle line, poll, guard): lib/ alone behind a port whose operations do nothing
+ * (the floor any port starts from), then the STM32 port with its receive stream in normal
+ * mode (re-armed after every idle line) and in circular mode. Frame CRCs in software (the
+ * CRC unit's path is measured by `make bench-target`).
+ */
+#include <stdio.h>
+#include <string.h>
+
+#include "j288/j288.h"
+#include "j288_stm32.h"
+
+#define SYST_CSR (*(volatile uint32_t *)0xE000E010u)
+#define SYST_RVR (*(volatile uint32_t *)0xE000E014u)
+#define SYST_CVR (*(volatile uint32_t *)0xE000E018u)
+#define ITERATIONS 200u
+#define CAL_LOOPS 100000u
+
+/* The spec's worked reply of servo 3. */
+static const uint8_t k_reply3[J288_REPLY_LEN] = {
+    0xfc, 0xee, 0x13, 0x24, 0x29, 0x30, 0x00, 0x05, 0xd7, 0xff, 0x5f, 0x14, 0x00,
+    0x00, 0x00, 0x00, 0x00, 0x00, 0xe8, 0x03, 0x00, 0x00, 0x49, 0xc2, 0x3b, 0xee};
+
+static uint32_t clock_us = 1000u;
+static uint32_t done_ok;
+
+/* Per-phase SysTick ticks: 0 submit and transmit start, 1 transmit complete and turn to
+ * receive, 2 the reply and the idle line, 3 the polls that finish and end the guard. */
+#define PHASES 4u
+static uint32_t phase_ticks[PHASES];
+static uint32_t phase_t;
+static void phase_begin(void) { phase_t = SYST_CVR; }
+static void phase_end(unsigned i)
+{
+    uint32_t t = SYST_CVR;
+    phase_ticks[i] += (phase_t - t) & 0x00FFFFFFu;
+    phase_t = t;
+}
+
+static void systick_start(void)
+{
+    SYST_CSR = 0u;
+    SYST_RVR = 0x00FFFFFFu;
+    SYST_CVR = 0u;
+    SYST_CSR = 5u; /* enable, processor clock, no interrupt */
+}
+static uint32_t systick_now(void) { return SYST_CVR; }
+static uint32_t ticks_between(uint32_t a, uint32_t b) { return (a - b) & 0x00FFFFFFu; }
+
+/* Instructions per SysTick tick, x1000, from a two-instruction loop. */
+static uint32_t calibrate(void)
+{
+    uint32_t n = CAL_LOOPS;
+    uint32_t t0 = systick_now();
+    __asm volatile(".syntax unified\n1: subs %0, %0, #1\n\tbne 1b" : "+l"(n) : : "cc");
+    return (uint32_t)((2ull * CAL_LOOPS * 1000u) / ticks_between(t0, systick_now()));
+}
+
+static uint32_t per_txn(uint32_t ticks, uint32_t ipt_milli)
+{
+    return (uint32_t)(((uint64_t)ticks * ipt_milli / 1000u + ITERATIONS / 2u) / ITERATIONS);
+}
+
+static void on_done(void *user, const j288_txn_t *txn)
+{
+    (void)user;
+    done_ok += (txn->result == J288_OK) ? 1u : 0u;
+}
+
+static j288_cmd_raw_t foc3_cmd(void)
+{
+    j288_cmd_raw_t c;
+    memset(&c, 0, sizeof c);
+    c.id = 3u;
+    c.status = J288_MODE_FOC;
+    c.watchdog = true;
+    c.pos = 5215;
+    c.kp = 1280;
+    c.kd = 12800;
+    return c;
+}
+
+/* ---- lib/ alone: a port whose operations do nothing ------------------------------------- */
+
+static j288_bus_t plain_bus;
+
+static int nop_start_tx(void *ctx, const uint8_t *data, size_t len)
+{
+    (void)ctx;
+    (void)data;
+    (void)len;
+    return 0;
+}
+static uint32_t nop_now_us(void *ctx)
+{
+    (void)ctx;
+    return clock_us;
+}
+static void nop_dir(void *ctx, j288_dir_t dir)
+{
+    (void)ctx;
+    (void)dir;
+}
+static void nop_ctx(void *ctx) { (void)ctx; }
+static void nop_arm(void *ctx, uint32_t t)
+{
+    (void)ctx;
+    (void)t;
+}
+
+static const j288_port_t nop_port = {
+    .start_tx = nop_start_tx,
+    .now_us = nop_now_us,
+    .start_rx = nop_ctx,
+    .set_dir = nop_dir,
+    .arm_timeout = nop_arm,
+    .lock = nop_ctx,
+    .unlock = nop_ctx,
+};
+
+static void plain_transaction(void)
+{
+    j288_cmd_raw_t cmd = foc3_cmd();
+    phase_begin();
+    (void)j288_bus_submit(&plain_bus, &cmd, clock_us, on_done, NULL);
+    j288_bus_poll(&plain_bus, clock_us);
+    phase_end(0u);
+    j288_bus_on_tx_done(&plain_bus);
+    phase_end(1u);
+    j288_bus_on_rx(&plain_bus, k_reply3, J288_REPLY_LEN);
+    j288_bus_on_rx_idle(&plain_bus);
+    phase_end(2u);
+    clock_us += 100u;
+    j288_bus_poll(&plain_bus, clock_us);
+    clock_us += 10u;
+    j288_bus_poll(&plain_bus, clock_us);
+    phase_end(3u);
+}
+
+/* ---- the STM32 port on the real HAL, peripherals in RAM --------------------------------- */
+
+/* DMA2 as the HAL addresses it: LISR, HISR, LIFCR, HIFCR, then 8 streams of 0x18 bytes from
+ * offset 0x10; the HAL finds a stream's flags from the stream's address. */
+static uint32_t dma2_block[0x100u / 4u] __attribute__((aligned(1024)));
+#define DMA2_STREAM(n) ((DMA_Stream_TypeDef *)(void *)((uint8_t *)dma2_block + 0x10u + 0x18u * (n)))
+#define DMA2_HISR (dma2_block[1])
+#define DMA2_LISR (dma2_block[0])
+#define TCIF7 (1u << 27) /* stream 7's transfer-complete flag in HISR */
+
+static USART_TypeDef usart1_regs;
+static TIM_TypeDef tim2_regs;
+static UART_HandleTypeDef huart1;
+static DMA_HandleTypeDef hdma_tx, hdma_rx;
+static TIM_HandleTypeDef htim2;
+J288_STM32_DMA_BUFFER(bus_dma);
+static j288_stm32_t port;
+
+/* The application's HAL callbacks, as in examples/stm32_hal/main.c. */
+void HAL_UART_TxCpltCallback(UART_HandleTypeDef *h) { (void)j288_stm32_on_tx_cplt(h); }
+void HAL_UARTEx_RxEventCallback(UART_HandleTypeDef *h, uint16_t n) { (void)j288_stm32_on_rx_event(h, n); }
+void HAL_UART_ErrorCallback(UART_HandleTypeDef *h) { (void)j288_stm32_on_error(h); }
+void HAL_TIM_OC_DelayElapsedCallback(TIM_HandleTypeDef *h) { (void)j288_stm32_on_timer(h); }
+
+static uint32_t bench_now_us(void) { return clock_us; }
+
+static int port_setup(uint32_t rx_mode)
+{
+    j288_stm32_config_t pc;
+    static const DMA_HandleTypeDef zero_dma;
+
+    memset(dma2_block, 0, sizeof dma2_block);
+    memset(&usart1_regs, 0, sizeof usart1_regs);
+    memset(&huart1, 0, sizeof huart1);
+    hdma_tx = zero_dma;
+    hdma_rx = zero_dma;
+
+    hdma_tx.Instance = DMA2_STREAM(7u);
+    hdma_tx.Init.Channel = DMA_CHANNEL_4;
+    hdma_tx.Init.Direction = DMA_MEMORY_TO_PERIPH;
+    hdma_tx.Init.MemInc = DMA_MINC_ENABLE;
+    hdma_tx.Init.Mode = DMA_NORMAL;
+    hdma_rx.Instance = DMA2_STREAM(2u);
+    hdma_rx.Init.Channel = DMA_CHANNEL_4;
+    hdma_rx.Init.Direction = DMA_PERIPH_TO_MEMORY;
+    hdma_rx.Init.MemInc = DMA_MINC_ENABLE;
+    hdma_rx.Init.Mode = rx_mode;
+    if ((HAL_DMA_Init(&hdma_tx) != HAL_OK) || (HAL_DMA_Init(&hdma_rx) != HAL_OK)) {
+        return -1;
+    }
+    /* What HAL_HalfDuplex_Init leaves (its clock and baud setup needs the RCC, which is not
+     * here): the handle ready, the UART on in half-duplex mode, the streams linked. */
+    huart1.Instance = &usart1_regs;
+    huart1.Init.BaudRate = 6000000u;
+    huart1.Init.Mode = UART_MODE_TX_RX;
+    huart1.Init.OverSampling = UART_OVERSAMPLING_8;
+    huart1.hdmatx = &hdma_tx;
+    huart1.hdmarx = &hdma_rx;
+    hdma_tx.Parent = &huart1;
+    hdma_rx.Parent = &huart1;
+    huart1.gState = HAL_UART_STATE_READY;
+    huart1.RxState = HAL_UART_STATE_READY;
+    usart1_regs.CR1 = USART_CR1_UE | USART_CR1_TE | USART_CR1_RE;
+    usart1_regs.CR3 = USART_CR3_HDSEL;
+
+    htim2.Instance = &tim2_regs;
+    tim2_regs.ARR = 0xFFFFFFFFu;
+
+    memset(&pc, 0, sizeof pc);
+    pc.huart = &huart1;
+    pc.dma = &bus_dma;
+    pc.now_us = bench_now_us;
+    pc.htim = &htim2;
+    pc.tim_channel = TIM_CHANNEL_1;
+    j288_stm32_deinit(&port);
+    return j288_stm32_init(&port, &pc, NULL);
+}
+
+/* The TX stream's last byte went to the UART, then the UART's last stop bit went out. */
+static void hw_transmit_done(void)
+{
+    DMA2_HISR |= TCIF7;
+    HAL_DMA_IRQHandler(&hdma_tx);
+    DMA2_HISR = 0u;
+    usart1_regs.SR |= USART_SR_TC;
+    HAL_UART_IRQHandler(&huart1);
+    usart1_regs.SR = 0u;
+}
+
+/* 26 bytes received by the RX stream (already in its buffer), then the line idles. */
+static void hw_reply_then_idle(void)
+{
+    hdma_rx.Instance->NDTR = J288_STM32_RX_BUF_SIZE - J288_REPLY_LEN;
+    usart1_regs.SR |= USART_SR_IDLE;
+    HAL_UART_IRQHandler(&huart1);
+    usart1_regs.SR = 0u;
+}
+
+static void port_transaction(void)
+{
+    j288_cmd_raw_t cmd = foc3_cmd();
+    j288_bus_t *bus = j288_stm32_bus(&port);
+    phase_begin();
+    (void)j288_bus_submit(bus, &cmd, clock_us, on_done, NULL);
+    j288_bus_poll(bus, clock_us);
+    phase_end(0u);
+    hw_transmit_done();
+    phase_end(1u);
+    hw_reply_then_idle();
+    phase_end(2u);
+    clock_us += 100u;
+    j288_bus_poll(bus, clock_us);
+    clock_us += 10u;
+    j288_bus_poll(bus, clock_us);
+    phase_end(3u);
+}
+
+/* ---- the run ------------------------------------------------------------------------------ */
+
+typedef struct {
+    uint32_t total;
+    uint32_t phase[PHASES];
+} result_t;
+
+static result_t run(void (*txn)(void), uint32_t ipt)
+{
+    result_t r;
+    uint32_t t0, t1;
+    txn(); /* warm: the first transaction, then measure */
+    done_ok = 0u;
+    memset(phase_ticks, 0, sizeof phase_ticks);
+    t0 = systick_now();
+    for (uint32_t i = 0; i < ITERATIONS; i++) {
+        txn();
+    }
+    t1 = systick_now();
+    r.total = (done_ok == ITERATIONS) ? per_txn(ticks_between(t0, t1), ipt) : 0u;
+    for (unsigned i = 0; i < PHASES; i++) {
+        r.phase[i] = per_txn(phase_ticks[i], ipt);
+    }
+    return r;
+}
+
+static void print_row(const char *name, const result_t *r, const result_t *base)
+{
+    printf("| %s | %u", name, (unsigned)r->total);
+    if (base == NULL) {
+        printf(" | -");
+    } else {
+        printf(" | %u", (unsigned)(r->total - base->total));
+    }
+    for (unsigned i = 0; i < PHASES; i++) {
+        printf(" | %u", (unsigned)r->phase[i]);
+    }
+    printf(" |\n");
+}
+
+int main(void)
+{
+    uint32_t ipt;
+    result_t plain, normal, circular;
+
+    systick_start();
+    ipt = calibrate();
+    memcpy(bus_dma.rx, k_reply3, J288_REPLY_LEN);
+
+    if (j288_bus_init(&plain_bus, &nop_port, NULL, NULL) != J288_OK) {
+        return 1;
+    }
+    plain = run(plain_transaction, ipt);
+    if (port_setup(DMA_NORMAL) != J288_OK) {
+        printf("port setup failed\n");
+        return 1;
+    }
+    normal = run(port_transaction, ipt);
+    if (port_setup(DMA_CIRCULAR) != J288_OK) {
+        printf("port setup failed\n");
+        return 1;
+    }
+    circular = run(port_transaction, ipt);
+    if ((plain.total == 0u) || (normal.total == 0u) || (circular.total == 0u)) {
+        printf("a transaction did not end J288_OK\n");
+        return 1;
+    }
+    printf("bench: %u transactions each; %u.%03u instructions per SysTick tick\n",
+           (unsigned)ITERATIONS, (unsigned)(ipt / 1000u), (unsigned)(ipt % 1000u));
+    printf("| path | per transaction | added | submit + TX start | TX complete + turn | "
+           "reply + idle | polls to the end |\n");
+    printf("|---|---:|---:|---:|---:|---:|---:|\n");
+    print_row("lib/ alone (port operations empty)", &plain, NULL);
+    print_row("STM32 port + F4 HAL, RX stream normal", &normal, &plain);
+    print_row("STM32 port + F4 HAL, RX stream circular", &circular, &plain);
+    return 0;
+}
