@@ -54,6 +54,9 @@ int cli_bus_common_opt(cli_bus_opts_t *o, int key, const char *value)
     case CLI_OPT_JSON:
         o->json = true;
         return 0;
+    case CLI_OPT_CONFIG:
+        o->config = value;
+        return 0;
     default:
         return 1;
     }
