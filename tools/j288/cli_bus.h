@@ -75,6 +75,14 @@ extern volatile sig_atomic_t cli_stop_signal;
 /* Start from the global options (cli_global_t). */
 void cli_bus_opts_init(cli_bus_opts_t *o, const cli_global_t *g);
 
+/* The parse loop of a bus command: common options go to o, the command's own keys (and
+ * positional arguments, key CLI_ARG_POSITIONAL) to fn (NULL: none), which returns 0, -1 after
+ * an error message, or 1 for "not mine". Returns 0 when done, or -1 with *exit_code set
+ * (CLI_EXIT_OK after --help, which prints help; CLI_EXIT_USAGE). */
+typedef int (*cli_own_opt_fn)(void *ctx, int key, const char *value);
+int cli_parse_bus_args(int argc, char **argv, const cli_opt_t *opts, const char *help,
+                       cli_bus_opts_t *o, cli_own_opt_fn fn, void *ctx, int *exit_code);
+
 /* Handle a common option key; returns 0, or -1 after an error message. Keys below
  * CLI_BUS_OPT_BASE are not common: returns 1 (not handled). */
 int cli_bus_common_opt(cli_bus_opts_t *o, int key, const char *value);

@@ -17,43 +17,6 @@
 #define DEFAULT_RATE_HZ           200.0
 #define DEFAULT_MOVE_SPEED_OUTPUT 1.0 /* rad/s */
 
-/* Parse loop shared by every bus command: common options are handled here, the command's
- * own keys are passed to fn. Returns -1 (exit code in *exit_code) to stop, 0 when done. */
-typedef int (*own_opt_fn)(void *ctx, int key, const char *value);
-
-static int parse_bus_args(int argc, char **argv, const cli_opt_t *opts, const char *help,
-                          cli_bus_opts_t *o, own_opt_fn fn, void *ctx, int *exit_code)
-{
-    cli_args_t a;
-    const char *v;
-    int key, rc;
-    cli_args_init(&a, argc, argv);
-    while ((key = cli_args_next(&a, opts, &v)) != CLI_ARG_END) {
-        if (key == CLI_ARG_HELP) {
-            fputs(help, stdout);
-            *exit_code = CLI_EXIT_OK;
-            return -1;
-        }
-        if (key == CLI_ARG_ERROR) {
-            *exit_code = CLI_EXIT_USAGE;
-            return -1;
-        }
-        rc = key == CLI_ARG_POSITIONAL ? 1 : cli_bus_common_opt(o, key, v);
-        if (rc == 1) {
-            rc = fn != NULL ? fn(ctx, key, v) : 1;
-            if (rc == 1) {
-                cli_error("unexpected argument '%s' (try --help)", v != NULL ? v : "");
-                rc = -1;
-            }
-        }
-        if (rc != 0) {
-            *exit_code = CLI_EXIT_USAGE;
-            return -1;
-        }
-    }
-    return 0;
-}
-
 /* The robot config of this run: one per process, too large for the stack. */
 static cli_robot_t g_robot;
 
@@ -83,7 +46,7 @@ int cli_cmd_scan(int argc, char **argv, const cli_global_t *g)
     uint8_t id;
 
     cli_bus_opts_init(&o, g);
-    if (parse_bus_args(argc, argv, opts, scan_help, &o, NULL, NULL, &ec) != 0) {
+    if (cli_parse_bus_args(argc, argv, opts, scan_help, &o, NULL, NULL, &ec) != 0) {
         return ec;
     }
     if (cli_robot_load(&g_robot, o.config) != 0) {
@@ -250,7 +213,7 @@ int cli_cmd_status(int argc, char **argv, const cli_global_t *g)
     int ec;
 
     cli_bus_opts_init(&o, g);
-    if (parse_bus_args(argc, argv, opts, status_help, &o, parse_id_opt, &c, &ec) != 0) {
+    if (cli_parse_bus_args(argc, argv, opts, status_help, &o, parse_id_opt, &c, &ec) != 0) {
         return ec;
     }
     if (select_joint(&o, c.joint, c.id, &sel, &joint) != 0) {
@@ -312,7 +275,7 @@ int cli_cmd_stop(int argc, char **argv, const cli_global_t *g)
     int ec, rc;
 
     cli_bus_opts_init(&o, g);
-    if (parse_bus_args(argc, argv, opts, stop_help, &o, parse_id_opt, &c, &ec) != 0) {
+    if (cli_parse_bus_args(argc, argv, opts, stop_help, &o, parse_id_opt, &c, &ec) != 0) {
         return ec;
     }
     if (cli_robot_load(&g_robot, o.config) != 0) {
@@ -945,7 +908,7 @@ int cli_cmd_hold(int argc, char **argv, const cli_global_t *g)
     int ec;
     drive_args_init(&d, DRIVE_HOLD);
     cli_bus_opts_init(&o, g);
-    if (parse_bus_args(argc, argv, opts, hold_help, &o, parse_drive_opt, &d, &ec) != 0) {
+    if (cli_parse_bus_args(argc, argv, opts, hold_help, &o, parse_drive_opt, &d, &ec) != 0) {
         return ec;
     }
     return run_drive(&d, &o);
@@ -975,7 +938,7 @@ int cli_cmd_move(int argc, char **argv, const cli_global_t *g)
     int ec;
     drive_args_init(&d, DRIVE_MOVE);
     cli_bus_opts_init(&o, g);
-    if (parse_bus_args(argc, argv, opts, move_help, &o, parse_drive_opt, &d, &ec) != 0) {
+    if (cli_parse_bus_args(argc, argv, opts, move_help, &o, parse_drive_opt, &d, &ec) != 0) {
         return ec;
     }
     return run_drive(&d, &o);
@@ -997,7 +960,7 @@ int cli_cmd_torque(int argc, char **argv, const cli_global_t *g)
     int ec;
     drive_args_init(&d, DRIVE_TORQUE);
     cli_bus_opts_init(&o, g);
-    if (parse_bus_args(argc, argv, opts, torque_help, &o, parse_drive_opt, &d, &ec) != 0) {
+    if (cli_parse_bus_args(argc, argv, opts, torque_help, &o, parse_drive_opt, &d, &ec) != 0) {
         return ec;
     }
     return run_drive(&d, &o);
