@@ -22,13 +22,14 @@ $(LINUX_A): $(OBJ)/port/linux/j288_linux.o
 TOOL_CPPFLAGS := $(LINUX_CPPFLAGS) -D_XOPEN_SOURCE=700
 J288_SRC := $(sort $(wildcard tools/j288/*.c))
 J288_HDR := $(wildcard tools/j288/*.h)
-$(OBJ)/tools/j288/%.o: tools/j288/%.c $(J288_HDR) $(LIB_HDR) port/linux/j288_linux.h
+$(OBJ)/tools/j288/%.o: tools/j288/%.c $(J288_HDR) $(LIB_HDR) port/linux/j288_linux.h \
+    port/linux/j288_robot_config.h
 	@mkdir -p $(@D)
 	$(CC) $(TOOL_CPPFLAGS) $(CFLAGS_COMMON) -c $< -o $@
 
-$(J288_BIN): $(J288_SRC:%.c=$(OBJ)/%.o) $(LINUX_A) $(LIB_A)
+$(J288_BIN): $(J288_SRC:%.c=$(OBJ)/%.o) $(OBJ)/port/linux/j288_robot_config.o $(LINUX_A) $(LIB_A)
 	@mkdir -p $(@D)
-	$(CC) $(CFLAGS_COMMON) $^ -o $@ $(LDFLAGS_COMMON) -lm
+	$(CC) $(CFLAGS_COMMON) $^ -o $@ $(LDFLAGS_COMMON) $(call yaml_var,YAML_LIBS) -lm
 
 # The simulator: servo_model.c (servos and bus, no I/O) and sim_main.c (the pty front end).
 SIM_MODEL_OBJ := $(OBJ)/tools/j288-sim/servo_model.o

@@ -50,6 +50,28 @@ int j288_robot_config_find_bus(const j288_robot_config_t *cfg, const char *name)
     return -1;
 }
 
+void j288_robot_config_joint_config(const j288_robot_config_joint_t *rj, j288_joint_config_t *jc)
+{
+    if (rj == NULL || jc == NULL)
+        return;
+    memset(jc, 0, sizeof *jc);
+    jc->id = rj->id;
+    jc->direction = (int8_t)(rj->direction < 0 ? -1 : 1);
+    jc->clamp = rj->clamp;
+    jc->zero = (j288_real_t)rj->zero;
+    /* Without limits the file means the library's default range: both 0 say so. */
+    if (rj->has_limits) {
+        jc->pos_min = (j288_real_t)rj->pos_min;
+        jc->pos_max = (j288_real_t)rj->pos_max;
+    }
+    jc->max_speed = rj->has_max_speed ? (j288_real_t)rj->max_speed : 0;
+    jc->max_torque = rj->has_max_torque ? (j288_real_t)rj->max_torque : 0;
+    jc->kp = rj->has_kp ? (j288_real_t)rj->kp : 0;
+    jc->kd = rj->has_kd ? (j288_real_t)rj->kd : 0;
+    jc->has_phase = rj->has_phase;
+    jc->phase = rj->has_phase ? (j288_real_t)rj->phase : 0;
+}
+
 /* The whole file into a malloc'ed buffer (NUL-terminated for convenience), growing it as
  * needed up to J288_ROBOT_CONFIG_FILE_MAX bytes. */
 static int read_file(const char *path, char **text, size_t *len, char *err, size_t errlen)

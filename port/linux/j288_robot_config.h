@@ -54,6 +54,8 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "j288/joint.h"
+
 #ifdef __cplusplus
 extern "C" {
 #endif
@@ -138,6 +140,15 @@ int j288_robot_config_find_bus(const j288_robot_config_t *cfg, const char *name)
  * then untouched (an error while replacing it leaves the old file in place). */
 int j288_robot_config_write_joint(const char *path, const char *joint, const j288_robot_config_update_t *upd,
                             char *err, size_t errlen);
+
+/* The library's configuration of a joint read from the file (j288/joint.h): id, direction,
+ * zero, clamp and phase as given; limits, max_speed, max_torque, kp and kd as given, else 0
+ * (the library's defaults: [-pi, pi], no speed or torque limit beyond the wire's, no default
+ * gains); the start's sample count and tolerances at the library's defaults (0). Checks
+ * nothing: j288_joint_init() does, and the file's own checks keep its values in the ranges
+ * the library takes (but zero, which the library bounds by J288_JOINT_MAX_ANGLE). Works
+ * without libyaml. NULL arguments are ignored. */
+void j288_robot_config_joint_config(const j288_robot_config_joint_t *rj, j288_joint_config_t *jc);
 
 /* The text-level edit behind j288_robot_config_write_joint(): the len bytes of text in, the edited
  * text in out (outcap bytes: len plus, per key added, the joint's indentation plus 100), its

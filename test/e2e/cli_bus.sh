@@ -128,7 +128,7 @@ else
     e2e_fail status_human "rc $E2E_RC out '$E2E_OUT' err '$E2E_ERR'"
 fi
 expect_bad status_absent_servo 1 'no reply from servo 9' "$J288" --port "$MAIN" status --id 9
-expect_bad status_missing_id 2 '--id is required' "$J288" --port "$MAIN" status
+expect_bad status_missing_id 2 '--id N or --joint NAME is required' "$J288" --port "$MAIN" status
 expect_bad status_bad_id 2 '--id: 15 is out of range 0..14' "$J288" --port "$MAIN" status --id 15
 expect_bad status_unknown_option 2 "unknown option '--ids'" "$J288" --port "$MAIN" status --ids 1
 expect_bad status_bad_margin 2 '--margin-us' "$J288" --port "$MAIN" status --id 1 --margin-us 0
@@ -146,13 +146,21 @@ if [ $E2E_RC -eq 0 ] && grep -q 'servo locked' <<<"$E2E_OUT"; then e2e_pass hold
 expect_true hold_sends_foc_with_watchdog grep -Eq 'id=1 status=1 wd=1 .*kp=[1-9]' "$MAIN_LOG"
 expect_true hold_ends_with_lock bash -c "grep 'id=1 ' '$MAIN_LOG' | tail -n 1 | grep -q 'status=0'"
 
-e2e_run "$J288" --port "$MAIN" move --id 2 --pos 0.2 --speed 1 --duration 1.2 --json "${M[@]}"
-json_check move_reaches_target '
-assert o["ended"] == "done" and o["locked"] is True, o
-r = o["last_reply"]
-pos = r["output"]["pos_rad"]
+# The output side keeps its old meaning: rotor / N, counted from where the rotor started at
+# power-up (so first, while servo 2 is near there).
+e2e_run "$J288" --port "$MAIN" move --id 2 --side output --pos 0.2 --speed 1 --duration 1.2 --json "${M[@]}"
+json_check move_output_side '
+assert o["ended"] == "done" and o["side"] == "output", o
+pos = o["last_reply"]["output"]["pos_rad"]
 assert abs(pos - o["target_pos"]) < 0.02, (pos, o["target_pos"])
-assert abs(o["target_pos"] - 0.2) < 1e-3, o
+assert abs(o["target_pos"] - 0.2) < 1e-3, o'
+# The joint frame (the default): the move ends at joint angle 0.2 wherever the servo started.
+e2e_run "$J288" --port "$MAIN" move --id 2 --pos 0.2 --speed 5 --duration 1.5 --json "${M[@]}"
+json_check move_reaches_target '
+assert o["ended"] == "done" and o["locked"] is True and o["side"] == "joint", o
+assert o["joint_known"] is True, o
+assert abs(o["joint_pos"] - 0.2) < 0.02, o["joint_pos"]
+assert abs(o["target_pos"] - 0.2) < 1e-9, o
 # A healthy servo and a 250 ms margin: a failed refresh is a fault (one is tolerated, for a
 # machine frozen for a quarter of a second).
 assert o["commands"] >= 1 and o["replies"] + o["failures"] == o["commands"], o

@@ -128,6 +128,57 @@ static void test_full_file(void)
     TEST_ASSERT_EQUAL_INT(-1, j288_robot_config_find_bus(&g_cfg, "middle"));
 }
 
+/* The file's joints as the library takes them; the library accepts each. */
+static void test_joint_config(void)
+{
+    j288_joint_config_t jc;
+    j288_joint_t joint;
+    TEST_ASSERT_EQUAL_INT_MESSAGE(0, parse(k_full), g_err);
+    memset(&jc, 0x5a, sizeof jc);
+    j288_robot_config_joint_config(j288_robot_config_find_joint(&g_cfg, "hip"), &jc);
+    TEST_ASSERT_EQUAL_UINT8(1, jc.id);
+    TEST_ASSERT_EQUAL_INT8(-1, jc.direction);
+    TEST_ASSERT_TRUE(jc.clamp);
+    TEST_ASSERT_TRUE(jc.has_phase);
+    TEST_ASSERT_EQUAL_DOUBLE(2.1, (double)jc.phase);
+    TEST_ASSERT_EQUAL_DOUBLE(0.25, (double)jc.zero);
+    TEST_ASSERT_EQUAL_DOUBLE(-1.5, (double)jc.pos_min);
+    TEST_ASSERT_EQUAL_DOUBLE(1.5, (double)jc.pos_max);
+    TEST_ASSERT_EQUAL_DOUBLE(6.0, (double)jc.max_speed);
+    TEST_ASSERT_EQUAL_DOUBLE(30.0, (double)jc.max_torque);
+    TEST_ASSERT_EQUAL_DOUBLE(20.0, (double)jc.kp);
+    TEST_ASSERT_EQUAL_DOUBLE(0.5, (double)jc.kd);
+    TEST_ASSERT_EQUAL_UINT8(0, jc.init_samples);
+    TEST_ASSERT_EQUAL_DOUBLE(0.0, (double)jc.track_tol);
+    TEST_ASSERT_EQUAL_DOUBLE(0.0, (double)jc.cal_tol);
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_joint_init(&joint, &jc));
+    /* Nothing given: the all-zero configuration but the id, the library's defaults. */
+    TEST_ASSERT_EQUAL_INT_MESSAGE(0, parse("joints:\n  - name: a\n    id: 7\n"), g_err);
+    memset(&jc, 0x5a, sizeof jc);
+    j288_robot_config_joint_config(&g_cfg.joint[0], &jc);
+    TEST_ASSERT_EQUAL_UINT8(7, jc.id);
+    TEST_ASSERT_EQUAL_INT8(1, jc.direction);
+    TEST_ASSERT_FALSE(jc.clamp || jc.has_phase);
+    TEST_ASSERT_EQUAL_DOUBLE(0.0, (double)jc.zero);
+    TEST_ASSERT_EQUAL_DOUBLE(0.0, (double)jc.pos_min);
+    TEST_ASSERT_EQUAL_DOUBLE(0.0, (double)jc.pos_max);
+    TEST_ASSERT_EQUAL_DOUBLE(0.0, (double)jc.max_speed);
+    TEST_ASSERT_EQUAL_DOUBLE(0.0, (double)jc.max_torque);
+    TEST_ASSERT_EQUAL_DOUBLE(0.0, (double)jc.kp);
+    TEST_ASSERT_EQUAL_DOUBLE(0.0, (double)jc.kd);
+    TEST_ASSERT_EQUAL_DOUBLE(0.0, (double)jc.phase);
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_joint_init(&joint, &jc));
+    /* Limits only partly in the default range still come through as given. */
+    TEST_ASSERT_EQUAL_INT_MESSAGE(0, parse("joints:\n  - {name: a, id: 2, limits: [5.8, 6.8]}\n"),
+                                  g_err);
+    j288_robot_config_joint_config(&g_cfg.joint[0], &jc);
+    TEST_ASSERT_EQUAL_DOUBLE(5.8, (double)jc.pos_min);
+    TEST_ASSERT_EQUAL_DOUBLE(6.8, (double)jc.pos_max);
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_joint_init(&joint, &jc));
+    j288_robot_config_joint_config(NULL, &jc); /* ignored */
+    j288_robot_config_joint_config(&g_cfg.joint[0], NULL);
+}
+
 static void test_defaults(void)
 {
     const j288_robot_config_joint_t *j;
@@ -598,6 +649,7 @@ int main(void)
     UNITY_BEGIN();
     RUN_TEST(test_full_file);
     RUN_TEST(test_defaults);
+    RUN_TEST(test_joint_config);
     RUN_TEST(test_byte_order_mark_crlf_and_unicode);
     RUN_TEST(test_errors_keys);
     RUN_TEST(test_errors_types);

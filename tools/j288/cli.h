@@ -57,5 +57,7 @@ int cli_cmd_torque(int argc, char **argv, const cli_global_t *g);
 int cli_cmd_stop(int argc, char **argv, const cli_global_t *g);
 int cli_cmd_log(int argc, char **argv, const cli_global_t *g);
 int cli_cmd_plot(int argc, char **argv, const cli_global_t *g);
+int cli_cmd_zero(int argc, char **argv, const cli_global_t *g);
+int cli_cmd_calibrate(int argc, char **argv, const cli_global_t *g);
 
 #endif /* J288_CLI_H */

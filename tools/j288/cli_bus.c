@@ -54,6 +54,9 @@ int cli_bus_common_opt(cli_bus_opts_t *o, int key, const char *value)
     case CLI_OPT_JSON:
         o->json = true;
         return 0;
+    case CLI_OPT_CONFIG:
+        o->config = value;
+        return 0;
     default:
         return 1;
     }
@@ -214,4 +217,39 @@ int cli_bus_sleep_until(cli_bus_t *b, uint32_t until_us)
 {
     int rc = j288_linux_run(&b->lp, NULL, until_us, 0u);
     return rc == J288_ERR_TIMEOUT ? J288_OK : rc;
+}
+
+/* Parse loop shared by every bus command: common options are handled here, the command's
+ * own keys are passed to fn. Returns -1 (exit code in *exit_code) to stop, 0 when done. */
+int cli_parse_bus_args(int argc, char **argv, const cli_opt_t *opts, const char *help,
+                          cli_bus_opts_t *o, cli_own_opt_fn fn, void *ctx, int *exit_code)
+{
+    cli_args_t a;
+    const char *v;
+    int key, rc;
+    cli_args_init(&a, argc, argv);
+    while ((key = cli_args_next(&a, opts, &v)) != CLI_ARG_END) {
+        if (key == CLI_ARG_HELP) {
+            fputs(help, stdout);
+            *exit_code = CLI_EXIT_OK;
+            return -1;
+        }
+        if (key == CLI_ARG_ERROR) {
+            *exit_code = CLI_EXIT_USAGE;
+            return -1;
+        }
+        rc = key == CLI_ARG_POSITIONAL ? 1 : cli_bus_common_opt(o, key, v);
+        if (rc == 1) {
+            rc = fn != NULL ? fn(ctx, key, v) : 1;
+            if (rc == 1) {
+                cli_error("unexpected argument '%s' (try --help)", v != NULL ? v : "");
+                rc = -1;
+            }
+        }
+        if (rc != 0) {
+            *exit_code = CLI_EXIT_USAGE;
+            return -1;
+        }
+    }
+    return 0;
 }

@@ -18,6 +18,8 @@
 #include "args.h"
 #include "cli.h"
 #include "j288_linux.h"
+#include "j288_robot_config.h"
+#include "json.h"
 
 /* Keys of the common options; commands number their own below CLI_BUS_OPT_BASE. */
 #define CLI_BUS_OPT_BASE 100
@@ -27,14 +29,15 @@ enum {
     CLI_OPT_MARGIN,
     CLI_OPT_ECHO,
     CLI_OPT_RETRIES,
-    CLI_OPT_JSON
+    CLI_OPT_JSON,
+    CLI_OPT_CONFIG
 };
 #define CLI_BUS_COMMON_OPTS                                                                        \
     {"--port", true, CLI_OPT_PORT}, {"--baud", true, CLI_OPT_BAUD},                                \
         {"--margin-us", true, CLI_OPT_MARGIN}, {"--echo", false, CLI_OPT_ECHO},                    \
-        {"--retries", true, CLI_OPT_RETRIES},                                                      \
+        {"--retries", true, CLI_OPT_RETRIES}, {"--json", false, CLI_OPT_JSON},                     \
     {                                                                                              \
-        "--json", false, CLI_OPT_JSON                                                              \
+        "--config", true, CLI_OPT_CONFIG                                                           \
     }
 
 #define CLI_BUS_COMMON_HELP                                                                        \
@@ -45,7 +48,9 @@ enum {
     "                   adapter, 5000 for a pseudo-terminal (the simulator)\n"                     \
     "  --echo           the adapter hears its own transmit (skip and check the echo)\n"            \
     "  --retries N      re-send a failed command up to N times (0-3)\n"                            \
-    "  --json           machine-readable output\n"
+    "  --json           machine-readable output\n"                                                \
+    "  --config FILE    robot config (YAML): joints by name (--joint), their zero, direction,\n"  \
+    "                   limits, gains and phase, and the bus port when --port is not given\n"
 
 typedef struct {
     const char *port;
@@ -54,6 +59,7 @@ typedef struct {
     bool echo;
     int retries; /* -1: the command's default */
     bool json;
+    const char *config; /* --config FILE, or NULL */
 } cli_bus_opts_t;
 
 typedef struct {
@@ -68,6 +74,14 @@ extern volatile sig_atomic_t cli_stop_signal;
 
 /* Start from the global options (cli_global_t). */
 void cli_bus_opts_init(cli_bus_opts_t *o, const cli_global_t *g);
+
+/* The parse loop of a bus command: common options go to o, the command's own keys (and
+ * positional arguments, key CLI_ARG_POSITIONAL) to fn (NULL: none), which returns 0, -1 after
+ * an error message, or 1 for "not mine". Returns 0 when done, or -1 with *exit_code set
+ * (CLI_EXIT_OK after --help, which prints help; CLI_EXIT_USAGE). */
+typedef int (*cli_own_opt_fn)(void *ctx, int key, const char *value);
+int cli_parse_bus_args(int argc, char **argv, const cli_opt_t *opts, const char *help,
+                       cli_bus_opts_t *o, cli_own_opt_fn fn, void *ctx, int *exit_code);
 
 /* Handle a common option key; returns 0, or -1 after an error message. Keys below
  * CLI_BUS_OPT_BASE are not common: returns 1 (not handled). */
@@ -104,5 +118,67 @@ void cli_report_txn_failure(cli_bus_t *b, uint8_t id, int rc);
 /* Sleep until until_us (j288_linux_now_us() time) while keeping the port serviced.
  * Returns J288_OK, J288_ERR_ABORTED (stop signal) or J288_ERR_OFFLINE. */
 int cli_bus_sleep_until(cli_bus_t *b, uint32_t until_us);
+
+/* ---- the robot config and the joint frame (cli_joint.c) -------------------------------------
+ *
+ * A bus command that addresses one servo finds it with --id N or --joint NAME (NAME needs
+ * --config). cli_joint_select() resolves that to a joint configuration: the file's joint
+ * (j288_robot_config_joint_config()), or without a file the library's all-zero configuration,
+ * in which the joint angle is the output encoder angle wrapped to [-pi, pi). It also fills
+ * the bus options the command line left open (port, baud, margin, echo) from the joint's bus
+ * in the file. Other commands (a multi-bus runner) can call the same functions. */
+
+/* A loaded robot config (large: keep it static or on the heap). */
+typedef struct {
+    const char *path; /* NULL: no --config */
+    j288_robot_config_t cfg;
+} cli_robot_t;
+
+/* What cli_joint_select() resolved. */
+typedef struct {
+    uint8_t id;
+    const j288_robot_config_joint_t *rj; /* the file's joint, or NULL (no file, or not in it) */
+    j288_joint_config_t jc;             /* checked by j288_joint_init() */
+    char name[J288_ROBOT_CONFIG_NAME_MAX + 16]; /* "hip" or "servo 3", for messages */
+} cli_joint_sel_t;
+
+/* Load path (NULL: r->path = NULL, nothing else). 0, or -1 after one error line. */
+int cli_robot_load(cli_robot_t *r, const char *path);
+
+/* The joint by name (--joint, needs a file) or by id (id >= 0: the file's joint with that id,
+ * if any; one on the bus of o->port when several buses use the id). Fills o's open bus
+ * options from the joint's bus, or from the file's only bus. 0, or -1 after one error line
+ * (unknown name, --joint without --config, id ambiguous, configuration the library refuses:
+ * "FILE:LINE: joint NAME: ..."). */
+int cli_joint_select(const cli_robot_t *r, const char *joint_name, long long id,
+                     cli_bus_opts_t *o, cli_joint_sel_t *sel);
+
+/* Send lock to the joint's servo until j (initialised) knows its angle: the start's replies,
+ * re-tried up to a bound. The last good exchange in *last, the replies taken in *replies.
+ * CLI_EXIT_OK; the signal exit code; or CLI_EXIT_FAIL after one error line (no reply, or with
+ * report_unknown: encoder fault, calibration mismatch, no agreement). */
+int cli_joint_acquire(cli_bus_t *b, j288_joint_t *j, const char *name, j288_txn_t *last,
+                      unsigned *replies, bool report_unknown);
+
+/* Why j's angle is unknown after replies replies, as one line (no prefix) in buf. */
+void cli_joint_why_unknown(const j288_joint_t *j, const char *name, unsigned replies, char *buf,
+                           size_t len);
+
+/* Fill o's open bus options (port, baud, margin, echo) from rj's bus, or with rj NULL or
+ * without a bus from the file's only bus. Nothing without a file. */
+void cli_robot_fill_bus(const cli_robot_t *r, const j288_robot_config_joint_t *rj,
+                        cli_bus_opts_t *o);
+
+/* One line for a library error on joint name's target: "joint hip: --pos 2: target position
+ * outside the joint's limits [-1.5, 1.5]". */
+void cli_joint_target_error(const j288_joint_t *j, const char *name, const char *what, int rc);
+
+/* Whether a position target lies within the joint configuration's limits ([-pi, pi] when
+ * both are 0) or the joint clamps. For checks before the bus is opened. */
+bool cli_joint_pos_allowed(const j288_joint_config_t *jc, double pos);
+
+/* The joint-frame members of a JSON object: joint_known, joint_calibrated, joint_pos (rad,
+ * only when known), joint_speed, joint_torque, encoder_fault, cal_mismatch, beyond_limit. */
+void cli_json_joint_members(cli_json_t *jw, const j288_joint_t *j);
 
 #endif /* J288_CLI_BUS_H */

@@ -17,47 +17,13 @@
 #define DEFAULT_RATE_HZ           200.0
 #define DEFAULT_MOVE_SPEED_OUTPUT 1.0 /* rad/s */
 
-/* Parse loop shared by every bus command: common options are handled here, the command's
- * own keys are passed to fn. Returns -1 (exit code in *exit_code) to stop, 0 when done. */
-typedef int (*own_opt_fn)(void *ctx, int key, const char *value);
-
-static int parse_bus_args(int argc, char **argv, const cli_opt_t *opts, const char *help,
-                          cli_bus_opts_t *o, own_opt_fn fn, void *ctx, int *exit_code)
-{
-    cli_args_t a;
-    const char *v;
-    int key, rc;
-    cli_args_init(&a, argc, argv);
-    while ((key = cli_args_next(&a, opts, &v)) != CLI_ARG_END) {
-        if (key == CLI_ARG_HELP) {
-            fputs(help, stdout);
-            *exit_code = CLI_EXIT_OK;
-            return -1;
-        }
-        if (key == CLI_ARG_ERROR) {
-            *exit_code = CLI_EXIT_USAGE;
-            return -1;
-        }
-        rc = key == CLI_ARG_POSITIONAL ? 1 : cli_bus_common_opt(o, key, v);
-        if (rc == 1) {
-            rc = fn != NULL ? fn(ctx, key, v) : 1;
-            if (rc == 1) {
-                cli_error("unexpected argument '%s' (try --help)", v != NULL ? v : "");
-                rc = -1;
-            }
-        }
-        if (rc != 0) {
-            *exit_code = CLI_EXIT_USAGE;
-            return -1;
-        }
-    }
-    return 0;
-}
+/* The robot config of this run: one per process, too large for the stack. */
+static cli_robot_t g_robot;
 
 /* ---- scan ----------------------------------------------------------------------------------- */
 
 static const char scan_help[] =
-    "usage: j288 [--port DEV] scan [--json]\n"
+    "usage: j288 [--port DEV] scan [--json] [--config FILE]\n"
     "\n"
     "Address every id 0-14 once and list the servos that answer: mode, temperatures,\n"
     "voltage and faults. The protocol has no read-only query, so each id receives a lock\n"
@@ -80,9 +46,13 @@ int cli_cmd_scan(int argc, char **argv, const cli_global_t *g)
     uint8_t id;
 
     cli_bus_opts_init(&o, g);
-    if (parse_bus_args(argc, argv, opts, scan_help, &o, NULL, NULL, &ec) != 0) {
+    if (cli_parse_bus_args(argc, argv, opts, scan_help, &o, NULL, NULL, &ec) != 0) {
         return ec;
     }
+    if (cli_robot_load(&g_robot, o.config) != 0) {
+        return CLI_EXIT_USAGE;
+    }
+    cli_robot_fill_bus(&g_robot, NULL, &o);
     cli_signals_install();
     if ((ec = cli_bus_open(&b, &o, 1)) != CLI_EXIT_OK) {
         return ec;
@@ -152,15 +122,22 @@ int cli_cmd_scan(int argc, char **argv, const cli_global_t *g)
 /* ---- status --------------------------------------------------------------------------------- */
 
 static const char status_help[] =
-    "usage: j288 [--port DEV] status --id N [--json]\n"
+    "usage: j288 [--port DEV] status (--id N | --joint NAME --config FILE) [--json]\n"
     "\n"
-    "Read one servo's reply and decode it as `j288 decode` does (same JSON keys). The\n"
-    "protocol has no read-only query: the servo receives a lock command (watchdog bit 0).\n"
-    "Exit status: 0 the servo answered; 1 no reply or device error.\n"
+    "Read one servo's reply and decode it as `j288 decode` does (same JSON keys), plus the\n"
+    "joint frame: the absolute joint angle from the output encoder and the rotor (JSON:\n"
+    "joint_pos in rad, joint_known, joint_calibrated, joint_speed, joint_torque,\n"
+    "encoder_fault, cal_mismatch, beyond_limit). Without --config the joint angle is the\n"
+    "output encoder angle wrapped to [-pi, pi); with it, the joint's zero, direction, limits\n"
+    "and phase apply. Finding the angle takes a few replies (8 by default). The protocol has\n"
+    "no read-only query: the servo receives lock commands (watchdog bit 0).\n"
+    "Exit status: 0 the servo answered (joint_known says whether the angle is known; a\n"
+    "note on stderr says why not); 1 no reply or device error; 2 bad arguments.\n"
     "\n" CLI_BUS_COMMON_HELP;
 
 enum {
     OPT_ID = 0,
+    OPT_JOINT,
     OPT_KP,
     OPT_KD,
     OPT_POS,
@@ -170,11 +147,13 @@ enum {
     OPT_RATE,
     OPT_DURATION,
     OPT_WATCHDOG,
-    OPT_KEEP
+    OPT_KEEP,
+    OPT_RANGE
 };
 
 typedef struct {
     long long id;
+    const char *joint;
 } id_ctx_t;
 
 static int parse_id_opt(void *ctx, int key, const char *v)
@@ -183,37 +162,76 @@ static int parse_id_opt(void *ctx, int key, const char *v)
     if (key == OPT_ID) {
         return cli_parse_int("--id", v, 0, J288_MAX_ID, &c->id);
     }
+    if (key == OPT_JOINT) {
+        c->joint = v;
+        return 0;
+    }
     return 1;
+}
+
+
+/* --config and --id / --joint into a joint set up for the bus (o filled from the file). */
+static int select_joint(cli_bus_opts_t *o, const char *joint_name, long long id,
+                        cli_joint_sel_t *sel, j288_joint_t *j)
+{
+    if (cli_robot_load(&g_robot, o->config) != 0 ||
+        cli_joint_select(&g_robot, joint_name, id, o, sel) != 0) {
+        return -1;
+    }
+    return j288_joint_init(j, &sel->jc) == J288_OK ? 0 : -1;
+}
+
+static void status_text(const cli_bus_t *b, const cli_joint_sel_t *sel, const j288_joint_t *j,
+                        const j288_txn_t *txn)
+{
+    const j288_joint_state_t *st = j288_joint_state(j);
+    char title[200];
+    snprintf(title, sizeof title, "servo %u on %s: reply after %lu us", (unsigned)sel->id, b->dev,
+             (unsigned long)txn->latency_us);
+    cli_show_reply(stdout, &txn->reply, title);
+    if (st->known) {
+        printf("  %s: pos %.6f rad (%s), speed %.5g rad/s, torque %.5g N*m%s\n", sel->name,
+               (double)st->pos, st->calibrated ? "calibrated" : "from the output encoder",
+               (double)st->speed, (double)st->torque,
+               st->beyond_limit ? "; outside its limits" : "");
+    } else {
+        printf("  %s: angle unknown\n", sel->name);
+    }
 }
 
 int cli_cmd_status(int argc, char **argv, const cli_global_t *g)
 {
-    static const cli_opt_t opts[] = {{"--id", true, OPT_ID}, CLI_BUS_COMMON_OPTS, {NULL, false, 0}};
+    static const cli_opt_t opts[] = {
+        {"--id", true, OPT_ID}, {"--joint", true, OPT_JOINT}, CLI_BUS_COMMON_OPTS, {NULL, false, 0}};
     cli_bus_opts_t o;
     cli_bus_t b;
-    id_ctx_t c = {-1};
-    j288_cmd_raw_t cmd;
+    id_ctx_t c = {-1, NULL};
+    cli_joint_sel_t sel;
+    j288_joint_t joint;
     j288_txn_t txn;
-    int ec, rc;
+    unsigned replies = 0;
+    int ec;
 
     cli_bus_opts_init(&o, g);
-    if (parse_bus_args(argc, argv, opts, status_help, &o, parse_id_opt, &c, &ec) != 0) {
+    if (cli_parse_bus_args(argc, argv, opts, status_help, &o, parse_id_opt, &c, &ec) != 0) {
         return ec;
     }
-    if (c.id < 0) {
-        cli_error("--id is required (0-14)");
+    if (select_joint(&o, c.joint, c.id, &sel, &joint) != 0) {
         return CLI_EXIT_USAGE;
     }
     cli_signals_install();
     if ((ec = cli_bus_open(&b, &o, 2)) != CLI_EXIT_OK) {
         return ec;
     }
-    cli_lock_cmd((uint8_t)c.id, &cmd);
-    rc = cli_bus_transfer(&b, &cmd, &txn);
-    if (rc != J288_OK) {
-        cli_report_txn_failure(&b, (uint8_t)c.id, rc);
+    ec = cli_joint_acquire(&b, &joint, sel.name, &txn, &replies, false);
+    if (replies == 0u || (ec != CLI_EXIT_OK && ec != CLI_EXIT_FAIL)) {
         cli_bus_close(&b);
-        return CLI_EXIT_FAIL;
+        return ec != CLI_EXIT_OK ? ec : CLI_EXIT_FAIL;
+    }
+    if (ec != CLI_EXIT_OK) {
+        char why[400];
+        cli_joint_why_unknown(&joint, sel.name, replies, why, sizeof why);
+        fprintf(stderr, "note: %s\n", why);
     }
     if (o.json) {
         cli_json_t j;
@@ -221,13 +239,14 @@ int cli_cmd_status(int argc, char **argv, const cli_global_t *g)
         cli_json_begin_object(&j, NULL);
         cli_json_reply_members(&j, &txn.reply);
         cli_json_uint(&j, "latency_us", txn.latency_us);
+        if (sel.rj != NULL) {
+            cli_json_str(&j, "joint", sel.rj->name);
+        }
+        cli_json_joint_members(&j, &joint);
         cli_json_end_object(&j);
         cli_json_newline(&j);
     } else {
-        char title[160];
-        snprintf(title, sizeof title, "servo %u on %s: reply after %lu us", (unsigned)c.id, b.dev,
-                 (unsigned long)txn.latency_us);
-        cli_show_reply(stdout, &txn.reply, title);
+        status_text(&b, &sel, &joint, &txn);
     }
     cli_bus_close(&b);
     return CLI_EXIT_OK;
@@ -236,26 +255,40 @@ int cli_cmd_status(int argc, char **argv, const cli_global_t *g)
 /* ---- stop ----------------------------------------------------------------------------------- */
 
 static const char stop_help[] =
-    "usage: j288 [--port DEV] stop [--id N]\n"
+    "usage: j288 [--port DEV] stop [--id N | --joint NAME --config FILE]\n"
     "\n"
-    "Lock (no torque) servo N, confirmed by its reply; without --id, broadcast lock to every\n"
-    "servo on the bus (id 15: nobody replies). The lock goes out with the watchdog bit 0.\n"
+    "Lock (no torque) servo N, confirmed by its reply; without --id or --joint, broadcast\n"
+    "lock to every servo on the bus (id 15: nobody replies). The lock goes out with the\n"
+    "watchdog bit 0.\n"
     "Exit status: 0 sent (and confirmed with --id); 1 no reply or device error.\n"
     "\n" CLI_BUS_COMMON_HELP;
 
 int cli_cmd_stop(int argc, char **argv, const cli_global_t *g)
 {
-    static const cli_opt_t opts[] = {{"--id", true, OPT_ID}, CLI_BUS_COMMON_OPTS, {NULL, false, 0}};
+    static const cli_opt_t opts[] = {
+        {"--id", true, OPT_ID}, {"--joint", true, OPT_JOINT}, CLI_BUS_COMMON_OPTS, {NULL, false, 0}};
     cli_bus_opts_t o;
     cli_bus_t b;
-    id_ctx_t c = {-1};
+    id_ctx_t c = {-1, NULL};
     j288_cmd_raw_t cmd;
     j288_txn_t txn;
     int ec, rc;
 
     cli_bus_opts_init(&o, g);
-    if (parse_bus_args(argc, argv, opts, stop_help, &o, parse_id_opt, &c, &ec) != 0) {
+    if (cli_parse_bus_args(argc, argv, opts, stop_help, &o, parse_id_opt, &c, &ec) != 0) {
         return ec;
+    }
+    if (cli_robot_load(&g_robot, o.config) != 0) {
+        return CLI_EXIT_USAGE;
+    }
+    if (c.joint != NULL || (c.id >= 0 && o.config != NULL)) {
+        cli_joint_sel_t sel;
+        if (cli_joint_select(&g_robot, c.joint, c.id, &o, &sel) != 0) {
+            return CLI_EXIT_USAGE;
+        }
+        c.id = sel.id;
+    } else {
+        cli_robot_fill_bus(&g_robot, NULL, &o);
     }
     if ((ec = cli_bus_open(&b, &o, 2)) != CLI_EXIT_OK) {
         return ec;
@@ -283,28 +316,36 @@ int cli_cmd_stop(int argc, char **argv, const cli_global_t *g)
  */
 
 typedef enum { DRIVE_HOLD, DRIVE_MOVE, DRIVE_TORQUE } drive_kind_t;
+enum { SIDE_ROTOR = 0, SIDE_OUTPUT = 1, SIDE_JOINT = 2 };
 
 typedef struct {
     drive_kind_t kind;
     long long id;
-    int side; /* 0 rotor, 1 output */
+    const char *joint_name;
+    int side; /* SIDE_*: joint (default), or the raw rotor frame, or rotor / N */
     bool have_kp, have_kd, have_pos, have_speed, have_tau;
     double kp, kd, pos, speed, tau;
     double rate_hz;
     double duration_s; /* < 0: until a signal */
     bool watchdog;
     bool keep;
+    /* The joint (side joint) */
+    cli_joint_sel_t sel;
+    j288_joint_t j;
 } drive_args_t;
 
 static int parse_drive_opt(void *ctx, int key, const char *v)
 {
-    static const char *const sides[] = {"rotor", "output", NULL};
+    static const char *const sides[] = {"rotor", "output", "joint", NULL};
     static const char *const onoff[] = {"off", "on", NULL};
     drive_args_t *d = ctx;
     int choice;
     switch (key) {
     case OPT_ID:
         return cli_parse_int("--id", v, 0, J288_MAX_ID, &d->id);
+    case OPT_JOINT:
+        d->joint_name = v;
+        return 0;
     case OPT_KP:
         d->have_kp = true;
         return cli_parse_real("--kp", v, &d->kp);
@@ -329,7 +370,14 @@ static int parse_drive_opt(void *ctx, int key, const char *v)
         d->have_tau = true;
         return cli_parse_real("--tau", v, &d->tau);
     case OPT_SIDE:
-        return cli_parse_choice("--side", v, sides, &d->side);
+        for (choice = 0; sides[choice] != NULL; choice++) {
+            if (strcmp(v, sides[choice]) == 0) {
+                d->side = choice;
+                return 0;
+            }
+        }
+        cli_error("--side: '%s' is not joint, rotor or output", v);
+        return -1;
     case OPT_RATE:
         if (cli_parse_real("--rate", v, &d->rate_hz) != 0) {
             return -1;
@@ -370,11 +418,15 @@ typedef struct {
     double ramp_lsb_per_s; /* move: setpoint speed in position LSB per second */
     int16_t ramp_speed_raw;
     double ramp_time_s;
+    /* side joint: joint-frame values */
+    double q0;             /* the joint angle at the start */
+    double jkp, jkd;       /* gains */
+    double jspeed;         /* move: ramp speed, rad/s */
 } drive_plan_t;
 
 static j288_side_t side_of(const drive_args_t *d)
 {
-    return d->side == 0 ? J288_SIDE_ROTOR : J288_SIDE_OUTPUT;
+    return d->side == SIDE_ROTOR ? J288_SIDE_ROTOR : J288_SIDE_OUTPUT;
 }
 
 static int si_error(const char *opt, double v, int rc)
@@ -387,6 +439,47 @@ static int si_error(const char *opt, double v, int rc)
     return -1;
 }
 
+/* Joint side: gains from the command line, else the config, else the defaults; targets
+ * checked against the joint's limits before anything is sent. */
+static int plan_joint(const drive_args_t *d, drive_plan_t *p)
+{
+    const j288_joint_config_t *jc = &d->sel.jc;
+    j288_cmd_raw_t probe;
+    int rc;
+    p->jkp = d->have_kp ? d->kp : (d->sel.rj != NULL && d->sel.rj->has_kp ? (double)jc->kp : DEFAULT_KP_OUTPUT);
+    p->jkd = d->have_kd ? d->kd : (d->sel.rj != NULL && d->sel.rj->has_kd ? (double)jc->kd : DEFAULT_KD_OUTPUT);
+    p->jspeed = d->have_speed ? d->speed : DEFAULT_MOVE_SPEED_OUTPUT;
+    if (d->kind == DRIVE_TORQUE) {
+        p->jkp = 0.0;
+        p->jkd = 0.0;
+    }
+    if ((rc = j288_kp_to_raw((j288_real_t)p->jkp, J288_SIDE_OUTPUT, &probe.kp)) != J288_OK) {
+        return si_error("--kp", p->jkp, rc);
+    }
+    if ((rc = j288_kd_to_raw((j288_real_t)p->jkd, J288_SIDE_OUTPUT, &probe.kd)) != J288_OK) {
+        return si_error("--kd", p->jkd, rc);
+    }
+    if (d->kind == DRIVE_MOVE && !cli_joint_pos_allowed(jc, d->pos)) {
+        cli_joint_target_error(&d->j, d->sel.name, "--pos", J288_ERR_LIMIT_POS);
+        return -1;
+    }
+    if (d->kind == DRIVE_MOVE && jc->max_speed > 0 && !jc->clamp && p->jspeed > (double)jc->max_speed) {
+        cli_joint_target_error(&d->j, d->sel.name, "--speed", J288_ERR_LIMIT_SPEED);
+        return -1;
+    }
+    if (d->kind == DRIVE_TORQUE) {
+        int16_t tau;
+        if (jc->max_torque > 0 && !jc->clamp && fabs(d->tau) > (double)jc->max_torque) {
+            cli_joint_target_error(&d->j, d->sel.name, "--tau", J288_ERR_LIMIT_TORQUE);
+            return -1;
+        }
+        if ((rc = j288_torque_to_raw((j288_real_t)d->tau, J288_SIDE_OUTPUT, &tau)) != J288_OK) {
+            return si_error("--tau", d->tau, rc);
+        }
+    }
+    return 0;
+}
+
 /* Everything that can be checked before touching the bus. */
 static int plan_fields(const drive_args_t *d, drive_plan_t *p)
 {
@@ -396,6 +489,9 @@ static int plan_fields(const drive_args_t *d, drive_plan_t *p)
     p->base.id = (uint8_t)d->id;
     p->base.status = J288_MODE_FOC;
     p->base.watchdog = d->watchdog;
+    if (d->side == SIDE_JOINT) {
+        return plan_joint(d, p);
+    }
     if (d->kind != DRIVE_TORQUE) {
         double kp = d->have_kp ? d->kp : DEFAULT_KP_OUTPUT;
         double kd = d->have_kd ? d->kd : DEFAULT_KD_OUTPUT;
@@ -434,7 +530,7 @@ static int plan_fields(const drive_args_t *d, drive_plan_t *p)
     return 0;
 }
 
-/* The command at time t since the start. */
+/* The command at time t since the start (rotor and output sides). */
 static void drive_setpoint(const drive_args_t *d, const drive_plan_t *p, double t,
                            j288_cmd_raw_t *cmd)
 {
@@ -455,48 +551,99 @@ static void drive_setpoint(const drive_args_t *d, const drive_plan_t *p, double 
     }
 }
 
+/* The joint-frame target at time t since the start (side joint). */
+static void joint_setpoint(const drive_args_t *d, const drive_plan_t *p, double t,
+                           j288_joint_target_t *tg)
+{
+    const j288_joint_state_t *st = j288_joint_state(&d->j);
+    memset(tg, 0, sizeof *tg);
+    tg->kp = (j288_real_t)p->jkp;
+    tg->kd = (j288_real_t)p->jkd;
+    tg->pos = (j288_real_t)p->q0;
+    if (d->kind == DRIVE_MOVE) {
+        double dist = d->pos - p->q0;
+        double travelled = p->jspeed * t;
+        if (travelled >= fabs(dist)) {
+            tg->pos = (j288_real_t)d->pos;
+        } else {
+            tg->pos = (j288_real_t)(p->q0 + (dist < 0.0 ? -travelled : travelled));
+            tg->speed = (j288_real_t)(dist < 0.0 ? -p->jspeed : p->jspeed);
+        }
+    } else if (d->kind == DRIVE_TORQUE) {
+        /* No stiffness: the position only has to pass the limit check. */
+        double lo = (double)d->j.cfg.pos_min, hi = (double)d->j.cfg.pos_max, q = (double)st->pos;
+        if (lo == 0.0 && hi == 0.0) {
+            lo = -J288_PI;
+            hi = J288_PI;
+        }
+        tg->pos = (j288_real_t)(q < lo ? lo : (q > hi ? hi : q));
+        tg->torque = (j288_real_t)d->tau;
+    }
+}
+
 typedef struct {
     uint32_t sent, ok, failed, overruns;
     j288_reply_raw_t last;
     bool have_last;
     j288_cmd_raw_t last_cmd;
+    double last_target; /* side joint: the latest target position */
 } drive_result_t;
 
-static void drive_report(const drive_args_t *d, const drive_result_t *r, cli_bus_t *b,
-                         const char *how, bool json)
+static void drive_report_json(const drive_args_t *d, const drive_result_t *r, const char *how)
 {
     j288_side_t side = side_of(d);
-    const char *unit_side = side == J288_SIDE_ROTOR ? "rotor" : "output";
-    if (json) {
-        cli_json_t j;
-        cli_json_init(&j, stdout);
-        cli_json_begin_object(&j, NULL);
-        cli_json_str(&j, "ended", how);
-        cli_json_int(&j, "id", d->id);
-        cli_json_uint(&j, "commands", r->sent);
-        cli_json_uint(&j, "replies", r->ok);
-        cli_json_uint(&j, "failures", r->failed);
-        cli_json_uint(&j, "overruns", r->overruns);
-        cli_json_bool(&j, "locked", !d->keep || cli_stop_signal != 0);
-        cli_json_str(&j, "side", unit_side);
+    cli_json_t j;
+    cli_json_init(&j, stdout);
+    cli_json_begin_object(&j, NULL);
+    cli_json_str(&j, "ended", how);
+    cli_json_int(&j, "id", d->id);
+    if (d->sel.rj != NULL) {
+        cli_json_str(&j, "joint", d->sel.rj->name);
+    }
+    cli_json_uint(&j, "commands", r->sent);
+    cli_json_uint(&j, "replies", r->ok);
+    cli_json_uint(&j, "failures", r->failed);
+    cli_json_uint(&j, "overruns", r->overruns);
+    cli_json_bool(&j, "locked", !d->keep || cli_stop_signal != 0);
+    if (d->side == SIDE_JOINT) {
+        cli_json_str(&j, "side", "joint");
+        cli_json_real(&j, "target_pos", r->last_target);
+        cli_json_joint_members(&j, &d->j);
+    } else {
+        cli_json_str(&j, "side", side == J288_SIDE_ROTOR ? "rotor" : "output");
         cli_json_real(&j, "target_pos", (double)j288_pos_from_raw(r->last_cmd.pos, side));
-        if (r->have_last) {
-            cli_json_begin_object(&j, "last_reply");
-            cli_json_reply_members(&j, &r->last);
-            cli_json_end_object(&j);
-        }
-        cli_json_end_object(&j);
-        cli_json_newline(&j);
-        (void)b;
-        return;
     }
     if (r->have_last) {
-        char list[512];
+        cli_json_begin_object(&j, "last_reply");
+        cli_json_reply_members(&j, &r->last);
+        cli_json_end_object(&j);
+    }
+    cli_json_end_object(&j);
+    cli_json_newline(&j);
+}
+
+static void drive_report(const drive_args_t *d, const drive_result_t *r, const char *how,
+                         bool json)
+{
+    j288_side_t side = side_of(d);
+    char list[512];
+    if (json) {
+        drive_report_json(d, r, how);
+        return;
+    }
+    if (r->have_last && d->side == SIDE_JOINT) {
+        const j288_joint_state_t *st = j288_joint_state(&d->j);
+        printf("%s: pos %.6g rad, speed %.5g rad/s, torque %.5g N*m (joint frame); target "
+               "%.6g rad; faults %s\n",
+               d->sel.name, (double)st->pos, (double)st->speed, (double)st->torque,
+               r->last_target, cli_fault_list(r->last.faults, list, sizeof list));
+    } else if (r->have_last) {
         printf("servo %lld: pos %.5g rad, speed %.5g rad/s, torque %.5g N*m (%s side); "
                "target %.5g rad; faults %s\n",
                d->id, (double)j288_pos_from_raw(r->last.pos, side),
                (double)j288_speed_from_raw(r->last.speed, side),
-               (double)j288_torque_from_raw(r->last.torque, side), unit_side,
+               (double)j288_torque_from_raw(r->last.torque, side),
+               side == J288_SIDE_ROTOR ? "rotor" : "output",
                (double)j288_pos_from_raw(r->last_cmd.pos, side),
                cli_fault_list(r->last.faults, list, sizeof list));
     }
@@ -511,16 +658,13 @@ typedef enum {
     DRIVE_END_DONE,   /* --duration reached */
     DRIVE_END_SIGNAL, /* SIGINT or SIGTERM */
     DRIVE_END_GONE,   /* the device went away: nothing can be sent any more */
-    DRIVE_END_SILENT  /* the servo stopped answering: lock already sent */
+    DRIVE_END_SILENT, /* the servo stopped answering: lock already sent */
+    DRIVE_END_JOINT   /* the joint angle was lost or a target refused: lock already sent */
 } drive_end_t;
 
 /* The options each command requires. */
 static int drive_check(const drive_args_t *d)
 {
-    if (d->id < 0) {
-        cli_error("--id is required (0-14)");
-        return -1;
-    }
     if (d->kind == DRIVE_MOVE && !d->have_pos) {
         cli_error("--pos is required");
         return -1;
@@ -532,38 +676,83 @@ static int drive_check(const drive_args_t *d)
     return 0;
 }
 
-/* Where is the servo now? (A lock: the protocol has no read-only query.) */
-static int drive_start(cli_bus_t *b, const drive_args_t *d, drive_plan_t *p, drive_result_t *res)
+/* Where is the servo now? (Locks: the protocol has no read-only query.) */
+static int drive_start(cli_bus_t *b, drive_args_t *d, drive_plan_t *p, drive_result_t *res)
 {
     j288_cmd_raw_t cmd;
     j288_txn_t txn;
+    unsigned replies = 0;
     int rc;
-    cli_lock_cmd((uint8_t)d->id, &cmd);
-    rc = cli_bus_transfer(b, &cmd, &txn);
-    if (rc != J288_OK) {
-        cli_report_txn_failure(b, (uint8_t)d->id, rc);
-        return -1;
+    if (d->side == SIDE_JOINT) {
+        rc = cli_joint_acquire(b, &d->j, d->sel.name, &txn, &replies, true);
+        if (rc != CLI_EXIT_OK) {
+            return rc;
+        }
+        p->q0 = (double)j288_joint_state(&d->j)->pos;
+        res->last_target = p->q0;
+    } else {
+        cli_lock_cmd((uint8_t)d->id, &cmd);
+        rc = cli_bus_transfer(b, &cmd, &txn);
+        if (rc != J288_OK) {
+            cli_report_txn_failure(b, (uint8_t)d->id, rc);
+            return CLI_EXIT_FAIL;
+        }
     }
     p->start_pos = txn.reply.pos;
     res->last = txn.reply;
     res->have_last = true;
+    return CLI_EXIT_OK;
+}
+
+/* Side joint: the command at time t from the joint layer. Returns 0, or -1 after an error
+ * line (refused: nothing is sent). */
+static int joint_command_at(drive_args_t *d, const drive_plan_t *p, double t,
+                            drive_result_t *res, j288_cmd_raw_t *cmd)
+{
+    j288_joint_target_t tg;
+    int rc;
+    joint_setpoint(d, p, t, &tg);
+    rc = j288_joint_command(&d->j, &tg, cmd, NULL);
+    if (rc != J288_OK) {
+        cli_joint_target_error(&d->j, d->sel.name, "target", rc);
+        return -1;
+    }
+    cmd->watchdog = d->watchdog;
+    res->last_target = (double)tg.pos;
     return 0;
 }
 
-/* One refresh: the command at time t, sent and counted. Returns the transfer's result. */
-static int drive_step(cli_bus_t *b, const drive_args_t *d, const drive_plan_t *p, double t,
+/* One refresh: the command at time t, sent and counted. Returns the transfer's result, or
+ * J288_ERR_ANGLE_UNKNOWN when the joint refused the target or lost its angle (reported). */
+static int drive_step(cli_bus_t *b, drive_args_t *d, const drive_plan_t *p, double t,
                       drive_result_t *res)
 {
     j288_cmd_raw_t cmd;
     j288_txn_t txn;
+    unsigned events = 0;
     int rc;
-    drive_setpoint(d, p, t, &cmd);
+    if (d->side == SIDE_JOINT) {
+        if (joint_command_at(d, p, t, res, &cmd) != 0) {
+            return J288_ERR_ANGLE_UNKNOWN;
+        }
+    } else {
+        drive_setpoint(d, p, t, &cmd);
+    }
     res->last_cmd = cmd;
     res->sent++;
     rc = cli_bus_transfer(b, &cmd, &txn);
     if (rc == J288_OK) {
         res->ok++;
         res->last = txn.reply;
+        if (d->side == SIDE_JOINT) {
+            (void)j288_joint_take_reply(&d->j, &txn.reply, &events);
+            if ((events & J288_JOINT_EV_BIT(J288_JOINT_EV_ANGLE_LOST)) != 0u) {
+                cli_error("%s: the joint angle was lost (rotor and output encoder differ by %.4f "
+                          "rad: a power cycle or a slipped gear); lock sent",
+                          d->sel.name, (double)j288_joint_state(&d->j)->residual);
+                return J288_ERR_ANGLE_UNKNOWN;
+            }
+        }
     } else if (rc != J288_ERR_OFFLINE) {
         res->failed++;
     }
@@ -573,7 +762,7 @@ static int drive_step(cli_bus_t *b, const drive_args_t *d, const drive_plan_t *p
 /* Refresh the command at --rate until --duration or a stop signal; a late cycle never
  * bursts to catch up. Gives up when the device goes away or after FAILS_BEFORE_GIVING_UP
  * failures in a row (then sending lock). */
-static drive_end_t drive_loop(cli_bus_t *b, const drive_args_t *d, const drive_plan_t *p,
+static drive_end_t drive_loop(cli_bus_t *b, drive_args_t *d, const drive_plan_t *p,
                               drive_result_t *res)
 {
     uint32_t period_us = (uint32_t)lround(1e6 / d->rate_hz);
@@ -591,6 +780,10 @@ static drive_end_t drive_loop(cli_bus_t *b, const drive_args_t *d, const drive_p
         if (rc == J288_ERR_OFFLINE) {
             cli_report_txn_failure(b, (uint8_t)d->id, rc);
             return DRIVE_END_GONE;
+        }
+        if (rc == J288_ERR_ANGLE_UNKNOWN) {
+            (void)cli_bus_lock_driven(b);
+            return DRIVE_END_JOINT;
         }
         fails = rc == J288_OK ? 0 : fails + 1;
         if (fails >= FAILS_BEFORE_GIVING_UP) {
@@ -618,7 +811,7 @@ static drive_end_t drive_loop(cli_bus_t *b, const drive_args_t *d, const drive_p
 static int drive_finish(cli_bus_t *b, const drive_args_t *d, const drive_result_t *res,
                         drive_end_t end, bool json)
 {
-    if (end == DRIVE_END_GONE || end == DRIVE_END_SILENT) {
+    if (end == DRIVE_END_GONE || end == DRIVE_END_SILENT || end == DRIVE_END_JOINT) {
         return CLI_EXIT_FAIL;
     }
     if (cli_stop_signal != 0 || !d->keep) {
@@ -627,18 +820,29 @@ static int drive_finish(cli_bus_t *b, const drive_args_t *d, const drive_result_
             return cli_stop_signal != 0 ? cli_signal_exit_code() : CLI_EXIT_FAIL;
         }
     }
-    drive_report(d, res, b, end == DRIVE_END_SIGNAL ? "stopped by signal" : "done", json);
+    drive_report(d, res, end == DRIVE_END_SIGNAL ? "stopped by signal" : "done", json);
     return cli_stop_signal != 0 ? cli_signal_exit_code() : CLI_EXIT_OK;
 }
 
-static int run_drive(drive_args_t *d, const cli_bus_opts_t *o)
+/* --config, --id / --joint: the servo and, on the joint side, its joint. */
+static int drive_select(drive_args_t *d, cli_bus_opts_t *o)
+{
+    if (cli_robot_load(&g_robot, o->config) != 0 ||
+        cli_joint_select(&g_robot, d->joint_name, d->id, o, &d->sel) != 0) {
+        return -1;
+    }
+    d->id = d->sel.id;
+    return j288_joint_init(&d->j, &d->sel.jc) == J288_OK ? 0 : -1;
+}
+
+static int run_drive(drive_args_t *d, cli_bus_opts_t *o)
 {
     cli_bus_t b;
     drive_plan_t plan;
     drive_result_t res;
     int ec;
 
-    if (drive_check(d) != 0 || plan_fields(d, &plan) != 0) {
+    if (drive_check(d) != 0 || drive_select(d, o) != 0 || plan_fields(d, &plan) != 0) {
         return CLI_EXIT_USAGE;
     }
     cli_signals_install();
@@ -646,9 +850,7 @@ static int run_drive(drive_args_t *d, const cli_bus_opts_t *o)
         return ec;
     }
     memset(&res, 0, sizeof res);
-    if (drive_start(&b, d, &plan, &res) != 0) {
-        ec = CLI_EXIT_FAIL;
-    } else {
+    if ((ec = drive_start(&b, d, &plan, &res)) == CLI_EXIT_OK) {
         ec = drive_finish(&b, d, &res, drive_loop(&b, d, &plan, &res), o->json);
     }
     cli_bus_close(&b);
@@ -661,56 +863,67 @@ static int run_drive(drive_args_t *d, const cli_bus_opts_t *o)
     "  --watchdog W     on (default): the servo locks itself if commands stop for 1 s\n"           \
     "  --keep           at the end of --duration leave the last command in force instead\n"        \
     "                   of locking (with the watchdog on the servo locks itself 1 s later)\n"      \
-    "  --side S         SI values on the output side (default) or the rotor side\n"                \
+    "  --side S         joint (default): the absolute joint frame (output encoder angle\n"         \
+    "                   wrapped to [-pi, pi), or the --config joint's zero, direction,\n"          \
+    "                   limits and gains); rotor: the raw rotor frame; output: rotor / N,\n"       \
+    "                   counted from wherever the rotor started at power-up (no limits)\n"         \
+    "  --id N           the servo; or --joint NAME with --config FILE\n"                           \
+    "A target outside the joint's limits is refused before anything is sent (exit 2),\n"          \
+    "unless the joint is configured to clamp. The joint angle is watched: if it is lost\n"         \
+    "(power cycle, slipped gear) the servo is locked and the command fails.\n"                     \
     "Ctrl-C or SIGTERM: the servo is sent lock before exiting (exit 130 / 143).\n"                 \
-    "Exit status: 0 done; 1 no reply, servo stopped answering or device error; 2 bad\n"            \
-    "arguments.\n"
+    "Exit status: 0 done; 1 no reply, servo stopped answering, joint angle unknown or lost,\n"     \
+    "or device error; 2 bad arguments or a target outside the limits.\n"
 
 #define DRIVE_OPTS                                                                                 \
-    {"--id", true, OPT_ID}, {"--side", true, OPT_SIDE}, {"--rate", true, OPT_RATE},                \
-        {"--duration", true, OPT_DURATION}, {"--watchdog", true, OPT_WATCHDOG},                    \
-        {"--keep", false, OPT_KEEP}, CLI_BUS_COMMON_OPTS
+    {"--id", true, OPT_ID}, {"--joint", true, OPT_JOINT}, {"--side", true, OPT_SIDE},              \
+        {"--rate", true, OPT_RATE}, {"--duration", true, OPT_DURATION},                            \
+        {"--watchdog", true, OPT_WATCHDOG}, {"--keep", false, OPT_KEEP}, CLI_BUS_COMMON_OPTS
 
 static void drive_args_init(drive_args_t *d, drive_kind_t kind)
 {
     memset(d, 0, sizeof *d);
     d->kind = kind;
     d->id = -1;
-    d->side = 1;
+    d->side = SIDE_JOINT;
     d->rate_hz = DEFAULT_RATE_HZ;
     d->duration_s = -1.0;
     d->watchdog = true;
 }
 
 static const char hold_help[] =
-    "usage: j288 [--port DEV] hold --id N [--kp NM_RAD] [--kd NMS_RAD] [options]\n"
+    "usage: j288 [--port DEV] hold (--id N | --joint NAME --config FILE) [--kp NM_RAD]\n"
+    "                 [--kd NMS_RAD] [options]\n"
     "\n"
     "Hold servo N at the position it is at now (FOC, stiffness kp, damping kd), refreshing\n"
-    "the command at --rate. Default gains on the output side: kp 20 N*m/rad, kd 2.5\n"
-    "N*m*s/rad.\n" DRIVE_COMMON_HELP "\n" CLI_BUS_COMMON_HELP;
+    "the command at --rate. Default gains (joint or output side): the config's kp and kd,\n"
+    "else kp 20 N*m/rad, kd 2.5 N*m*s/rad.\n" DRIVE_COMMON_HELP "\n" CLI_BUS_COMMON_HELP;
 
 int cli_cmd_hold(int argc, char **argv, const cli_global_t *g)
 {
     static const cli_opt_t opts[] = {
         {"--kp", true, OPT_KP}, {"--kd", true, OPT_KD}, DRIVE_OPTS, {NULL, false, 0}};
-    drive_args_t d;
+    static drive_args_t d;
     cli_bus_opts_t o;
     int ec;
     drive_args_init(&d, DRIVE_HOLD);
     cli_bus_opts_init(&o, g);
-    if (parse_bus_args(argc, argv, opts, hold_help, &o, parse_drive_opt, &d, &ec) != 0) {
+    if (cli_parse_bus_args(argc, argv, opts, hold_help, &o, parse_drive_opt, &d, &ec) != 0) {
         return ec;
     }
     return run_drive(&d, &o);
 }
 
 static const char move_help[] =
-    "usage: j288 [--port DEV] move --id N --pos RAD [--speed RAD_S] [--kp NM_RAD]\n"
-    "                 [--kd NMS_RAD] [--side output|rotor] [options]\n"
+    "usage: j288 [--port DEV] move (--id N | --joint NAME --config FILE) --pos RAD\n"
+    "                 [--speed RAD_S] [--kp NM_RAD] [--kd NMS_RAD] [--side joint|rotor|output]\n"
+    "                 [options]\n"
     "\n"
     "Move servo N from where it is to --pos along a ramp at --speed (default 1 rad/s on the\n"
-    "output side), then hold there. Default gains on the output side: kp 20 N*m/rad, kd 2.5\n"
-    "N*m*s/rad.\n" DRIVE_COMMON_HELP "\n" CLI_BUS_COMMON_HELP;
+    "joint or output side), then hold there. On the joint side (the default) --pos is the\n"
+    "absolute joint angle: the move ends at joint angle RAD whatever the rotor did since\n"
+    "power-up. Default gains: the config's kp and kd, else kp 20 N*m/rad, kd 2.5 N*m*s/rad.\n"
+    DRIVE_COMMON_HELP "\n" CLI_BUS_COMMON_HELP;
 
 int cli_cmd_move(int argc, char **argv, const cli_global_t *g)
 {
@@ -720,32 +933,34 @@ int cli_cmd_move(int argc, char **argv, const cli_global_t *g)
                                      {"--kd", true, OPT_KD},
                                      DRIVE_OPTS,
                                      {NULL, false, 0}};
-    drive_args_t d;
+    static drive_args_t d;
     cli_bus_opts_t o;
     int ec;
     drive_args_init(&d, DRIVE_MOVE);
     cli_bus_opts_init(&o, g);
-    if (parse_bus_args(argc, argv, opts, move_help, &o, parse_drive_opt, &d, &ec) != 0) {
+    if (cli_parse_bus_args(argc, argv, opts, move_help, &o, parse_drive_opt, &d, &ec) != 0) {
         return ec;
     }
     return run_drive(&d, &o);
 }
 
 static const char torque_help[] =
-    "usage: j288 [--port DEV] torque --id N --tau NM [--side output|rotor] [options]\n"
+    "usage: j288 [--port DEV] torque (--id N | --joint NAME --config FILE) --tau NM\n"
+    "                 [--side joint|rotor|output] [options]\n"
     "\n"
-    "Apply a constant feed-forward torque (FOC, kp = kd = 0) to servo N.\n" DRIVE_COMMON_HELP
+    "Apply a constant feed-forward torque (FOC, kp = kd = 0) to servo N; on the joint side\n"
+    "in the joint's direction, refused beyond its max_torque.\n" DRIVE_COMMON_HELP
     "\n" CLI_BUS_COMMON_HELP;
 
 int cli_cmd_torque(int argc, char **argv, const cli_global_t *g)
 {
     static const cli_opt_t opts[] = {{"--tau", true, OPT_TAU}, DRIVE_OPTS, {NULL, false, 0}};
-    drive_args_t d;
+    static drive_args_t d;
     cli_bus_opts_t o;
     int ec;
     drive_args_init(&d, DRIVE_TORQUE);
     cli_bus_opts_init(&o, g);
-    if (parse_bus_args(argc, argv, opts, torque_help, &o, parse_drive_opt, &d, &ec) != 0) {
+    if (cli_parse_bus_args(argc, argv, opts, torque_help, &o, parse_drive_opt, &d, &ec) != 0) {
         return ec;
     }
     return run_drive(&d, &o);

@@ -29,6 +29,8 @@ static const command_t commands[] = {
     {"stop", cli_cmd_stop, "lock one servo, or all (broadcast)"},
     {"log", cli_cmd_log, "run the cycle scheduler and log replies to CSV"},
     {"plot", cli_cmd_plot, "plot a log CSV to PNG with gnuplot"},
+    {"zero", cli_cmd_zero, "make a joint's current pose its zero (written to --config)"},
+    {"calibrate", cli_cmd_calibrate, "fit a joint's rotor phase (written to --config)"},
     {NULL, NULL, NULL}};
 
 static void usage(FILE *f)
@@ -40,7 +42,7 @@ static void usage(FILE *f)
           "commands:\n",
           f);
     for (c = commands; c->name != NULL; c++) {
-        fprintf(f, "  %-8s %s\n", c->name, c->summary);
+        fprintf(f, "  %-9s %s\n", c->name, c->summary);
     }
     fputs("\n"
           "global options (bus commands also take them after the command):\n"

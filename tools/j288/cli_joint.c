@@ -1,0 +1,251 @@
+/* The robot config and the joint frame for the bus commands; see cli_bus.h. */
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "cli_bus.h"
+
+/* Lock exchanges allowed for a start: the start's samples several times over, so that a
+ * dropped reply or a restarted collection does not fail it. */
+#define ACQUIRE_TRIES_PER_SAMPLE 4u
+#define ACQUIRE_TRIES_MIN 40u
+
+int cli_robot_load(cli_robot_t *r, const char *path)
+{
+    char err[J288_ROBOT_CONFIG_ERROR_MAX];
+    r->path = path;
+    if (path == NULL) {
+        return 0;
+    }
+    if (j288_robot_config_load(path, &r->cfg, err, sizeof err) != 0) {
+        cli_error("%s", err);
+        return -1;
+    }
+    return 0;
+}
+
+/* The file's joint with id: the only one, or the one on the bus whose port is o->port. */
+static int joint_by_id(const cli_robot_t *r, uint8_t id, const cli_bus_opts_t *o,
+                       const j288_robot_config_joint_t **found)
+{
+    const j288_robot_config_joint_t *match = NULL;
+    unsigned n = 0;
+    size_t i;
+    for (i = 0; i < r->cfg.njoints; i++) {
+        const j288_robot_config_joint_t *rj = &r->cfg.joint[i];
+        if (rj->id != id) {
+            continue;
+        }
+        if (o->port != NULL && rj->bus >= 0 && strcmp(r->cfg.bus[rj->bus].port, o->port) != 0) {
+            continue;
+        }
+        match = rj;
+        n++;
+    }
+    if (n > 1u) {
+        cli_error("%s: id %u is used on %u buses: name the joint with --joint or the bus with "
+                  "--port",
+                  r->path, (unsigned)id, n);
+        return -1;
+    }
+    *found = match;
+    return 0;
+}
+
+/* The bus options the command line left open, from the joint's bus (or the file's only
+ * bus). */
+void cli_robot_fill_bus(const cli_robot_t *r, const j288_robot_config_joint_t *rj,
+                        cli_bus_opts_t *o)
+{
+    const j288_robot_config_bus_t *bus = NULL;
+    if (r->path == NULL) {
+        return;
+    }
+    if (rj != NULL && rj->bus >= 0) {
+        bus = &r->cfg.bus[rj->bus];
+    } else if (r->cfg.nbuses == 1u) {
+        bus = &r->cfg.bus[0];
+    }
+    if (bus == NULL) {
+        return;
+    }
+    if (o->port == NULL) {
+        o->port = bus->port;
+    }
+    if (o->baud == 0u && bus->has_baud) {
+        o->baud = bus->baud;
+    }
+    if (o->margin_us == 0u && bus->has_margin_us) {
+        o->margin_us = bus->margin_us;
+    }
+    if (!o->echo && bus->has_echo) {
+        o->echo = bus->echo;
+    }
+}
+
+int cli_joint_select(const cli_robot_t *r, const char *joint_name, long long id,
+                     cli_bus_opts_t *o, cli_joint_sel_t *sel)
+{
+    j288_joint_t probe;
+    int rc;
+    memset(sel, 0, sizeof *sel);
+    if (joint_name != NULL && id >= 0) {
+        cli_error("--id and --joint exclude each other");
+        return -1;
+    }
+    if (joint_name == NULL && id < 0) {
+        cli_error("--id N or --joint NAME is required");
+        return -1;
+    }
+    if (joint_name != NULL) {
+        if (r->path == NULL) {
+            cli_error("--joint %s needs --config FILE (the robot config naming it)", joint_name);
+            return -1;
+        }
+        sel->rj = j288_robot_config_find_joint(&r->cfg, joint_name);
+        if (sel->rj == NULL) {
+            cli_error("%s: no joint named '%s'", r->path, joint_name);
+            return -1;
+        }
+    } else if (r->path != NULL && joint_by_id(r, (uint8_t)id, o, &sel->rj) != 0) {
+        return -1;
+    }
+    if (sel->rj != NULL) {
+        sel->id = sel->rj->id;
+        j288_robot_config_joint_config(sel->rj, &sel->jc);
+        (void)snprintf(sel->name, sizeof sel->name, "joint %s", sel->rj->name);
+    } else {
+        sel->id = (uint8_t)id;
+        sel->jc.id = sel->id; /* the all-zero configuration: the library's defaults */
+        (void)snprintf(sel->name, sizeof sel->name, "servo %u", (unsigned)sel->id);
+    }
+    cli_robot_fill_bus(r, sel->rj, o);
+    rc = j288_joint_init(&probe, &sel->jc);
+    if (rc != J288_OK) {
+        cli_error("%s:%u: %s: %s (zero and limits within +-%g rad, phase within 2 pi)",
+                  r->path != NULL ? r->path : "-", sel->rj != NULL ? sel->rj->line : 0u, sel->name,
+                  j288_strerror(rc), J288_JOINT_MAX_ANGLE);
+        return -1;
+    }
+    return 0;
+}
+
+void cli_joint_why_unknown(const j288_joint_t *j, const char *name, unsigned replies, char *buf,
+                           size_t len)
+{
+    const j288_joint_state_t *st = j288_joint_state(j);
+    if (st->encoder_fault) {
+        (void)snprintf(buf, len, "%s: output encoder fault (fault bit 12): the joint angle is "
+                       "unknown", name);
+    } else if (st->cal_mismatch) {
+        (void)snprintf(buf, len, "%s: %s: the rotor is %.3f rad away from where the phase puts "
+                       "it (tolerance %.3f): the gear or the servo changed; run j288 calibrate, "
+                       "or remove phase from the config to run uncalibrated",
+                       name, j288_strerror(J288_ERR_CAL_MISMATCH), (double)st->cal_residual,
+                       (double)j->cfg.cal_tol);
+    } else {
+        (void)snprintf(buf, len, "%s: the joint angle is still unknown after %u replies (the "
+                       "output encoder and the rotor disagree: the joint is moving fast, or the "
+                       "encoder is noisy)", name, replies);
+    }
+}
+
+int cli_joint_acquire(cli_bus_t *b, j288_joint_t *j, const char *name, j288_txn_t *last,
+                      unsigned *replies, bool report_unknown)
+{
+    const j288_joint_state_t *st = j288_joint_state(j);
+    unsigned samples = j->cfg.init_samples != 0u ? j->cfg.init_samples : 8u;
+    unsigned tries = samples * ACQUIRE_TRIES_PER_SAMPLE, n;
+    j288_cmd_raw_t cmd;
+    j288_txn_t txn;
+    int rc = J288_ERR_TIMEOUT;
+    if (tries < ACQUIRE_TRIES_MIN) {
+        tries = ACQUIRE_TRIES_MIN;
+    }
+    *replies = 0;
+    cli_lock_cmd(j->cfg.id, &cmd);
+    for (n = 0; n < tries && !st->known; n++) {
+        rc = cli_bus_transfer(b, &cmd, &txn);
+        if (rc == J288_ERR_OFFLINE || cli_stop_signal != 0) {
+            break;
+        }
+        if (rc == J288_OK) {
+            (*replies)++;
+            (void)j288_joint_take_reply(j, &txn.reply, NULL);
+            *last = txn;
+        }
+        /* An encoder the servo reports broken or a phase that does not fit will not come
+         * right by asking again and again: give up after a start's worth of replies. */
+        if ((st->encoder_fault || st->cal_mismatch) && *replies >= 2u * samples) {
+            break;
+        }
+    }
+    if (st->known) {
+        return CLI_EXIT_OK;
+    }
+    if (cli_stop_signal != 0) {
+        return cli_signal_exit_code();
+    }
+    if (*replies == 0u || rc == J288_ERR_OFFLINE) {
+        cli_report_txn_failure(b, j->cfg.id, rc);
+    } else if (report_unknown) {
+        char why[400];
+        cli_joint_why_unknown(j, name, *replies, why, sizeof why);
+        cli_error("%s", why);
+    }
+    return CLI_EXIT_FAIL;
+}
+
+static void joint_range(const j288_joint_config_t *jc, double *lo, double *hi)
+{
+    if (jc->pos_min == 0 && jc->pos_max == 0) {
+        *lo = -J288_PI;
+        *hi = J288_PI;
+    } else {
+        *lo = (double)jc->pos_min;
+        *hi = (double)jc->pos_max;
+    }
+}
+
+bool cli_joint_pos_allowed(const j288_joint_config_t *jc, double pos)
+{
+    double lo, hi;
+    joint_range(jc, &lo, &hi);
+    return jc->clamp || (pos >= lo && pos <= hi);
+}
+
+void cli_joint_target_error(const j288_joint_t *j, const char *name, const char *what, int rc)
+{
+    double lo, hi;
+    joint_range(&j->cfg, &lo, &hi);
+    if (rc == J288_ERR_LIMIT_POS) {
+        cli_error("%s: %s: %s [%g, %g]; nothing sent", name, what, j288_strerror(rc), lo, hi);
+    } else if (rc == J288_ERR_LIMIT_SPEED) {
+        cli_error("%s: %s: %s (%g rad/s); nothing sent", name, what, j288_strerror(rc),
+                  (double)j->cfg.max_speed);
+    } else if (rc == J288_ERR_LIMIT_TORQUE) {
+        cli_error("%s: %s: %s (%g N*m); nothing sent", name, what, j288_strerror(rc),
+                  (double)j->cfg.max_torque);
+    } else {
+        cli_error("%s: %s: %s", name, what, j288_strerror(rc));
+    }
+}
+
+void cli_json_joint_members(cli_json_t *jw, const j288_joint_t *j)
+{
+    const j288_joint_state_t *st = j288_joint_state(j);
+    cli_json_bool(jw, "joint_known", st->known);
+    cli_json_bool(jw, "joint_calibrated", st->calibrated);
+    if (st->known) {
+        cli_json_real(jw, "joint_pos", (double)st->pos);
+    }
+    cli_json_real(jw, "joint_speed", (double)st->speed);
+    cli_json_real(jw, "joint_torque", (double)st->torque);
+    cli_json_real(jw, "joint_encoder", (double)st->encoder);
+    cli_json_bool(jw, "encoder_fault", st->encoder_fault);
+    cli_json_bool(jw, "cal_mismatch", st->cal_mismatch);
+    if (st->cal_mismatch) {
+        cli_json_real(jw, "cal_residual", (double)st->cal_residual);
+    }
+    cli_json_bool(jw, "beyond_limit", st->beyond_limit);
+}
