@@ -2,9 +2,7 @@
 #   $(SO_LIB)      build/lib/libj288.so: lib/ + the Linux port + the robot config reader and the
 #                  multi-bus runner, position-independent, linked with libyaml (what the Python
 #                  package loads; C programs may link it too)
-#   $(PC_FILE)     build/lib/pkgconfig/j288.pc, from cmake/j288.pc.in (the same file
-#                  `cmake --install` writes)
-#   make shared    the two
+#   make shared    that
 # The one version: J288_VERSION_STRING in lib/include/j288/j288.h (Makefile's J288_VERSION).
 .PHONY: shared
 
@@ -30,16 +28,14 @@ $(SO_LIB): $(SO_REAL)
 	ln -sf $(notdir $(SO_REAL)) $(BUILD)/lib/$(SO_NAME)
 	ln -sf $(SO_NAME) $@
 
-PC_FILE := $(BUILD)/lib/pkgconfig/j288.pc
-# $(call PC_GEN,prefix,libdir,includedir,out): cmake/j288.pc.in with the @...@ names filled in.
-PC_GEN = sed -e 's|@PREFIX@|$(1)|g' -e 's|@LIBDIR@|$(2)|g' -e 's|@INCLUDEDIR@|$(3)|g' \
-    -e 's|@J288_VERSION@|$(J288_VERSION)|g' cmake/j288.pc.in >$(4)
+# j288.pc for `make install`: cmake/j288.pc.in with its prefix relative to ${pcfiledir}, so
+# that it holds wherever the files land (PREFIX, DESTDIR) or are moved; `cmake --install`
+# writes the same. $(call PC_GEN,libdir,includedir,out): both relative to PREFIX.
+PC_UP = $(shell printf '%s' '$(1)/pkgconfig' | sed 's|[^/][^/]*|..|g')
+PC_GEN = sed -e 's|@PREFIX@|$${pcfiledir}/$(call PC_UP,$(1))|g' -e 's|@LIBDIR@|$${prefix}/$(1)|g' \
+    -e 's|@INCLUDEDIR@|$${prefix}/$(2)|g' -e 's|@J288_VERSION@|$(J288_VERSION)|g' cmake/j288.pc.in >$(3)
 
-$(PC_FILE): cmake/j288.pc.in lib/include/j288/j288.h
-	@mkdir -p $(@D)
-	$(call PC_GEN,$(PREFIX),$(LIBDIR),$(INCLUDEDIR),$@)
-
-shared: $(SO_LIB) $(PC_FILE)
+shared: $(SO_LIB)
 ALL_TARGETS += $(SO_LIB)
 
 # What `make install` adds to the static library, headers, CMake package and tools (the
@@ -54,6 +50,6 @@ install-release: $(SO_LIB)
 	ln -sf $(notdir $(SO_REAL)) $(DESTDIR)$(LIBDIR)/$(SO_NAME)
 	ln -sf $(SO_NAME) $(DESTDIR)$(LIBDIR)/libj288.so
 	install -m 644 $(PORT_HDR) $(DESTDIR)$(INCLUDEDIR)/j288/
-	$(call PC_GEN,$(PREFIX),$(LIBDIR),$(INCLUDEDIR),$(DESTDIR)$(LIBDIR)/pkgconfig/j288.pc)
+	$(call PC_GEN,$(patsubst $(PREFIX)/%,%,$(LIBDIR)),$(patsubst $(PREFIX)/%,%,$(INCLUDEDIR)),$(DESTDIR)$(LIBDIR)/pkgconfig/j288.pc)
 	install -m 644 python/j288/*.py python/j288/py.typed $(DESTDIR)$(PYTHONDIR)/j288/
 install: install-release

@@ -23,6 +23,8 @@ packages=(
     qemu-user                       # make test-be / test-32 (qemu-s390x, qemu-arm)
     binutils                        # make check-symbols (nm)
     python3                         # make fuzz-corpus, golden vectors
+    python3-pytest python3-numpy    # scripts/python-test.sh (make test: the Python package)
+    pkg-config                      # scripts/check-consumers.sh (a pkg-config consumer)
 )
 
 missing=()
