@@ -1,6 +1,7 @@
 # The multi-bus runner (port/linux/j288_robot.c) and its tests.
 #   $(ROBOT_OBJ)       the runner; link with $(CONFIG_OBJ), $(LINUX_A), $(LIB_A) and the yaml libs
 #   test/linux/test_robot.c   several j288-sim buses from one loop (HOST_TESTS)
+#   test/e2e/cli_robot.sh     j288 --config FILE log|status|hold|stop (TEST_SCRIPTS)
 ROBOT_OBJ := $(OBJ)/port/linux/j288_robot.o
 ROBOT_HDR := port/linux/j288_robot.h port/linux/j288_robot_config.h port/linux/j288_linux.h
 
@@ -27,3 +28,5 @@ $(OBJ)/tools/j288/cmd_robot.o: $(ROBOT_HDR)
 $(J288_BIN): $(ROBOT_OBJ) $(CONFIG_OBJ)
 # (the archives again after them: the tool's link rule lists its own prerequisites first)
 $(J288_BIN): LDFLAGS_COMMON += $(LINUX_A) $(LIB_A) $(call yaml_var,YAML_LIBS)
+TEST_SCRIPTS += test/e2e/cli_robot.sh
+TEST_DEPS += $(J288_BIN)
