@@ -638,14 +638,35 @@ int j288_robot_run(j288_robot_t *r, uint32_t period_us, uint32_t ncycles, uint32
     }
 }
 
+/* How long the stop frames may take: the transaction in flight ends by its deadline, the
+ * guard after a failure lasts one reply budget, and a stop frame whose transmit fails is
+ * re-sent (J288_ESTOP_ATTEMPTS in all), so a bus with a long margin needs longer. */
+static uint32_t stop_bound_us(const j288_robot_t *r)
+{
+    uint32_t bound = J288_ROBOT_STOP_TIMEOUT_US;
+    unsigned i;
+    for (i = 0; i < r->nbuses; i++) {
+        if (bus_live(&r->bus[i])) {
+            uint64_t b = (uint64_t)j288_bus_reply_budget_us(&r->bus[i].bus) *
+                             (J288_ESTOP_ATTEMPTS + 2u) + J288_ROBOT_STOP_TIMEOUT_US;
+            if (b > 60000000u)
+                b = 60000000u;
+            if (b > bound)
+                bound = (uint32_t)b;
+        }
+    }
+    return bound;
+}
+
 int j288_robot_stop(j288_robot_t *r)
 {
-    uint32_t start, now;
+    uint32_t start, now, bound;
     unsigned i;
     int rc = J288_OK;
     if (r == NULL)
         return J288_ERR_NULL;
     start = j288_linux_now_us();
+    bound = stop_bound_us(r);
     for (i = 0; i < r->nbuses; i++) {
         if (bus_live(&r->bus[i]))
             (void)j288_sched_estop(&r->bus[i].sched, start);
@@ -671,12 +692,11 @@ int j288_robot_stop(j288_robot_t *r)
         }
         if (!pending)
             return rc;
-        if (now - start >= J288_ROBOT_STOP_TIMEOUT_US) {
-            set_err(r, "the stop frames did not go out within %u ms",
-                    J288_ROBOT_STOP_TIMEOUT_US / 1000u);
+        if (now - start >= bound) {
+            set_err(r, "the stop frames did not go out within %u ms", (unsigned)(bound / 1000u));
             return J288_ERR_TIMEOUT;
         }
-        wait_all(r, now, start + J288_ROBOT_STOP_TIMEOUT_US);
+        wait_all(r, now, start + bound);
     }
 }
 

@@ -51,6 +51,10 @@
 #include "j288_linux.h"
 #include "j288_robot_config.h"
 
+#if !J288_CONFIG_SI
+#error "the multi-bus runner needs the SI-unit API (J288_CONFIG_SI=1): it drives joints"
+#endif
+
 #ifdef __cplusplus
 extern "C" {
 #endif
@@ -59,7 +63,8 @@ extern "C" {
 #define J288_ROBOT_MAX_JOINTS 64u
 #define J288_ROBOT_DEFAULT_DOWN_AFTER 3u         /* empty sweeps before a bus is down */
 #define J288_ROBOT_DEFAULT_CYCLE_TIMEOUT_US 1000000u
-#define J288_ROBOT_STOP_TIMEOUT_US 200000u       /* bound on flushing the stop frames */
+#define J288_ROBOT_STOP_TIMEOUT_US 200000u       /* bound on flushing the stop frames, beyond
+                                                    the buses' own reply budgets */
 #define J288_ROBOT_MSG_LEN 512u
 
 typedef enum {
@@ -245,8 +250,10 @@ int j288_robot_cycle(j288_robot_t *r, uint32_t timeout_us, j288_robot_cycle_t *i
 int j288_robot_run(j288_robot_t *r, uint32_t period_us, uint32_t ncycles, uint32_t duration_us);
 
 /* Broadcast lock on every bus still there, every joint's slot at lock; returns once the stop
- * frames are out (at most J288_ROBOT_STOP_TIMEOUT_US). J288_OK, J288_ERR_OFFLINE (some bus
- * is gone: nothing could be sent there), J288_ERR_TIMEOUT, J288_ERR_NULL. */
+ * frames are out: after the transaction in flight on each bus (its reply budget) and any
+ * re-sends, at most (J288_ESTOP_ATTEMPTS + 2) reply budgets + J288_ROBOT_STOP_TIMEOUT_US.
+ * J288_OK, J288_ERR_OFFLINE (some bus is gone: nothing could be sent there),
+ * J288_ERR_TIMEOUT, J288_ERR_NULL. */
 int j288_robot_stop(j288_robot_t *r);
 
 /* ---- joints (index 0 .. njoints - 1, in the config's order) */

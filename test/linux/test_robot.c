@@ -513,6 +513,35 @@ static void test_stop_flag_stops_every_bus(void)
     TEST_ASSERT_EQUAL_INT(J288_ERR_NULL, j288_robot_run(NULL, 0, 1, 0));
 }
 
+/* A stop while a silent bus waits out a long reply margin: the stop waits for that
+ * transaction's deadline (longer than J288_ROBOT_STOP_TIMEOUT_US), then the broadcast goes out
+ * there too. */
+static void test_stop_waits_for_a_long_margin(void)
+{
+    j288_robot_options_t o;
+    j288_robot_cycle_t info;
+    memset(&o, 0, sizeof o);
+    sim_start(0, "1,2,3");
+    sim_start(1, "1,2,3");
+    make_config(2, LOADED_MARGIN_US);
+    g_cfg.bus[1].margin_us = 400000u; /* beyond J288_ROBOT_STOP_TIMEOUT_US */
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_robot_open(&g_robot, &g_cfg, &o));
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_robot_cycle(&g_robot, 0, NULL));
+    TEST_ASSERT_EQUAL_INT(0, kill(g_sim[1].pid, SIGSTOP));
+    g_sim[1].stopped = true;
+    /* The cycle gives up after 50 ms; bus 1's transaction is still waiting for its reply. */
+    TEST_ASSERT_EQUAL_INT(J288_ERR_TIMEOUT, j288_robot_cycle(&g_robot, 50000u, &info));
+    TEST_ASSERT_EQUAL_UINT(3, info.fresh);
+    TEST_ASSERT_EQUAL_INT_MESSAGE(J288_OK, j288_robot_stop(&g_robot), j288_robot_error(&g_robot));
+    TEST_ASSERT_EQUAL_UINT32(1, j288_robot_bus_wire_stats(&g_robot, 1)->estops);
+    TEST_ASSERT_EQUAL_UINT32(0, j288_robot_bus_wire_stats(&g_robot, 1)->estop_failures);
+    j288_robot_close(&g_robot);
+    TEST_ASSERT_EQUAL_INT(0, kill(g_sim[1].pid, SIGCONT));
+    g_sim[1].stopped = false;
+    sim_stop(1);
+    TEST_ASSERT_TRUE(log_contains(1, " id=15 status=0 wd=1"));
+}
+
 /* Servo level on one bus without a config: scan-like exchanges. */
 static void test_exchange_on_one_port(void)
 {
@@ -548,6 +577,7 @@ int main(void)
     RUN_TEST(test_missing_device);
     RUN_TEST(test_one_bus_stops_answering);
     RUN_TEST(test_stop_flag_stops_every_bus);
+    RUN_TEST(test_stop_waits_for_a_long_margin);
     RUN_TEST(test_exchange_on_one_port);
     return UNITY_END();
 }
