@@ -250,7 +250,10 @@ class Robot:
             self.close()
 
     def __del__(self) -> None:
-        self.close()
+        try:
+            self.close()
+        except Exception:  # interpreter shutdown: the library may be gone already
+            pass
 
 
 __all__ = ["Robot", "Cycle", "State", "J288Error"]
