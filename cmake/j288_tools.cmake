@@ -1,5 +1,8 @@
-# The Linux port (j288_linux, static) and the tools j288 (tools/j288) and j288-sim
-# (tools/j288-sim), with the Makefile's sources and flags. POSIX programs: Linux only.
+# The Linux port (j288_linux, static), the robot config reader and multi-bus runner
+# (j288_robot, static; libyaml when found, else the reader says it is missing), the shared
+# library libj288.so (lib + port + runner: what the Python package loads) and the tools j288
+# (tools/j288) and j288-sim (tools/j288-sim), with the Makefile's sources and flags. POSIX
+# programs: Linux only.
 if(NOT CMAKE_SYSTEM_NAME STREQUAL "Linux")
     message(STATUS "j288: the Linux port, j288 and j288-sim are built on Linux only")
     return()
@@ -10,11 +13,42 @@ add_library(j288_linux STATIC "${PROJECT_SOURCE_DIR}/port/linux/j288_linux.c")
 target_include_directories(j288_linux PUBLIC "${PROJECT_SOURCE_DIR}/port/linux")
 target_link_libraries(j288_linux PUBLIC j288::j288)
 
+find_library(J288_YAML_LIB yaml)
+find_path(J288_YAML_INCLUDE yaml.h)
+set(_j288_robot_sources "${PROJECT_SOURCE_DIR}/port/linux/j288_robot.c"
+                        "${PROJECT_SOURCE_DIR}/port/linux/j288_robot_config.c")
+add_library(j288_robot STATIC ${_j288_robot_sources})
+target_link_libraries(j288_robot PUBLIC j288_linux)
+
+file(GLOB _j288_shared_sources CONFIGURE_DEPENDS "${PROJECT_SOURCE_DIR}/lib/src/*.c")
+add_library(j288_shared SHARED ${_j288_shared_sources} "${PROJECT_SOURCE_DIR}/port/linux/j288_linux.c"
+            ${_j288_robot_sources})
+target_include_directories(j288_shared PUBLIC "${PROJECT_SOURCE_DIR}/lib/include"
+                           "${PROJECT_SOURCE_DIR}/port/linux")
+get_target_property(_j288_defs j288 INTERFACE_COMPILE_DEFINITIONS)
+target_compile_definitions(j288_shared PUBLIC ${_j288_defs})
+set_target_properties(j288_shared PROPERTIES OUTPUT_NAME j288 VERSION ${PROJECT_VERSION}
+                      SOVERSION ${PROJECT_VERSION_MAJOR})
+
+foreach(t j288_robot j288_shared)
+    if(J288_YAML_LIB AND J288_YAML_INCLUDE)
+        target_compile_definitions(${t} PRIVATE J288_HAVE_LIBYAML)
+        target_include_directories(${t} PRIVATE "${J288_YAML_INCLUDE}")
+        target_link_libraries(${t} PRIVATE ${J288_YAML_LIB})
+    endif()
+endforeach()
+if(NOT (J288_YAML_LIB AND J288_YAML_INCLUDE))
+    message(STATUS "j288: libyaml not found (Debian: libyaml-dev): robot config files are refused")
+endif()
+
 file(GLOB _j288_cli_sources CONFIGURE_DEPENDS "${PROJECT_SOURCE_DIR}/tools/j288/*.c")
 add_executable(j288_cli ${_j288_cli_sources})
 # The tools are POSIX programs (signals, realpath, popen); lib/ stays pure C99.
 target_compile_definitions(j288_cli PRIVATE _XOPEN_SOURCE=700)
-target_link_libraries(j288_cli PRIVATE j288_linux)
+target_link_libraries(j288_cli PRIVATE j288_robot j288_linux)
+if(J288_YAML_LIB AND J288_YAML_INCLUDE)
+    target_link_libraries(j288_cli PRIVATE ${J288_YAML_LIB})
+endif()
 
 add_executable(j288_sim "${PROJECT_SOURCE_DIR}/tools/j288-sim/servo_model.c"
                         "${PROJECT_SOURCE_DIR}/tools/j288-sim/sim_main.c")
@@ -22,12 +56,12 @@ target_link_libraries(j288_sim PRIVATE j288::j288)
 
 set_target_properties(j288_cli PROPERTIES OUTPUT_NAME j288)
 set_target_properties(j288_sim PROPERTIES OUTPUT_NAME j288-sim)
-foreach(t j288_linux j288_cli j288_sim)
+foreach(t j288_linux j288_robot j288_shared j288_cli j288_sim)
     set_target_properties(${t} PROPERTIES C_STANDARD 99 C_STANDARD_REQUIRED ON C_EXTENSIONS OFF)
     if(CMAKE_C_COMPILER_ID MATCHES "GNU|Clang")
         target_compile_options(${t} PRIVATE ${J288_WARNINGS})
     endif()
-    if(J288_LIBM AND NOT t STREQUAL j288_linux)
+    if(J288_LIBM AND NOT t STREQUAL j288_linux AND NOT t STREQUAL j288_robot)
         target_link_libraries(${t} PRIVATE ${J288_LIBM})
     endif()
 endforeach()

@@ -4,7 +4,9 @@
 # protocol's worked frame): find_package(j288) after `cmake --install` and after
 # `make install DESTDIR=...` into temporary prefixes (the tools installed with them must run),
 # add_subdirectory, and the library cross-built with cmake/arm-none-eabi.cmake for Cortex-M4F
-# and Cortex-M0 (SI off). Needs cmake; the cross build needs arm-none-eabi-gcc.
+# and Cortex-M0 (SI off), and a pkg-config consumer (test/e2e/pkgconfig_consumer.c, against
+# the shared library of both installs). Needs cmake; the cross build needs arm-none-eabi-gcc,
+# the pkg-config consumer pkg-config.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/need.sh cmake cmake || exit $(($? == 1 ? 0 : 1))
@@ -23,12 +25,27 @@ consumer() {
 # installed PREFIX: what an install must hold, then a find_package consumer against it.
 installed() {
     local p=$1 f
-    for f in include/j288/j288.h lib/libj288.a lib/cmake/j288/j288Config.cmake bin/j288 bin/j288-sim; do
+    for f in include/j288/j288.h include/j288/j288_robot.h lib/libj288.a lib/libj288.so \
+        lib/pkgconfig/j288.pc lib/cmake/j288/j288Config.cmake bin/j288 bin/j288-sim; do
         [ -f "$p/$f" ] || { echo "check-consumers: $p/$f not installed" >&2; exit 1; }
     done
     quiet "$p/bin/j288" --version
     quiet "$p/bin/j288-sim" --help
     consumer "find_package-$(basename "$p")" -DCMAKE_PREFIX_PATH="$p"
+    pkgconfig_consumer "$p"
+}
+# pkgconfig_consumer PREFIX: build test/e2e/pkgconfig_consumer.c with pkg-config's flags for
+# the j288.pc under PREFIX and run it against that prefix's shared library.
+pkgconfig_consumer() {
+    local p=$1 exe=$root/pkgconfig-$(basename "$1")
+    if ! command -v pkg-config >/dev/null 2>&1; then
+        bash scripts/need.sh pkg-config pkg-config || { [ $? -eq 1 ] && return 0; exit 1; }
+    fi
+    quiet ${CC:-cc} -std=c99 -Wall -Wextra -Werror test/e2e/pkgconfig_consumer.c -o "$exe" \
+        $(PKG_CONFIG_PATH="$p/lib/pkgconfig" pkg-config --cflags --libs j288)
+    local out
+    out=$(LD_LIBRARY_PATH="$p/lib" "$exe")
+    echo "pkg-config-$(basename "$p"): $out"
 }
 
 quiet cmake -S . -B "$root/host" -DCMAKE_BUILD_TYPE=RelWithDebInfo

@@ -25,6 +25,8 @@ packages=(
     python3                         # make fuzz-corpus, golden vectors
     # RISC-V (mk/cpu/rv32imac.mk): test-target and bench-bus-target on RV32 under QEMU
     gcc-riscv64-unknown-elf picolibc-riscv64-unknown-elf qemu-system-misc
+    python3-pytest python3-numpy    # scripts/python-test.sh (make test: the Python package)
+    pkg-config                      # scripts/check-consumers.sh (a pkg-config consumer)
 )
 
 missing=()

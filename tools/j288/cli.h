@@ -9,6 +9,7 @@
 #ifndef J288_CLI_H
 #define J288_CLI_H
 
+#include <stdbool.h>
 #include <stdint.h>
 #include <stdio.h>
 
@@ -31,6 +32,7 @@
 typedef struct {
     const char *port; /* NULL: $J288_PORT, else an error for bus commands */
     uint32_t baud;    /* 0: J288_DEFAULT_BAUD */
+    const char *config; /* --config FILE before the command, or NULL */
 } cli_global_t;
 
 /* Name used as the message prefix ("encode" -> "j288 encode: ..."). NULL: plain "j288". */
@@ -59,5 +61,9 @@ int cli_cmd_log(int argc, char **argv, const cli_global_t *g);
 int cli_cmd_plot(int argc, char **argv, const cli_global_t *g);
 int cli_cmd_zero(int argc, char **argv, const cli_global_t *g);
 int cli_cmd_calibrate(int argc, char **argv, const cli_global_t *g);
+/* log, status, hold, stop over every bus of a robot config (cmd_robot.c): taken instead of
+ * the one-servo command when cli_robot_takes() says so (a --config, no --id or --joint). */
+int cli_cmd_robot(int argc, char **argv, const cli_global_t *g);
+bool cli_robot_takes(const char *command, int argc, char **argv, const cli_global_t *g);
 
 #endif /* J288_CLI_H */

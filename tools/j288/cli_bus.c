@@ -20,6 +20,7 @@ void cli_bus_opts_init(cli_bus_opts_t *o, const cli_global_t *g)
     memset(o, 0, sizeof *o);
     o->port = g->port;
     o->baud = g->baud;
+    o->config = g->config; /* `j288 --config F status --joint hip` as well */
     o->retries = -1;
 }
 

@@ -48,6 +48,8 @@ static void usage(FILE *f)
           "global options (bus commands also take them after the command):\n"
           "  --port DEV   serial device of the bus (default: $J288_PORT)\n"
           "  --baud N     line rate in bit/s (default 6000000)\n"
+          "  --config F   robot config: log, status, hold, stop without --id/--joint drive\n"
+          "               every bus and joint in it (j288 --config F log --help)\n"
           "  --version    print the library version\n"
           "\n"
           "exit status: 0 success; 1 invalid frame, device or bus failure (no reply, servo\n"
@@ -57,15 +59,16 @@ static void usage(FILE *f)
           f);
 }
 
-enum { OPT_PORT, OPT_BAUD, OPT_VERSION };
+enum { OPT_PORT, OPT_BAUD, OPT_VERSION, OPT_CONFIG };
 static const cli_opt_t global_opts[] = {{"--port", true, OPT_PORT},
+                                        {"--config", true, OPT_CONFIG},
                                         {"--baud", true, OPT_BAUD},
                                         {"--version", false, OPT_VERSION},
                                         {NULL, false, 0}};
 
 int main(int argc, char **argv)
 {
-    cli_global_t g = {NULL, 0};
+    cli_global_t g = {NULL, 0, NULL};
     cli_args_t a;
     const char *v;
     const command_t *c;
@@ -97,6 +100,8 @@ int main(int argc, char **argv)
         }
         if (key == OPT_PORT) {
             g.port = v;
+        } else if (key == OPT_CONFIG) {
+            g.config = v;
         } else if (cli_parse_int("--baud", v, 9600, 100000000, &baud) != 0) {
             return CLI_EXIT_USAGE;
         } else {
@@ -119,6 +124,10 @@ int main(int argc, char **argv)
         }
         usage(stdout);
         return CLI_EXIT_OK;
+    }
+    if (cli_robot_takes(v, argc - (a.index - 1), argv + (a.index - 1), &g)) {
+        cli_set_command(v);
+        return cli_cmd_robot(argc - (a.index - 1), argv + (a.index - 1), &g);
     }
     for (c = commands; c->name != NULL; c++) {
         if (strcmp(v, c->name) == 0) {

@@ -1,0 +1,19 @@
+# The Python package (python/j288: ctypes over $(SO_LIB), nothing to install).
+#   make python       the shared library, copied into the package in place:
+#                     PYTHONPATH=python python3 -c 'import j288; print(j288.__version__)'
+#   python tests      python/tests with pytest against j288-sim and this build's $(SO_LIB), part
+#                     of `make test` when pytest is there (Debian's python3-pytest for /usr/bin/python3); a notice
+#                     otherwise, a failure with CI=true (scripts/python-test.sh)
+.PHONY: python python-test
+PY_SO := python/j288/libj288.so
+
+$(PY_SO): $(SO_REAL)
+	cp $(SO_REAL) $@
+
+python: $(PY_SO)
+
+python-test: $(SO_LIB) $(SIM_BIN)
+	$(call RUN_TESTS,scripts/python-test.sh)
+
+TEST_SCRIPTS += scripts/python-test.sh
+TEST_DEPS += $(SO_LIB) $(SIM_BIN)

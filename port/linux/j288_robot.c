@@ -1,0 +1,1005 @@
+/*
+ * j288_robot.c - the multi-bus runner (see j288_robot.h for the contract).
+ *
+ * The runner belongs to the Linux port: it reads the port object's descriptor and timer
+ * (lp.fd, lp.timer_*) to put every bus into one ppoll(), and lets the port's own wait()
+ * (with a deadline of now) read a ready device, so that reading, flushing and the
+ * vanished-device handling stay in one place (j288_linux.c).
+ */
+#define _GNU_SOURCE 1 /* ppoll */
+
+#include "j288_robot.h"
+
+#include <errno.h>
+#include <poll.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <time.h>
+
+/* While a transaction is pending, wake at least this often to let each bus check its reply
+ * deadline (the port's timer gives the exact time when it is armed). */
+#define SLICE_US 1000u
+/* With a stop flag, never sleep longer than this. */
+#define STOP_SLICE_US 20000u
+
+static void set_err(j288_robot_t *r, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+
+static void set_err(j288_robot_t *r, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    (void)vsnprintf(r->err, sizeof r->err, fmt, ap);
+    va_end(ap);
+}
+
+static int32_t us_until(uint32_t t, uint32_t now) { return (int32_t)(t - now); }
+
+size_t j288_robot_sizeof(void) { return sizeof(j288_robot_t); }
+
+const char *j288_robot_version(void) { return J288_VERSION_STRING; }
+
+static bool bus_live(const j288_robot_bus_t *b) { return b->open && !b->stats.gone; }
+
+static void emit(j288_robot_t *r, const j288_robot_event_t *ev)
+{
+    if (r->opt.on_event != NULL)
+        r->opt.on_event(r->opt.user, ev);
+}
+
+static void emit_bus(j288_robot_t *r, j288_robot_event_kind_t kind, unsigned bus)
+{
+    j288_robot_event_t ev;
+    memset(&ev, 0, sizeof ev);
+    ev.kind = kind;
+    ev.bus = bus;
+    ev.joint = -1;
+    emit(r, &ev);
+}
+
+/* ---- scheduler and joint hooks (called from inside j288_sched_poll) -------------------------- */
+
+static void on_servo_event(void *user, const j288_event_t *sev)
+{
+    j288_robot_bus_t *b = user;
+    j288_robot_event_t ev;
+    memset(&ev, 0, sizeof ev);
+    ev.kind = J288_ROBOT_EV_SERVO;
+    ev.bus = b->index;
+    ev.id = sev->id;
+    ev.joint = (sev->id < J288_MAX_SERVOS) ? b->joint_of[sev->id] : -1;
+    ev.servo_ev = *sev;
+    emit(b->robot, &ev);
+}
+
+static void on_joint_event(void *user, const j288_joint_event_t *jev)
+{
+    j288_robot_bus_t *b = user;
+    j288_robot_event_t ev;
+    memset(&ev, 0, sizeof ev);
+    ev.kind = J288_ROBOT_EV_JOINT;
+    ev.bus = b->index;
+    ev.id = jev->id;
+    ev.joint = (jev->id < J288_MAX_SERVOS) ? b->joint_of[jev->id] : -1;
+    ev.joint_kind = jev->kind;
+    ev.value = (double)jev->value;
+    emit(b->robot, &ev);
+}
+
+static void on_reply(void *user, uint8_t id, const j288_slot_t *slot)
+{
+    j288_robot_bus_t *b = user;
+    b->swept_ok = true;
+    j288_joint_bus_on_reply(&b->jb, id, slot);
+    if (id < J288_MAX_SERVOS && b->joint_of[id] >= 0)
+        b->robot->fresh_at[b->joint_of[id]] = b->robot->cycle;
+}
+
+/* A sweep ended: a bus whose sweeps keep coming back empty goes down, a reply brings it up. */
+static void on_sweep(void *user, uint32_t sweep, uint32_t now_us)
+{
+    j288_robot_bus_t *b = user;
+    j288_robot_t *r = b->robot;
+    uint32_t took = now_us - b->sweep_start_us;
+    (void)sweep;
+    b->stats.sweeps++;
+    b->stats.last_sweep_us = took;
+    if (took > b->stats.worst_sweep_us)
+        b->stats.worst_sweep_us = took;
+    if (b->swept_ok) {
+        b->empty_run = 0;
+        if (!b->stats.up) {
+            b->stats.up = true;
+            emit_bus(r, J288_ROBOT_EV_BUS_UP, b->index);
+        }
+        return;
+    }
+    b->stats.empty_sweeps++;
+    if (b->empty_run < UINT8_MAX)
+        b->empty_run++;
+    if (b->stats.up && b->empty_run >= r->opt.down_after) {
+        b->stats.up = false;
+        b->stats.down_events++;
+        emit_bus(r, J288_ROBOT_EV_BUS_DOWN, b->index);
+    }
+}
+
+/* ---- open and close -------------------------------------------------------------------------- */
+
+static void reset_robot(j288_robot_t *r, const j288_robot_options_t *opt)
+{
+    unsigned i;
+    memset(r, 0, sizeof *r);
+    if (opt != NULL)
+        r->opt = *opt;
+    if (r->opt.down_after == 0u)
+        r->opt.down_after = J288_ROBOT_DEFAULT_DOWN_AFTER;
+    for (i = 0; i < J288_ROBOT_MAX_BUSES; i++)
+        r->bus[i].lp.fd = -1;
+    r->cycle = 1;
+}
+
+/* The joint layer's configuration from a config file's joint. */
+static void joint_config_from(const j288_robot_config_joint_t *cj, j288_joint_config_t *jc)
+{
+    memset(jc, 0, sizeof *jc);
+    jc->id = cj->id;
+    jc->direction = (int8_t)cj->direction;
+    jc->clamp = cj->clamp;
+    jc->zero = (j288_real_t)cj->zero;
+    if (cj->has_limits) {
+        jc->pos_min = (j288_real_t)cj->pos_min;
+        jc->pos_max = (j288_real_t)cj->pos_max;
+    }
+    if (cj->has_max_speed)
+        jc->max_speed = (j288_real_t)cj->max_speed;
+    if (cj->has_max_torque)
+        jc->max_torque = (j288_real_t)cj->max_torque;
+    if (cj->has_kp)
+        jc->kp = (j288_real_t)cj->kp;
+    if (cj->has_kd)
+        jc->kd = (j288_real_t)cj->kd;
+    if (cj->has_phase) {
+        jc->has_phase = true;
+        jc->phase = (j288_real_t)cj->phase;
+    }
+}
+
+/* Names, devices and ids are checked here too: a config may be built by hand. */
+static int check_config(j288_robot_t *r, const j288_robot_config_t *cfg)
+{
+    size_t i, k;
+    if (cfg->nbuses > J288_ROBOT_MAX_BUSES) {
+        set_err(r, "%zu buses: at most %u", cfg->nbuses, J288_ROBOT_MAX_BUSES);
+        return J288_ERR_BAD_CONFIG;
+    }
+    if (cfg->njoints > J288_ROBOT_MAX_JOINTS) {
+        set_err(r, "%zu joints: at most %u", cfg->njoints, J288_ROBOT_MAX_JOINTS);
+        return J288_ERR_BAD_CONFIG;
+    }
+    if (cfg->nbuses == 0u && (r->opt.port == NULL || r->opt.port[0] == '\0')) {
+        set_err(r, "the config names no bus and no port was given");
+        return J288_ERR_BAD_CONFIG;
+    }
+    for (i = 0; i < cfg->nbuses; i++) {
+        for (k = 0; k < i; k++) {
+            if (strcmp(cfg->bus[i].name, cfg->bus[k].name) == 0) {
+                set_err(r, "bus '%s' is named twice", cfg->bus[i].name);
+                return J288_ERR_BAD_CONFIG;
+            }
+            if (strcmp(cfg->bus[i].port, cfg->bus[k].port) == 0) {
+                set_err(r, "buses '%s' and '%s' are both on %s", cfg->bus[k].name,
+                        cfg->bus[i].name, cfg->bus[i].port);
+                return J288_ERR_BAD_CONFIG;
+            }
+        }
+    }
+    for (i = 0; i < cfg->njoints; i++) {
+        const j288_robot_config_joint_t *a = &cfg->joint[i];
+        int bi = (cfg->nbuses == 0u) ? 0 : a->bus;
+        if (bi < 0 || (cfg->nbuses != 0u && (size_t)bi >= cfg->nbuses)) {
+            set_err(r, "joint '%s' names no bus of the config", a->name);
+            return J288_ERR_BAD_CONFIG;
+        }
+        if (a->id >= J288_MAX_SERVOS) {
+            set_err(r, "joint '%s': id %u is not 0-14", a->name, (unsigned)a->id);
+            return J288_ERR_BAD_CONFIG;
+        }
+        for (k = 0; k < i; k++) {
+            const j288_robot_config_joint_t *b = &cfg->joint[k];
+            int bk = (cfg->nbuses == 0u) ? 0 : b->bus;
+            if (strcmp(a->name, b->name) == 0) {
+                set_err(r, "joint '%s' is named twice", a->name);
+                return J288_ERR_BAD_CONFIG;
+            }
+            if (bk == bi && a->id == b->id) {
+                set_err(r, "joints '%s' and '%s' both use id %u on one bus", b->name, a->name,
+                        (unsigned)a->id);
+                return J288_ERR_BAD_CONFIG;
+            }
+        }
+    }
+    return J288_OK;
+}
+
+/* Two names for one device (a symlink and its target) would open it twice: the second open
+ * would fail as "in use" by this very process, which says less than this. Checked before
+ * opening bus i; a path that cannot be examined is left to the open to report. */
+static int check_same_device(j288_robot_t *r, unsigned i, const char *port)
+{
+    struct stat si, sk;
+    unsigned k;
+    if (stat(port, &si) != 0)
+        return J288_OK;
+    for (k = 0; k < i; k++) {
+        if (fstat(r->bus[k].lp.fd, &sk) == 0 && si.st_rdev == sk.st_rdev &&
+            si.st_ino == sk.st_ino && si.st_dev == sk.st_dev) {
+            set_err(r, "buses '%s' and '%s' are the same device", r->bus[k].name,
+                    r->bus[i].name);
+            return J288_ERR_BAD_CONFIG;
+        }
+    }
+    return J288_OK;
+}
+
+static int open_bus(j288_robot_t *r, unsigned i, const char *name, const char *port,
+                    const j288_robot_config_bus_t *cb)
+{
+    j288_robot_bus_t *b = &r->bus[i];
+    j288_linux_options_t lo;
+    j288_sched_config_t sc;
+    uint32_t baud = r->opt.baud;
+    int rc;
+    unsigned id;
+
+    memset(&lo, 0, sizeof lo);
+    lo.margin_us = r->opt.margin_us;
+    lo.no_low_latency = r->opt.no_low_latency;
+    if (cb != NULL) {
+        if (cb->has_baud)
+            baud = cb->baud;
+        if (cb->has_margin_us)
+            lo.margin_us = cb->margin_us;
+        if (cb->has_echo)
+            lo.echo = cb->echo;
+    }
+    b->robot = r;
+    b->index = i;
+    (void)snprintf(b->name, sizeof b->name, "%s", name);
+    for (id = 0; id < J288_MAX_SERVOS; id++)
+        b->joint_of[id] = -1;
+    rc = check_same_device(r, i, port);
+    if (rc != J288_OK)
+        return rc;
+    rc = j288_linux_open(&b->lp, port, baud, &lo);
+    if (rc != J288_OK) {
+        set_err(r, "bus '%s': %s", name, j288_linux_error(&b->lp));
+        return rc;
+    }
+    b->open = true;
+    b->stats.up = true;
+    rc = j288_linux_bus_init(&b->lp, &b->bus, NULL);
+    if (rc == J288_OK) {
+        memset(&sc, 0, sizeof sc);
+        sc.on_event = on_servo_event;
+        sc.on_sweep = on_sweep;
+        sc.on_reply = on_reply;
+        sc.user = b;
+        rc = j288_sched_init(&b->sched, &b->bus, &sc);
+    }
+    if (rc == J288_OK)
+        rc = j288_joint_bus_init(&b->jb, &b->sched, on_joint_event, b);
+    if (rc != J288_OK)
+        set_err(r, "bus '%s': %s", name, j288_strerror(rc));
+    return rc;
+}
+
+static int add_joint(j288_robot_t *r, const j288_robot_config_joint_t *cj, unsigned bi)
+{
+    j288_robot_bus_t *b = &r->bus[bi];
+    unsigned j = r->njoints;
+    j288_joint_config_t jc;
+    int rc;
+    joint_config_from(cj, &jc);
+    rc = j288_joint_init(&r->joint[j], &jc);
+    if (rc == J288_OK)
+        rc = j288_joint_bus_add(&b->jb, &r->joint[j]);
+    if (rc == J288_OK)
+        rc = j288_sched_enable(&b->sched, cj->id, true);
+    if (rc != J288_OK) {
+        set_err(r, "joint '%s': %s", cj->name, j288_strerror(rc));
+        return (rc == J288_ERR_NULL) ? rc : J288_ERR_BAD_CONFIG;
+    }
+    b->joint_of[cj->id] = (int)j;
+    r->joint_bus[j] = bi;
+    (void)snprintf(r->joint_name[j], sizeof r->joint_name[j], "%s", cj->name);
+    r->njoints++;
+    return J288_OK;
+}
+
+static void close_buses(j288_robot_t *r)
+{
+    unsigned i;
+    for (i = 0; i < J288_ROBOT_MAX_BUSES; i++) {
+        if (r->bus[i].open)
+            j288_linux_close(&r->bus[i].lp);
+        r->bus[i].open = false;
+    }
+}
+
+int j288_robot_open(j288_robot_t *r, const j288_robot_config_t *cfg,
+                    const j288_robot_options_t *opt)
+{
+    size_t i;
+    int rc;
+    if (r == NULL)
+        return J288_ERR_NULL;
+    reset_robot(r, opt);
+    if (cfg == NULL) {
+        set_err(r, "no config");
+        return J288_ERR_NULL;
+    }
+    rc = check_config(r, cfg);
+    if (rc != J288_OK)
+        return rc;
+    if (cfg->nbuses == 0u) {
+        rc = open_bus(r, 0, "bus", r->opt.port, NULL);
+        r->nbuses = 1;
+    }
+    for (i = 0; rc == J288_OK && i < cfg->nbuses; i++) {
+        rc = open_bus(r, (unsigned)i, cfg->bus[i].name, cfg->bus[i].port, &cfg->bus[i]);
+        r->nbuses = (unsigned)i + 1u;
+    }
+    for (i = 0; rc == J288_OK && i < cfg->njoints; i++)
+        rc = add_joint(r, &cfg->joint[i], (cfg->nbuses == 0u) ? 0u : (unsigned)cfg->joint[i].bus);
+    if (rc != J288_OK) {
+        close_buses(r);
+        r->nbuses = 0;
+        r->njoints = 0;
+    }
+    return rc;
+}
+
+int j288_robot_open_file(j288_robot_t *r, const char *path, const j288_robot_options_t *opt)
+{
+    j288_robot_config_t cfg;
+    char err[J288_ROBOT_CONFIG_ERROR_MAX];
+    if (r == NULL)
+        return J288_ERR_NULL;
+    if (path == NULL) {
+        reset_robot(r, opt);
+        set_err(r, "no config file");
+        return J288_ERR_NULL;
+    }
+    if (j288_robot_config_load(path, &cfg, err, sizeof err) != 0) {
+        reset_robot(r, opt);
+        set_err(r, "%s", err);
+        return J288_ERR_BAD_CONFIG;
+    }
+    return j288_robot_open(r, &cfg, opt);
+}
+
+int j288_robot_open_port(j288_robot_t *r, const char *port, const j288_robot_options_t *opt)
+{
+    j288_robot_options_t o;
+    static const j288_robot_config_t empty; /* zero buses, zero joints */
+    if (r == NULL)
+        return J288_ERR_NULL;
+    if (opt != NULL)
+        o = *opt;
+    else
+        memset(&o, 0, sizeof o);
+    o.port = port;
+    if (port == NULL || port[0] == '\0') {
+        reset_robot(r, &o);
+        set_err(r, "no port given");
+        return J288_ERR_NULL;
+    }
+    return j288_robot_open(r, &empty, &o);
+}
+
+void j288_robot_close(j288_robot_t *r)
+{
+    if (r == NULL)
+        return;
+    if (r->driven)
+        (void)j288_robot_stop(r);
+    close_buses(r);
+}
+
+void j288_robot_set_stop_flag(j288_robot_t *r, const volatile sig_atomic_t *flag)
+{
+    if (r != NULL)
+        r->stop_flag = flag;
+}
+
+/* ---- the loop -------------------------------------------------------------------------------- */
+
+static bool stop_requested(const j288_robot_t *r)
+{
+    return r->stop_flag != NULL && *r->stop_flag != 0;
+}
+
+/* Poll every bus; report and leave out a bus whose device vanished. */
+static void poll_all(j288_robot_t *r, uint32_t now)
+{
+    unsigned i;
+    for (i = 0; i < r->nbuses; i++) {
+        j288_robot_bus_t *b = &r->bus[i];
+        if (!bus_live(b))
+            continue;
+        j288_sched_poll(&b->sched, now);
+        if (j288_linux_offline(&b->lp)) {
+            b->stats.gone = true;
+            b->stats.up = false;
+            set_err(r, "bus '%s': %s", b->name, j288_linux_error(&b->lp));
+            emit_bus(r, J288_ROBOT_EV_BUS_GONE, i);
+        }
+    }
+}
+
+static bool bus_pending(const j288_robot_bus_t *b)
+{
+    return j288_sched_busy(&b->sched) || !j288_bus_is_idle(&b->bus);
+}
+
+/* Sleep in one ppoll over every live bus until bytes come, a bus's timer is due, or
+ * until_us; then let each ready port read its device. */
+static void wait_all(j288_robot_t *r, uint32_t now, uint32_t until_us)
+{
+    struct pollfd pfd[J288_ROBOT_MAX_BUSES];
+    unsigned who[J288_ROBOT_MAX_BUSES];
+    nfds_t n = 0;
+    int32_t left = us_until(until_us, now);
+    struct timespec ts;
+    unsigned i;
+    int rc;
+
+    if (left < 0)
+        left = 0;
+    for (i = 0; i < r->nbuses; i++) {
+        j288_robot_bus_t *b = &r->bus[i];
+        if (!bus_live(b))
+            continue;
+        if (bus_pending(b)) {
+            if (left > (int32_t)SLICE_US)
+                left = (int32_t)SLICE_US;
+            if (b->lp.timer_armed && us_until(b->lp.timer_us, now) < left)
+                left = us_until(b->lp.timer_us, now);
+        }
+        pfd[n].fd = b->lp.fd;
+        pfd[n].events = POLLIN;
+        pfd[n].revents = 0;
+        who[n] = i;
+        n++;
+    }
+    if (r->stop_flag != NULL && left > (int32_t)STOP_SLICE_US)
+        left = (int32_t)STOP_SLICE_US;
+    if (left < 0)
+        left = 0;
+    ts.tv_sec = (time_t)((uint32_t)left / 1000000u);
+    ts.tv_nsec = (long)((uint32_t)left % 1000000u) * 1000L;
+    rc = ppoll(pfd, n, &ts, NULL);
+    if (rc <= 0)
+        return; /* timeout, or a signal: the caller looks at its flags */
+    for (i = 0; i < (unsigned)n; i++) {
+        if (pfd[i].revents != 0) {
+            j288_linux_t *lp = &r->bus[who[i]].lp;
+            /* A deadline of now: the port reads what is there (or finds the device gone). */
+            (void)j288_linux_port.wait(lp, j288_linux_now_us());
+        }
+    }
+}
+
+/* The cycle is over when no bus that is up has a sweep running. */
+static bool cycle_done(const j288_robot_t *r)
+{
+    unsigned i;
+    for (i = 0; i < r->nbuses; i++) {
+        const j288_robot_bus_t *b = &r->bus[i];
+        if (bus_live(b) && b->stats.up && bus_pending(b))
+            return false;
+    }
+    return true;
+}
+
+static bool any_live(const j288_robot_t *r)
+{
+    unsigned i;
+    for (i = 0; i < r->nbuses; i++) {
+        if (bus_live(&r->bus[i]))
+            return true;
+    }
+    return false;
+}
+
+static void start_sweeps(j288_robot_t *r, uint32_t now)
+{
+    unsigned i;
+    for (i = 0; i < r->nbuses; i++) {
+        j288_robot_bus_t *b = &r->bus[i];
+        /* A down bus still sweeping from an earlier cycle goes on in the background. */
+        if (!bus_live(b) || j288_sched_busy(&b->sched))
+            continue;
+        b->swept_ok = false;
+        b->sweep_start_us = now;
+        (void)j288_sched_start_sweep(&b->sched, now);
+    }
+}
+
+static void finish_cycle(j288_robot_t *r, uint32_t start, j288_robot_cycle_t *info)
+{
+    unsigned j, fresh = 0;
+    uint32_t took = j288_linux_now_us() - start;
+    for (j = 0; j < r->njoints; j++) {
+        if (r->fresh_at[j] == r->cycle) {
+            fresh++;
+            r->jstats[j].fresh_cycles++;
+        } else {
+            r->jstats[j].stale_cycles++;
+        }
+    }
+    r->stats.cycles++;
+    if (fresh == r->njoints)
+        r->stats.complete_cycles++;
+    r->stats.last_cycle_us = took;
+    if (took > r->stats.worst_cycle_us)
+        r->stats.worst_cycle_us = took;
+    info->cycle = r->stats.cycles;
+    info->start_us = start;
+    info->duration_us = took;
+    info->fresh = fresh;
+    info->joints = r->njoints;
+    info->complete = fresh == r->njoints;
+    r->cycle++;
+    if (r->opt.on_cycle != NULL)
+        r->opt.on_cycle(r->opt.user, r, info);
+}
+
+int j288_robot_cycle(j288_robot_t *r, uint32_t timeout_us, j288_robot_cycle_t *info)
+{
+    j288_robot_cycle_t local;
+    uint32_t start, until;
+    if (r == NULL)
+        return J288_ERR_NULL;
+    if (info == NULL)
+        info = &local;
+    memset(info, 0, sizeof *info);
+    if (!any_live(r)) {
+        set_err(r, "every bus is gone");
+        return J288_ERR_OFFLINE;
+    }
+    if (timeout_us == 0u)
+        timeout_us = J288_ROBOT_DEFAULT_CYCLE_TIMEOUT_US;
+    start = j288_linux_now_us();
+    until = start + timeout_us;
+    start_sweeps(r, start);
+    for (;;) {
+        uint32_t now = j288_linux_now_us();
+        poll_all(r, now);
+        if (stop_requested(r)) {
+            (void)j288_robot_stop(r);
+            return J288_ERR_ABORTED;
+        }
+        if (cycle_done(r) || us_until(until, now) <= 0)
+            break;
+        wait_all(r, now, until);
+    }
+    finish_cycle(r, start, info);
+    if (!any_live(r))
+        return J288_ERR_OFFLINE;
+    return info->complete ? J288_OK : J288_ERR_TIMEOUT;
+}
+
+/* Sleep until t (a cycle's start), still serving buses that sweep in the background. */
+static int wait_until(j288_robot_t *r, uint32_t t)
+{
+    for (;;) {
+        uint32_t now = j288_linux_now_us();
+        poll_all(r, now);
+        if (stop_requested(r))
+            return J288_ERR_ABORTED;
+        if (us_until(t, now) <= 0)
+            return J288_OK;
+        wait_all(r, now, t);
+    }
+}
+
+int j288_robot_run(j288_robot_t *r, uint32_t period_us, uint32_t ncycles, uint32_t duration_us)
+{
+    uint32_t t0, next, done = 0;
+    if (r == NULL)
+        return J288_ERR_NULL;
+    t0 = j288_linux_now_us();
+    next = t0;
+    for (;;) {
+        uint32_t now;
+        int rc;
+        if (ncycles != 0u && done >= ncycles)
+            return J288_OK;
+        if (period_us != 0u) {
+            if (wait_until(r, next) != J288_OK) {
+                (void)j288_robot_stop(r);
+                return J288_ERR_ABORTED;
+            }
+            now = j288_linux_now_us();
+            next += period_us;
+            if (us_until(next, now) < 0)
+                next = now; /* late: start at once, do not catch up */
+        }
+        now = j288_linux_now_us();
+        if (duration_us != 0u && now - t0 >= duration_us)
+            return J288_OK;
+        rc = j288_robot_cycle(r, 0, NULL);
+        if (rc == J288_ERR_ABORTED || rc == J288_ERR_OFFLINE || rc == J288_ERR_NULL)
+            return rc;
+        done++;
+    }
+}
+
+/* How long the stop frames may take: the transaction in flight ends by its deadline, the
+ * guard after a failure lasts one reply budget, and a stop frame whose transmit fails is
+ * re-sent (J288_ESTOP_ATTEMPTS in all), so a bus with a long margin needs longer. */
+static uint32_t stop_bound_us(const j288_robot_t *r)
+{
+    uint32_t bound = J288_ROBOT_STOP_TIMEOUT_US;
+    unsigned i;
+    for (i = 0; i < r->nbuses; i++) {
+        if (bus_live(&r->bus[i])) {
+            uint64_t b = (uint64_t)j288_bus_reply_budget_us(&r->bus[i].bus) *
+                             (J288_ESTOP_ATTEMPTS + 2u) + J288_ROBOT_STOP_TIMEOUT_US;
+            if (b > 60000000u)
+                b = 60000000u;
+            if (b > bound)
+                bound = (uint32_t)b;
+        }
+    }
+    return bound;
+}
+
+int j288_robot_stop(j288_robot_t *r)
+{
+    uint32_t start, now, bound;
+    unsigned i;
+    int rc = J288_OK;
+    if (r == NULL)
+        return J288_ERR_NULL;
+    start = j288_linux_now_us();
+    bound = stop_bound_us(r);
+    for (i = 0; i < r->nbuses; i++) {
+        if (bus_live(&r->bus[i]))
+            (void)j288_sched_estop(&r->bus[i].sched, start);
+        else if (r->bus[i].open)
+            rc = J288_ERR_OFFLINE;
+    }
+    r->driven = false;
+    for (;;) {
+        bool pending = false;
+        now = j288_linux_now_us();
+        for (i = 0; i < r->nbuses; i++) {
+            j288_robot_bus_t *b = &r->bus[i];
+            if (!bus_live(b))
+                continue;
+            j288_bus_poll(&b->bus, now);
+            if (j288_linux_offline(&b->lp)) {
+                b->stats.gone = true;
+                rc = J288_ERR_OFFLINE;
+                continue;
+            }
+            if (!j288_bus_is_idle(&b->bus))
+                pending = true;
+        }
+        if (!pending)
+            return rc;
+        if (now - start >= bound) {
+            set_err(r, "the stop frames did not go out within %u ms", (unsigned)(bound / 1000u));
+            return J288_ERR_TIMEOUT;
+        }
+        wait_all(r, now, start + bound);
+    }
+}
+
+/* ---- joints ---------------------------------------------------------------------------------- */
+
+unsigned j288_robot_njoints(const j288_robot_t *r) { return (r == NULL) ? 0u : r->njoints; }
+unsigned j288_robot_nbuses(const j288_robot_t *r) { return (r == NULL) ? 0u : r->nbuses; }
+
+int j288_robot_find_joint(const j288_robot_t *r, const char *name)
+{
+    unsigned j;
+    if (r == NULL || name == NULL)
+        return -1;
+    for (j = 0; j < r->njoints; j++) {
+        if (strcmp(r->joint_name[j], name) == 0)
+            return (int)j;
+    }
+    return -1;
+}
+
+const char *j288_robot_joint_name(const j288_robot_t *r, unsigned joint)
+{
+    return (r == NULL || joint >= r->njoints) ? "" : r->joint_name[joint];
+}
+
+const char *j288_robot_bus_name(const j288_robot_t *r, unsigned bus)
+{
+    return (r == NULL || bus >= r->nbuses) ? "" : r->bus[bus].name;
+}
+
+int j288_robot_joint_bus(const j288_robot_t *r, unsigned joint)
+{
+    return (r == NULL || joint >= r->njoints) ? -1 : (int)r->joint_bus[joint];
+}
+
+int j288_robot_joint_id(const j288_robot_t *r, unsigned joint)
+{
+    return (r == NULL || joint >= r->njoints) ? -1 : (int)r->joint[joint].cfg.id;
+}
+
+int j288_robot_read(const j288_robot_t *r, unsigned joint, j288_robot_state_t *st)
+{
+    const j288_joint_state_t *js;
+    const j288_slot_t *slot;
+    const j288_robot_bus_t *b;
+    if (r == NULL || st == NULL)
+        return J288_ERR_NULL;
+    if (joint >= r->njoints)
+        return J288_ERR_BAD_ARG;
+    b = &r->bus[r->joint_bus[joint]];
+    js = j288_joint_state(&r->joint[joint]);
+    slot = j288_sched_slot(&b->sched, r->joint[joint].cfg.id);
+    memset(st, 0, sizeof *st);
+    st->known = js->known;
+    st->online = slot->online && bus_live(b);
+    st->fresh = r->fresh_at[joint] != 0u && r->fresh_at[joint] + 1u == r->cycle;
+    st->pos = js->known ? (double)js->pos : 0.0;
+    st->speed = (double)js->speed;
+    st->torque = (double)js->torque;
+    if (slot->has_reply) {
+        st->faults = slot->reply.faults;
+        st->warnings = slot->reply.warnings;
+        st->case_temp_c = (double)slot->reply.case_temp_c;
+        st->winding_temp_c = (double)slot->reply.winding_temp_c;
+        st->voltage_v = (double)slot->reply.voltage_raw * 0.5;
+    }
+    return J288_OK;
+}
+
+int j288_robot_read_all(const j288_robot_t *r, size_t n, double *pos, double *speed,
+                        double *torque, uint8_t *known)
+{
+    unsigned j;
+    if (r == NULL)
+        return J288_ERR_NULL;
+    if (n < r->njoints)
+        return J288_ERR_BAD_ARG;
+    for (j = 0; j < r->njoints; j++) {
+        const j288_joint_state_t *js = j288_joint_state(&r->joint[j]);
+        if (pos != NULL)
+            pos[j] = js->known ? (double)js->pos : 0.0;
+        if (speed != NULL)
+            speed[j] = (double)js->speed;
+        if (torque != NULL)
+            torque[j] = (double)js->torque;
+        if (known != NULL)
+            known[j] = js->known ? 1u : 0u;
+    }
+    return J288_OK;
+}
+
+static int target_check(const j288_robot_t *r, unsigned joint)
+{
+    if (joint >= r->njoints)
+        return J288_ERR_BAD_ARG;
+    if (!bus_live(&r->bus[r->joint_bus[joint]]))
+        return J288_ERR_OFFLINE;
+    return J288_OK;
+}
+
+static void to_joint_target(const j288_robot_target_t *t, j288_joint_target_t *jt)
+{
+    jt->pos = (j288_real_t)t->pos;
+    jt->speed = (j288_real_t)t->speed;
+    jt->torque = (j288_real_t)t->torque;
+    jt->kp = (j288_real_t)t->kp;
+    jt->kd = (j288_real_t)t->kd;
+}
+
+int j288_robot_set_target(j288_robot_t *r, unsigned joint, const j288_robot_target_t *t)
+{
+    j288_joint_target_t jt;
+    int rc;
+    if (r == NULL || t == NULL)
+        return J288_ERR_NULL;
+    rc = target_check(r, joint);
+    if (rc != J288_OK)
+        return rc;
+    to_joint_target(t, &jt);
+    rc = j288_joint_bus_set_target(&r->bus[r->joint_bus[joint]].jb, &r->joint[joint], &jt, NULL);
+    if (rc == J288_OK)
+        r->driven = true;
+    return rc;
+}
+
+int j288_robot_set_targets(j288_robot_t *r, size_t n, const double *pos, const double *speed,
+                           const double *torque, const double *kp, const double *kd,
+                           unsigned *bad)
+{
+    j288_cmd_raw_t cmd[J288_ROBOT_MAX_JOINTS];
+    unsigned j;
+    int rc;
+    if (r == NULL || pos == NULL)
+        return J288_ERR_NULL;
+    if (n < r->njoints)
+        return J288_ERR_BAD_ARG;
+    /* Every command is built (and so checked) before any slot changes. */
+    for (j = 0; j < r->njoints; j++) {
+        j288_joint_target_t jt;
+        j288_joint_target_init(&r->joint[j], &jt);
+        jt.pos = (j288_real_t)pos[j];
+        jt.speed = (speed != NULL) ? (j288_real_t)speed[j] : (j288_real_t)0;
+        jt.torque = (torque != NULL) ? (j288_real_t)torque[j] : (j288_real_t)0;
+        if (kp != NULL)
+            jt.kp = (j288_real_t)kp[j];
+        if (kd != NULL)
+            jt.kd = (j288_real_t)kd[j];
+        rc = target_check(r, j);
+        if (rc == J288_OK)
+            rc = j288_joint_command(&r->joint[j], &jt, &cmd[j], NULL);
+        if (rc != J288_OK) {
+            if (bad != NULL)
+                *bad = j;
+            return rc;
+        }
+    }
+    for (j = 0; j < r->njoints; j++)
+        (void)j288_sched_set_cmd(&r->bus[r->joint_bus[j]].sched, &cmd[j]);
+    r->driven = true;
+    return J288_OK;
+}
+
+int j288_robot_hold(j288_robot_t *r, unsigned joint)
+{
+    j288_joint_target_t jt;
+    int rc;
+    if (r == NULL)
+        return J288_ERR_NULL;
+    rc = target_check(r, joint);
+    if (rc != J288_OK)
+        return rc;
+    if (!j288_joint_state(&r->joint[joint])->known)
+        return J288_ERR_ANGLE_UNKNOWN;
+    j288_joint_target_init(&r->joint[joint], &jt);
+    rc = j288_joint_bus_set_target(&r->bus[r->joint_bus[joint]].jb, &r->joint[joint], &jt, NULL);
+    if (rc == J288_OK)
+        r->driven = true;
+    return rc;
+}
+
+int j288_robot_lock(j288_robot_t *r, unsigned joint)
+{
+    if (r == NULL)
+        return J288_ERR_NULL;
+    if (joint >= r->njoints)
+        return J288_ERR_BAD_ARG;
+    return j288_joint_bus_lock(&r->bus[r->joint_bus[joint]].jb, &r->joint[joint]);
+}
+
+/* ---- statistics ------------------------------------------------------------------------------ */
+
+int j288_robot_stats(const j288_robot_t *r, j288_robot_stats_t *out)
+{
+    if (r == NULL || out == NULL)
+        return J288_ERR_NULL;
+    *out = r->stats;
+    return J288_OK;
+}
+
+int j288_robot_bus_stats(const j288_robot_t *r, unsigned bus, j288_robot_bus_stats_t *out)
+{
+    if (r == NULL || out == NULL)
+        return J288_ERR_NULL;
+    if (bus >= r->nbuses)
+        return J288_ERR_BAD_ARG;
+    *out = r->bus[bus].stats;
+    return J288_OK;
+}
+
+const j288_bus_stats_t *j288_robot_bus_wire_stats(const j288_robot_t *r, unsigned bus)
+{
+    if (r == NULL || bus >= r->nbuses)
+        return NULL;
+    return j288_bus_stats(&r->bus[bus].bus);
+}
+
+int j288_robot_joint_stats(const j288_robot_t *r, unsigned joint, j288_robot_joint_stats_t *out)
+{
+    const j288_slot_t *slot;
+    if (r == NULL || out == NULL)
+        return J288_ERR_NULL;
+    if (joint >= r->njoints)
+        return J288_ERR_BAD_ARG;
+    *out = r->jstats[joint];
+    slot = j288_sched_slot(&r->bus[r->joint_bus[joint]].sched, r->joint[joint].cfg.id);
+    out->servo = slot->stats;
+    return J288_OK;
+}
+
+/* ---- servo level ----------------------------------------------------------------------------- */
+
+static void servo_from_reply(const j288_txn_t *txn, j288_robot_servo_t *out)
+{
+    j288_reply_si_t si;
+    memset(out, 0, sizeof *out);
+    (void)j288_reply_to_si(&txn->reply, J288_SIDE_OUTPUT, &si);
+    out->id = si.id;
+    out->mode = si.status;
+    out->watchdog_tripped = si.watchdog_tripped;
+    out->pos = (double)si.pos;
+    out->speed = (double)si.speed;
+    out->torque = (double)si.torque;
+    out->out_pos = (double)si.out_pos;
+    out->case_temp_c = (double)si.case_temp_c;
+    out->winding_temp_c = (double)si.winding_temp_c;
+    out->voltage_v = (double)si.voltage_v;
+    out->faults = si.faults;
+    out->warnings = si.warnings;
+    out->latency_us = txn->latency_us;
+}
+
+int j288_robot_exchange(j288_robot_t *r, unsigned bus, uint8_t id, const j288_robot_target_t *foc,
+                        j288_robot_servo_t *out)
+{
+    j288_cmd_raw_t cmd;
+    j288_txn_t txn;
+    j288_robot_bus_t *b;
+    int rc;
+    if (r == NULL)
+        return J288_ERR_NULL;
+    if (bus >= r->nbuses)
+        return J288_ERR_BAD_ARG;
+    if (id >= J288_MAX_SERVOS)
+        return J288_ERR_BAD_ID;
+    b = &r->bus[bus];
+    if (!bus_live(b))
+        return J288_ERR_OFFLINE;
+    if (j288_sched_busy(&b->sched))
+        return J288_ERR_BUSY;
+    memset(&cmd, 0, sizeof cmd);
+    cmd.id = id;
+    cmd.status = J288_MODE_LOCK;
+    cmd.watchdog = true;
+    if (foc != NULL) {
+        j288_cmd_si_t si;
+        memset(&si, 0, sizeof si);
+        si.id = id;
+        si.status = J288_MODE_FOC;
+        si.watchdog = true;
+        si.pos = (j288_real_t)foc->pos;
+        si.speed = (j288_real_t)foc->speed;
+        si.tau = (j288_real_t)foc->torque;
+        si.kp = (j288_real_t)foc->kp;
+        si.kd = (j288_real_t)foc->kd;
+        rc = j288_cmd_from_si(&si, J288_SIDE_OUTPUT, &cmd);
+        if (rc != J288_OK)
+            return rc;
+    }
+    rc = j288_bus_transfer_blocking(&b->bus, &cmd, &txn);
+    if (j288_linux_offline(&b->lp) && !b->stats.gone) {
+        b->stats.gone = true;
+        b->stats.up = false;
+        set_err(r, "bus '%s': %s", b->name, j288_linux_error(&b->lp));
+        emit_bus(r, J288_ROBOT_EV_BUS_GONE, bus);
+        return J288_ERR_OFFLINE;
+    }
+    if (rc == J288_OK) {
+        if (foc != NULL)
+            r->driven = true;
+        if (out != NULL)
+            servo_from_reply(&txn, out);
+    }
+    return rc;
+}
+
+const char *j288_robot_error(const j288_robot_t *r) { return (r == NULL) ? "no robot" : r->err; }

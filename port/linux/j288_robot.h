@@ -1,0 +1,319 @@
+/*
+ * j288_robot.h - several buses from one loop: the joints of a robot config, one thread, one
+ * ppoll() over every bus's device.
+ *
+ * A cycle starts a scheduler sweep on every bus at once and completes whichever bus answers
+ * first; it ends when every bus that answers has finished its sweep, and calls on_cycle once,
+ * with how many joints got fresh state in it. Between cycles the application sets joint
+ * targets (joint frame, SI units) for the next one, from on_cycle or after j288_robot_cycle().
+ *
+ * Buses that fail do not stop the others:
+ * - a bus whose sweeps get no reply at all down_after times in a row is "down"
+ *   (J288_ROBOT_EV_BUS_DOWN): cycles stop waiting for it; it keeps being swept in the
+ *   background, and the first reply brings it back (J288_ROBOT_EV_BUS_UP). Its joints are not
+ *   fresh meanwhile, so those cycles are incomplete.
+ * - a bus whose device vanishes (adapter unplugged, simulator gone) is reported once
+ *   (J288_ROBOT_EV_BUS_GONE, with the port's message in j288_robot_error()) and left out from
+ *   then on. Only when every bus is gone does a cycle fail (J288_ERR_OFFLINE).
+ * Nothing waits without a bound: every transaction ends by its reply deadline (the bus's
+ * margin_us), and a cycle by its timeout.
+ *
+ * Safe stop: j288_robot_stop() sends the broadcast lock on every bus still there (after the
+ * transaction in flight) and waits, bounded, until the stop frames are out; every joint's
+ * slot is left at lock, so a later cycle does not resume motion. j288_robot_run() and
+ * j288_robot_cycle() do it themselves when the stop flag (j288_robot_set_stop_flag(), e.g.
+ * set by a SIGINT handler installed without SA_RESTART) becomes non-zero, then return
+ * J288_ERR_ABORTED. j288_robot_close() stops first if any target was sent since the last stop.
+ *
+ * Joints: each joint of the config becomes a j288_joint_t (lib/joint.h) bound to its bus's
+ * scheduler, in the config's order (joint index 0 .. njoints-1). A joint's angle is unknown
+ * until its first replies (joint.h); until then targets are refused (J288_ERR_ANGLE_UNKNOWN)
+ * and the joint is held at lock.
+ *
+ * Bad input (J288_ERR_BAD_CONFIG with a message in j288_robot_error()): no bus, a bus
+ * named twice, two buses on the same device, a joint on a bus that does not exist, an id
+ * used twice on one bus, a joint the joint layer refuses. A device that cannot be opened:
+ * j288_linux_open()'s code and message. Nothing stays open after a failed open.
+ *
+ * Objects are caller-allocated (j288_robot_sizeof() for foreign callers), hold no heap memory
+ * and must not move while open. One thread owns a robot; nothing here is ISR- or
+ * signal-safe but the stop flag. Results are the library's codes (j288/error.h).
+ */
+#ifndef J288_ROBOT_H
+#define J288_ROBOT_H
+
+#include <signal.h>
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "j288/j288.h"
+#include "j288_linux.h"
+#include "j288_robot_config.h"
+
+#if !J288_CONFIG_SI
+#error "the multi-bus runner needs the SI-unit API (J288_CONFIG_SI=1): it drives joints"
+#endif
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define J288_ROBOT_MAX_BUSES 8u
+#define J288_ROBOT_MAX_JOINTS 64u
+#define J288_ROBOT_DEFAULT_DOWN_AFTER 3u         /* empty sweeps before a bus is down */
+#define J288_ROBOT_DEFAULT_CYCLE_TIMEOUT_US 1000000u
+#define J288_ROBOT_STOP_TIMEOUT_US 200000u       /* bound on flushing the stop frames, beyond
+                                                    the buses' own reply budgets */
+#define J288_ROBOT_MSG_LEN 512u
+
+typedef enum {
+    J288_ROBOT_EV_SERVO = 0, /* a scheduler event on a joint's servo: servo_ev */
+    J288_ROBOT_EV_JOINT,     /* a joint-layer event: joint_kind, value */
+    J288_ROBOT_EV_BUS_DOWN,  /* no reply in down_after sweeps: cycles go on without it */
+    J288_ROBOT_EV_BUS_UP,    /* a down bus answers again */
+    J288_ROBOT_EV_BUS_GONE   /* its device vanished: left out from now on */
+} j288_robot_event_kind_t;
+
+typedef struct {
+    j288_robot_event_kind_t kind;
+    unsigned bus;        /* bus index */
+    int joint;           /* joint index, or -1 (bus events, a servo that is no joint) */
+    uint8_t id;          /* servo id (SERVO, JOINT) */
+    j288_event_t servo_ev;                /* SERVO: the scheduler's event */
+    j288_joint_event_kind_t joint_kind;   /* JOINT */
+    double value;                         /* JOINT: see joint.h */
+} j288_robot_event_t;
+
+/* What on_cycle is told. */
+typedef struct {
+    uint32_t cycle;       /* cycles completed, this one included */
+    uint32_t start_us;    /* j288_linux_now_us() clock */
+    uint32_t duration_us;
+    unsigned fresh;       /* joints with a new reply in this cycle */
+    unsigned joints;      /* joints in all */
+    bool complete;        /* fresh == joints */
+} j288_robot_cycle_t;
+
+typedef struct j288_robot j288_robot_t;
+typedef void (*j288_robot_event_fn)(void *user, const j288_robot_event_t *ev);
+typedef void (*j288_robot_cycle_fn)(void *user, j288_robot_t *r, const j288_robot_cycle_t *c);
+
+/* All-zero means defaults. */
+typedef struct {
+    const char *port;      /* the device when the config has no buses (NULL: then an error) */
+    uint32_t baud;         /* for buses that give none; 0: 6000000 */
+    uint32_t margin_us;    /* reply margin for buses that give none; 0: 20 ms (USB) */
+    uint8_t down_after;    /* 0: J288_ROBOT_DEFAULT_DOWN_AFTER */
+    bool no_low_latency;   /* as j288_linux_options_t */
+    j288_robot_event_fn on_event; /* may be NULL */
+    j288_robot_cycle_fn on_cycle; /* may be NULL; called at the end of every cycle */
+    void *user;
+} j288_robot_options_t;
+
+typedef struct {
+    uint32_t sweeps;          /* sweeps completed */
+    uint32_t empty_sweeps;    /* of them, with no good reply */
+    uint32_t down_events;     /* times it went down */
+    uint32_t last_sweep_us;   /* duration of the latest sweep */
+    uint32_t worst_sweep_us;
+    bool up;                  /* cycles wait for it */
+    bool gone;                /* its device vanished */
+} j288_robot_bus_stats_t;
+
+typedef struct {
+    uint32_t fresh_cycles;    /* cycles in which this joint got a reply */
+    uint32_t stale_cycles;    /* cycles in which it did not */
+    j288_slot_stats_t servo;  /* the scheduler's statistics of its slot */
+} j288_robot_joint_stats_t;
+
+typedef struct {
+    uint32_t cycles;
+    uint32_t complete_cycles;
+    uint32_t last_cycle_us;
+    uint32_t worst_cycle_us;
+} j288_robot_stats_t;
+
+/* A joint's state (j288_robot_read()): joint frame, SI units. */
+typedef struct {
+    bool known;        /* pos is the absolute joint angle (joint.h) */
+    bool online;       /* its servo answers */
+    bool fresh;        /* a reply came in the latest cycle */
+    double pos;        /* rad (0 while unknown) */
+    double speed;      /* rad/s */
+    double torque;     /* N*m */
+    uint32_t faults;   /* the servo's fault bits (J288_FAULT_*) */
+    uint8_t warnings;
+    double case_temp_c;
+    double winding_temp_c;
+    double voltage_v;
+} j288_robot_state_t;
+
+/* A joint target (joint frame, SI units); see j288_joint_target_t. */
+typedef struct {
+    double pos, speed, torque, kp, kd;
+} j288_robot_target_t;
+
+/* One servo's reply, output side (j288_robot_exchange()). */
+typedef struct {
+    uint8_t id;
+    uint8_t mode;       /* J288_MODE_LOCK or J288_MODE_FOC */
+    bool watchdog_tripped;
+    double pos;         /* rad, output side, from the rotor's multi-turn count */
+    double speed;       /* rad/s, output side */
+    double torque;      /* N*m, output side */
+    double out_pos;     /* rad, output encoder, [0, 2 pi) */
+    double case_temp_c;
+    double winding_temp_c;
+    double voltage_v;
+    uint32_t faults;
+    uint8_t warnings;
+    uint32_t latency_us;
+} j288_robot_servo_t;
+
+typedef struct {
+    j288_linux_t lp;
+    j288_bus_t bus;
+    j288_sched_t sched;
+    j288_joint_bus_t jb;
+    j288_robot_t *robot;
+    unsigned index;
+    char name[J288_ROBOT_CONFIG_NAME_MAX];
+    int joint_of[J288_MAX_SERVOS]; /* joint index per id, or -1 */
+    bool open;
+    bool swept_ok;       /* the sweep in progress had a good reply */
+    uint8_t empty_run;   /* consecutive sweeps without a reply */
+    uint32_t sweep_start_us;
+    j288_robot_bus_stats_t stats;
+} j288_robot_bus_t;
+
+struct j288_robot {
+    /* Private: use the functions below. */
+    j288_robot_options_t opt;
+    unsigned nbuses;
+    unsigned njoints;
+    j288_robot_bus_t bus[J288_ROBOT_MAX_BUSES];
+    j288_joint_t joint[J288_ROBOT_MAX_JOINTS];
+    unsigned joint_bus[J288_ROBOT_MAX_JOINTS];
+    char joint_name[J288_ROBOT_MAX_JOINTS][J288_ROBOT_CONFIG_NAME_MAX];
+    uint32_t fresh_at[J288_ROBOT_MAX_JOINTS]; /* cycle number + 1 of the latest reply */
+    j288_robot_joint_stats_t jstats[J288_ROBOT_MAX_JOINTS];
+    uint32_t cycle;      /* the cycle in progress (cycles completed + 1) */
+    bool driven;         /* a target went out since the last stop */
+    const volatile sig_atomic_t *stop_flag;
+    j288_robot_stats_t stats;
+    char err[J288_ROBOT_MSG_LEN];
+};
+
+/* sizeof(j288_robot_t), for callers that allocate it themselves (ctypes). */
+size_t j288_robot_sizeof(void);
+
+/* The library's version (J288_VERSION_STRING). */
+const char *j288_robot_version(void);
+
+/* Open every bus of cfg (buses in cfg order; a config without buses: opt->port) and set up
+ * its joints (every joint's slot enabled, at lock). Errors: J288_ERR_NULL, J288_ERR_BAD_CONFIG
+ * (see the top), j288_linux_open()'s codes; the message in j288_robot_error(). r need not be
+ * initialised before; after a failure j288_robot_error() stays valid and close is harmless. */
+int j288_robot_open(j288_robot_t *r, const j288_robot_config_t *cfg,
+                    const j288_robot_options_t *opt);
+
+/* The same from a robot config file (j288_robot_config_load(): its message on failure). */
+int j288_robot_open_file(j288_robot_t *r, const char *path, const j288_robot_options_t *opt);
+
+/* One bus on device port and no joints: servo-level use (j288_robot_exchange()). */
+int j288_robot_open_port(j288_robot_t *r, const char *port, const j288_robot_options_t *opt);
+
+/* Stop (if any target went out since the last stop) and close every bus. Safe on a closed
+ * or failed robot, and twice. */
+void j288_robot_close(j288_robot_t *r);
+
+/* Let cycles return J288_ERR_ABORTED (after j288_robot_stop()) once *flag is non-zero. */
+void j288_robot_set_stop_flag(j288_robot_t *r, const volatile sig_atomic_t *flag);
+
+/*
+ * One cycle: start a sweep on every bus (a down bus's sweep only if its previous one ended),
+ * drive them all from one ppoll() until every bus that is up has finished, then call on_cycle.
+ * timeout_us bounds the cycle (0: 1 s). Returns J288_OK when every joint got fresh state,
+ * J288_ERR_TIMEOUT when some did not (*info says how many; a cycle cut by the timeout leaves
+ * the remaining sweeps running into the next cycle), J288_ERR_OFFLINE when every bus is gone,
+ * J288_ERR_ABORTED after a stop on the stop flag, J288_ERR_NULL. info may be NULL.
+ */
+int j288_robot_cycle(j288_robot_t *r, uint32_t timeout_us, j288_robot_cycle_t *info);
+
+/*
+ * Cycles until ncycles are done (0: no limit) or duration_us has passed (0: no limit), one
+ * every period_us (0: back to back; a late cycle starts at once, the schedule is not caught
+ * up). Returns J288_OK, or J288_ERR_ABORTED (stop flag: every bus stopped), J288_ERR_OFFLINE
+ * (every bus gone), J288_ERR_NULL. Incomplete cycles do not end the run.
+ */
+int j288_robot_run(j288_robot_t *r, uint32_t period_us, uint32_t ncycles, uint32_t duration_us);
+
+/* Broadcast lock on every bus still there, every joint's slot at lock; returns once the stop
+ * frames are out: after the transaction in flight on each bus (its reply budget) and any
+ * re-sends, at most (J288_ESTOP_ATTEMPTS + 2) reply budgets + J288_ROBOT_STOP_TIMEOUT_US.
+ * J288_OK, J288_ERR_OFFLINE (some bus is gone: nothing could be sent there),
+ * J288_ERR_TIMEOUT, J288_ERR_NULL. */
+int j288_robot_stop(j288_robot_t *r);
+
+/* ---- joints (index 0 .. njoints - 1, in the config's order) */
+
+unsigned j288_robot_njoints(const j288_robot_t *r);
+unsigned j288_robot_nbuses(const j288_robot_t *r);
+/* The joint called name, or -1. */
+int j288_robot_find_joint(const j288_robot_t *r, const char *name);
+/* Names ("" for a bad index); the bus index and servo id of a joint (-1 for a bad index). */
+const char *j288_robot_joint_name(const j288_robot_t *r, unsigned joint);
+const char *j288_robot_bus_name(const j288_robot_t *r, unsigned bus);
+int j288_robot_joint_bus(const j288_robot_t *r, unsigned joint);
+int j288_robot_joint_id(const j288_robot_t *r, unsigned joint);
+
+/* The joint's state after the latest cycle. Errors: J288_ERR_NULL, J288_ERR_BAD_ARG. */
+int j288_robot_read(const j288_robot_t *r, unsigned joint, j288_robot_state_t *st);
+
+/* Every joint at once, into arrays of n (>= njoints) entries; any array may be NULL. Unknown
+ * angles read 0 (known[] says which). Errors: J288_ERR_NULL, J288_ERR_BAD_ARG (n too small). */
+int j288_robot_read_all(const j288_robot_t *r, size_t n, double *pos, double *speed,
+                        double *torque, uint8_t *known);
+
+/* The joint's next command from a target (joint.h's checks and limits). Errors: those of
+ * j288_joint_command(), J288_ERR_BAD_ARG (bad index), J288_ERR_OFFLINE (its bus is gone). */
+int j288_robot_set_target(j288_robot_t *r, unsigned joint, const j288_robot_target_t *t);
+
+/* Every joint at once from arrays of n (>= njoints) entries; speed, torque, kp, kd may be
+ * NULL (0, 0, and each joint's configured gains). All targets are checked before any is set:
+ * on an error nothing changes and *bad (may be NULL) gets the failing joint's index. */
+int j288_robot_set_targets(j288_robot_t *r, size_t n, const double *pos, const double *speed,
+                           const double *torque, const double *kp, const double *kd,
+                           unsigned *bad);
+
+/* Hold the joint where it is (its configured gains), or put it at lock. Errors:
+ * J288_ERR_NULL, J288_ERR_BAD_ARG; hold: J288_ERR_ANGLE_UNKNOWN. */
+int j288_robot_hold(j288_robot_t *r, unsigned joint);
+int j288_robot_lock(j288_robot_t *r, unsigned joint);
+
+/* ---- statistics */
+int j288_robot_stats(const j288_robot_t *r, j288_robot_stats_t *out);
+int j288_robot_bus_stats(const j288_robot_t *r, unsigned bus, j288_robot_bus_stats_t *out);
+/* The bus engine's own counters (bus.h), or NULL for a bad index. */
+const j288_bus_stats_t *j288_robot_bus_wire_stats(const j288_robot_t *r, unsigned bus);
+int j288_robot_joint_stats(const j288_robot_t *r, unsigned joint, j288_robot_joint_stats_t *out);
+
+/* ---- servo level, outside cycles */
+
+/* One transaction with servo id (0-14) on a bus: foc NULL sends lock, else an FOC command
+ * from an output-side SI target (j288_cmd_from_si()'s checks); the watchdog bit is on. out
+ * (may be NULL) gets the reply. Not while a cycle's sweep runs on that bus. Errors:
+ * J288_ERR_NULL, J288_ERR_BAD_ARG (bus), J288_ERR_BUSY, the encoder's and the bus's results
+ * (J288_ERR_TIMEOUT: no servo answered, ...), J288_ERR_OFFLINE. */
+int j288_robot_exchange(j288_robot_t *r, unsigned bus, uint8_t id, const j288_robot_target_t *foc,
+                        j288_robot_servo_t *out);
+
+/* The latest error, one line ("" if none). Never NULL. */
+const char *j288_robot_error(const j288_robot_t *r);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* J288_ROBOT_H */

@@ -1,0 +1,169 @@
+"""The C library, loaded with ctypes: prototypes and the structures j288_robot.h declares.
+
+ctypes is in the standard library: nothing to install and nothing to compile for the
+binding itself, on every Python 3 Debian ships. cffi would need python3-cffi and a C compiler
+at install time (API mode) or the same hand-written declarations (ABI mode), for no gain
+here: the calls are few and coarse (one per cycle), so their per-call cost is what matters,
+and it is measured in docs/performance.md.
+
+The library is looked for, in order: $J288_LIB (a path), libj288.so next to this file (what
+``make python`` puts there), then the system's (``make install``: ldconfig's libj288.so.0).
+"""
+
+from __future__ import annotations
+
+import ctypes
+import ctypes.util
+import os
+from ctypes import (POINTER, Structure, c_bool, c_char_p, c_double, c_int, c_size_t, c_uint,
+                    c_uint8, c_uint32, c_void_p)
+from typing import Optional
+
+MAX_SERVOS = 15
+BROADCAST_ID = 15
+
+
+class Target(Structure):
+    """j288_robot_target_t: joint frame (Robot) or output side (Bus), SI units."""
+
+    _fields_ = [("pos", c_double), ("speed", c_double), ("torque", c_double),
+                ("kp", c_double), ("kd", c_double)]
+
+
+class ServoReply(Structure):
+    """j288_robot_servo_t: one reply, output side."""
+
+    _fields_ = [("id", c_uint8), ("mode", c_uint8), ("watchdog_tripped", c_bool),
+                ("pos", c_double), ("speed", c_double), ("torque", c_double),
+                ("out_pos", c_double), ("case_temp_c", c_double),
+                ("winding_temp_c", c_double), ("voltage_v", c_double),
+                ("faults", c_uint32), ("warnings", c_uint8), ("latency_us", c_uint32)]
+
+
+class JointState(Structure):
+    """j288_robot_state_t: one joint, joint frame."""
+
+    _fields_ = [("known", c_bool), ("online", c_bool), ("fresh", c_bool),
+                ("pos", c_double), ("speed", c_double), ("torque", c_double),
+                ("faults", c_uint32), ("warnings", c_uint8),
+                ("case_temp_c", c_double), ("winding_temp_c", c_double),
+                ("voltage_v", c_double)]
+
+
+class CycleInfo(Structure):
+    """j288_robot_cycle_t."""
+
+    _fields_ = [("cycle", c_uint32), ("start_us", c_uint32), ("duration_us", c_uint32),
+                ("fresh", c_uint), ("joints", c_uint), ("complete", c_bool)]
+
+
+class RobotStats(Structure):
+    """j288_robot_stats_t."""
+
+    _fields_ = [("cycles", c_uint32), ("complete_cycles", c_uint32),
+                ("last_cycle_us", c_uint32), ("worst_cycle_us", c_uint32)]
+
+
+class BusStats(Structure):
+    """j288_robot_bus_stats_t."""
+
+    _fields_ = [("sweeps", c_uint32), ("empty_sweeps", c_uint32), ("down_events", c_uint32),
+                ("last_sweep_us", c_uint32), ("worst_sweep_us", c_uint32),
+                ("up", c_bool), ("gone", c_bool)]
+
+
+class SlotStats(Structure):
+    """j288_slot_stats_t (sched.h)."""
+
+    _fields_ = [(n, c_uint32) for n in (
+        "transactions", "successes", "timeouts", "crc_errors", "wrong_id", "collisions",
+        "other_errors", "consecutive_failures", "last_latency_us", "worst_latency_us")]
+
+
+class JointStats(Structure):
+    """j288_robot_joint_stats_t."""
+
+    _fields_ = [("fresh_cycles", c_uint32), ("stale_cycles", c_uint32), ("servo", SlotStats)]
+
+
+class Options(Structure):
+    """j288_robot_options_t (callbacks left NULL: Python polls)."""
+
+    _fields_ = [("port", c_char_p), ("baud", c_uint32), ("margin_us", c_uint32),
+                ("down_after", c_uint8), ("no_low_latency", c_bool),
+                ("on_event", c_void_p), ("on_cycle", c_void_p), ("user", c_void_p)]
+
+
+def _find() -> str:
+    env = os.environ.get("J288_LIB")
+    if env:
+        return env
+    here = os.path.join(os.path.dirname(os.path.abspath(__file__)), "libj288.so")
+    if os.path.exists(here):
+        return here
+    found = ctypes.util.find_library("j288")
+    if found:
+        return found
+    raise ImportError("libj288.so not found: run `make python` (in place) or `make install`, "
+                      "or set J288_LIB to its path")
+
+
+def _bind(lib: ctypes.CDLL) -> None:
+    P = POINTER
+    robot = c_void_p
+    protos = {
+        "j288_strerror": (c_char_p, [c_int]),
+        "j288_robot_sizeof": (c_size_t, []),
+        "j288_robot_version": (c_char_p, []),
+        "j288_robot_open_file": (c_int, [robot, c_char_p, P(Options)]),
+        "j288_robot_open_port": (c_int, [robot, c_char_p, P(Options)]),
+        "j288_robot_close": (None, [robot]),
+        "j288_robot_cycle": (c_int, [robot, c_uint32, P(CycleInfo)]),
+        "j288_robot_run": (c_int, [robot, c_uint32, c_uint32, c_uint32]),
+        "j288_robot_stop": (c_int, [robot]),
+        "j288_robot_njoints": (c_uint, [robot]),
+        "j288_robot_nbuses": (c_uint, [robot]),
+        "j288_robot_find_joint": (c_int, [robot, c_char_p]),
+        "j288_robot_joint_name": (c_char_p, [robot, c_uint]),
+        "j288_robot_bus_name": (c_char_p, [robot, c_uint]),
+        "j288_robot_joint_bus": (c_int, [robot, c_uint]),
+        "j288_robot_joint_id": (c_int, [robot, c_uint]),
+        "j288_robot_read": (c_int, [robot, c_uint, P(JointState)]),
+        "j288_robot_read_all": (c_int, [robot, c_size_t, P(c_double), P(c_double),
+                                        P(c_double), P(c_uint8)]),
+        "j288_robot_set_target": (c_int, [robot, c_uint, P(Target)]),
+        "j288_robot_set_targets": (c_int, [robot, c_size_t, P(c_double), P(c_double),
+                                           P(c_double), P(c_double), P(c_double), P(c_uint)]),
+        "j288_robot_hold": (c_int, [robot, c_uint]),
+        "j288_robot_lock": (c_int, [robot, c_uint]),
+        "j288_robot_stats": (c_int, [robot, P(RobotStats)]),
+        "j288_robot_bus_stats": (c_int, [robot, c_uint, P(BusStats)]),
+        "j288_robot_joint_stats": (c_int, [robot, c_uint, P(JointStats)]),
+        "j288_robot_exchange": (c_int, [robot, c_uint, c_uint8, P(Target), P(ServoReply)]),
+        "j288_robot_error": (c_char_p, [robot]),
+    }
+    for name, (res, args) in protos.items():
+        fn = getattr(lib, name)
+        fn.restype = res
+        fn.argtypes = args
+
+
+def _load() -> ctypes.CDLL:
+    lib = ctypes.CDLL(_find())
+    _bind(lib)
+    return lib
+
+
+LIB: ctypes.CDLL = _load()
+VERSION: str = LIB.j288_robot_version().decode()
+
+
+def new_robot() -> ctypes.Array:
+    """Room for one j288_robot_t (the C side never allocates)."""
+    return ctypes.create_string_buffer(LIB.j288_robot_sizeof())
+
+
+def error_text(robot: Optional[ctypes.Array]) -> str:
+    if robot is None:
+        return ""
+    return LIB.j288_robot_error(robot).decode(errors="replace")

@@ -1,0 +1,259 @@
+"""A robot: every bus of a robot config file driven from one loop, joints in the joint frame."""
+
+from __future__ import annotations
+
+import ctypes
+from dataclasses import dataclass
+from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
+
+from . import _native
+from ._native import (LIB, BusStats, CycleInfo, JointState, JointStats, RobotStats, Target,
+                      c_double, c_uint, c_uint8)
+from .errors import J288Error, error_for
+
+try:  # NumPy is optional: arrays where a loop wants them, lists without it.
+    import numpy as _np
+except ImportError:  # pragma: no cover - depends on the machine
+    _np = None
+
+Vector = Union[Sequence[float], Any]  # a sequence of floats or a NumPy array
+
+
+@dataclass(frozen=True)
+class Cycle:
+    """The outcome of one cycle (every bus swept once)."""
+
+    number: int        #: cycles completed, this one included
+    duration_us: int
+    fresh: int         #: joints with a new reply in this cycle
+    joints: int
+    complete: bool     #: every joint fresh
+
+
+@dataclass(frozen=True)
+class State:
+    """One joint after the latest cycle: joint frame, SI units."""
+
+    known: bool        #: pos is the absolute joint angle (after the first replies)
+    online: bool
+    fresh: bool        #: a reply came in the latest cycle
+    pos: float         #: rad (0 while not known)
+    speed: float       #: rad/s
+    torque: float      #: N*m
+    faults: int
+    warnings: int
+    case_temp_c: float
+    winding_temp_c: float
+    voltage_v: float
+
+
+def _doubles(values: Optional[Vector], n: int) -> Tuple[Any, Any]:
+    """(keep-alive object, double*) for n values, or (None, None)."""
+    if values is None:
+        return None, None
+    if _np is not None:
+        arr = _np.ascontiguousarray(values, dtype=_np.float64)
+        if arr.shape != (n,):
+            raise ValueError(f"expected {n} values, got shape {arr.shape}")
+        return arr, arr.ctypes.data_as(ctypes.POINTER(c_double))
+    vals = list(values)
+    if len(vals) != n:
+        raise ValueError(f"expected {n} values, got {len(vals)}")
+    buf = (c_double * n)(*vals)
+    return buf, ctypes.cast(buf, ctypes.POINTER(c_double))
+
+
+class Robot:
+    """Every bus and joint of a robot config file (YAML: buses, joints with name, bus, id,
+    direction, zero, limits, gains; see port/linux/j288_robot_config.h).
+
+    One cycle sends every joint its command on every bus at once and returns when each bus
+    that answers has finished. Set targets between cycles::
+
+        with j288.Robot("robot.yaml") as robot:
+            while not all(robot.read()[3]):      # joint angles known after a few replies
+                robot.cycle()
+            robot.hold()
+            for _ in range(1000):
+                pos, speed, torque, known = robot.read()
+                robot.set_targets(pos0 + 0.1)    # NumPy arrays, joint frame, rad
+                robot.cycle()
+
+    On exit from the with block (an exception or Ctrl-C included) every bus gets the
+    broadcast lock. A bus that stops answering is left behind by the cycles (its joints go
+    stale, bus_stats() says "down") and picked up again when it answers; a vanished device
+    is left out.
+
+    Args:
+        config: path of the robot config file.
+        port: the device when the file names no bus.
+        margin_us: reply margin for buses whose entry gives none (default 20 ms).
+    Raises:
+        J288Error: J288_ERR_BAD_CONFIG (file errors, with "FILE:LINE: ..." in detail), a
+            device that cannot be opened (OfflineError), ...
+    """
+
+    def __init__(self, config: str, port: Optional[str] = None, margin_us: int = 0) -> None:
+        self._r: Optional[ctypes.Array] = _native.new_robot()
+        opt = _native.Options(port=port.encode() if port else None, margin_us=margin_us)
+        rc = LIB.j288_robot_open_file(self._r, config.encode(), ctypes.byref(opt))
+        if rc != 0:
+            detail = _native.error_text(self._r)
+            self._r = None
+            raise error_for(rc, detail, config)
+        r = self._r
+        self.joints: List[str] = [LIB.j288_robot_joint_name(r, j).decode()
+                                  for j in range(LIB.j288_robot_njoints(r))]
+        self.buses: List[str] = [LIB.j288_robot_bus_name(r, b).decode()
+                                 for b in range(LIB.j288_robot_nbuses(r))]
+        self._n = len(self.joints)
+        self._pos = (c_double * self._n)()
+        self._speed = (c_double * self._n)()
+        self._torque = (c_double * self._n)()
+        self._known = (c_uint8 * self._n)()
+
+    # ---- plumbing
+    def _robot(self) -> ctypes.Array:
+        if self._r is None:
+            raise ValueError("the robot is closed")
+        return self._r
+
+    def _check(self, rc: int, what: str = "") -> None:
+        if rc != 0:
+            raise error_for(rc, _native.error_text(self._r), what)
+
+    def _index(self, joint: Union[int, str]) -> int:
+        if isinstance(joint, str):
+            j = LIB.j288_robot_find_joint(self._robot(), joint.encode())
+            if j < 0:
+                raise KeyError(f"no joint named {joint!r}")
+            return int(j)
+        if not 0 <= joint < self._n:
+            raise IndexError(f"joint index {joint} outside 0-{self._n - 1}")
+        return joint
+
+    # ---- the loop
+    def cycle(self, timeout: float = 1.0) -> Cycle:
+        """Sweep every bus once. Returns the cycle's outcome, also when some joint got no
+        reply (complete False). Raises OfflineError when every bus is gone."""
+        info = CycleInfo()
+        rc = LIB.j288_robot_cycle(self._robot(), int(timeout * 1e6), ctypes.byref(info))
+        if rc not in (0, -31):
+            self._check(rc)
+        return Cycle(info.cycle, info.duration_us, info.fresh, info.joints, bool(info.complete))
+
+    def run(self, cycles: int = 0, rate_hz: float = 0.0, duration: float = 0.0) -> None:
+        """Cycles in C (no Python per cycle): `cycles` of them (0: no limit) or for `duration`
+        seconds (0: no limit), at rate_hz (0: back to back), with the targets set before."""
+        period = int(1e6 / rate_hz) if rate_hz > 0 else 0
+        self._check(LIB.j288_robot_run(self._robot(), period, cycles, int(duration * 1e6)))
+
+    def stop(self) -> None:
+        """Broadcast lock on every bus; every joint at lock until new targets are set."""
+        self._check(LIB.j288_robot_stop(self._robot()))
+
+    # ---- state
+    def read(self) -> Tuple[Any, Any, Any, Any]:
+        """(pos, speed, torque, known) of every joint, in self.joints' order: NumPy arrays
+        (float64, bool) when NumPy is there, else lists. Joint frame, rad, rad/s, N*m."""
+        self._check(LIB.j288_robot_read_all(self._robot(), self._n, self._pos, self._speed,
+                                            self._torque, self._known))
+        if _np is not None:
+            return (_np.frombuffer(self._pos, dtype=_np.float64).copy(),
+                    _np.frombuffer(self._speed, dtype=_np.float64).copy(),
+                    _np.frombuffer(self._torque, dtype=_np.float64).copy(),
+                    _np.frombuffer(self._known, dtype=_np.uint8).astype(bool))
+        return (list(self._pos), list(self._speed), list(self._torque),
+                [bool(k) for k in self._known])
+
+    def state(self, joint: Union[int, str]) -> State:
+        """One joint's state (by name or index)."""
+        st = JointState()
+        self._check(LIB.j288_robot_read(self._robot(), self._index(joint), ctypes.byref(st)))
+        return State(bool(st.known), bool(st.online), bool(st.fresh), st.pos, st.speed,
+                     st.torque, st.faults, st.warnings, st.case_temp_c, st.winding_temp_c,
+                     st.voltage_v)
+
+    # ---- targets (sent in the next cycle)
+    def set_target(self, joint: Union[int, str], pos: float, speed: float = 0.0,
+                   torque: float = 0.0, kp: float = 0.0, kd: float = 0.0) -> None:
+        """One joint's target, joint frame. Raises J288Error: J288_ERR_ANGLE_UNKNOWN (not
+        known yet), J288_ERR_LIMIT_POS / _SPEED / _TORQUE (outside its limits), ..."""
+        j = self._index(joint)
+        t = Target(pos, speed, torque, kp, kd)
+        self._check(LIB.j288_robot_set_target(self._robot(), j, ctypes.byref(t)),
+                    self.joints[j])
+
+    def set_targets(self, pos: Vector, speed: Optional[Vector] = None,
+                    torque: Optional[Vector] = None, kp: Optional[Vector] = None,
+                    kd: Optional[Vector] = None) -> None:
+        """Every joint's target at once (arrays in self.joints' order; gains default to
+        each joint's configured kp, kd). All are checked first: on an error none changes,
+        and the exception names the joint."""
+        n = self._n
+        keep = [_doubles(v, n) for v in (pos, speed, torque, kp, kd)]
+        bad = c_uint(0)
+        rc = LIB.j288_robot_set_targets(self._robot(), n, *[p for _, p in keep],
+                                        ctypes.byref(bad))
+        if rc != 0:
+            name = self.joints[bad.value] if bad.value < n else ""
+            self._check(rc, name)
+
+    def hold(self, joint: Union[int, str, None] = None) -> None:
+        """Hold a joint (or every joint) where it is, with its configured gains."""
+        for j in ([self._index(joint)] if joint is not None else range(self._n)):
+            self._check(LIB.j288_robot_hold(self._robot(), j), self.joints[j])
+
+    def lock(self, joint: Union[int, str, None] = None) -> None:
+        """Put a joint (or every joint) at lock (no torque) from the next cycle."""
+        for j in ([self._index(joint)] if joint is not None else range(self._n)):
+            self._check(LIB.j288_robot_lock(self._robot(), j), self.joints[j])
+
+    # ---- statistics
+    def stats(self) -> Dict[str, int]:
+        """Cycles, complete cycles, last and worst cycle time (us)."""
+        s = RobotStats()
+        self._check(LIB.j288_robot_stats(self._robot(), ctypes.byref(s)))
+        return {f: getattr(s, f) for f, _ in RobotStats._fields_}
+
+    def bus_stats(self, bus: Union[int, str]) -> Dict[str, Any]:
+        """One bus: sweeps, empty sweeps, down events, sweep times, up, gone."""
+        b = self.buses.index(bus) if isinstance(bus, str) else bus
+        s = BusStats()
+        self._check(LIB.j288_robot_bus_stats(self._robot(), b, ctypes.byref(s)))
+        return {f: getattr(s, f) for f, _ in BusStats._fields_}
+
+    def joint_stats(self, joint: Union[int, str]) -> Dict[str, int]:
+        """One joint: fresh and stale cycles, and its servo's transaction counters."""
+        s = JointStats()
+        self._check(LIB.j288_robot_joint_stats(self._robot(), self._index(joint),
+                                               ctypes.byref(s)))
+        out = {"fresh_cycles": s.fresh_cycles, "stale_cycles": s.stale_cycles}
+        out.update({f: getattr(s.servo, f) for f, _ in s.servo._fields_})
+        return out
+
+    # ---- lifetime
+    def close(self) -> None:
+        """Stop (if targets went out since the last stop) and close every bus. Safe twice."""
+        if self._r is not None:
+            LIB.j288_robot_close(self._r)
+            self._r = None
+
+    def __enter__(self) -> "Robot":
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        try:
+            if self._r is not None:
+                LIB.j288_robot_stop(self._r)
+        finally:
+            self.close()
+
+    def __del__(self) -> None:
+        try:
+            self.close()
+        except Exception:  # interpreter shutdown: the library may be gone already
+            pass
+
+
+__all__ = ["Robot", "Cycle", "State", "J288Error"]

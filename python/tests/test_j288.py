@@ -1,0 +1,232 @@
+"""The Python package against j288-sim (pseudo-terminals), through libj288.so.
+
+Run by scripts/python-test.sh (make test). Replies that must come in time get a 250 ms
+margin, so that a loaded machine or valgrind does not fail a check; no check times anything.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import subprocess
+import sys
+import textwrap
+from pathlib import Path
+from typing import Iterator, List
+
+import pytest
+
+import j288
+
+ROOT = Path(__file__).resolve().parents[2]
+SIM = os.environ.get("J288_SIM", str(ROOT / "build" / "bin" / "j288-sim"))
+MARGIN = 250000
+
+
+class Sim:
+    """One j288-sim on a pseudo-terminal, with its command log."""
+
+    def __init__(self, tmp: Path, ids: str, name: str) -> None:
+        self.log = tmp / f"{name}.log"
+        self.proc = subprocess.Popen([SIM, "--quiet", "--exit-after", "60", "--ids", ids,
+                                      "--log", str(self.log)],
+                                     stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
+        assert self.proc.stdout is not None
+        self.pty = self.proc.stdout.readline().strip()
+        assert self.pty.startswith("/dev/"), "j288-sim did not print its pty path"
+
+    def stop(self) -> None:
+        if self.proc.poll() is None:
+            self.proc.terminate()
+            try:
+                self.proc.wait(20)
+            except subprocess.TimeoutExpired:
+                self.proc.kill()
+                self.proc.wait()
+
+    def logged(self, needle: str) -> bool:
+        return self.log.exists() and needle in self.log.read_text()
+
+
+@pytest.fixture
+def sims(tmp_path: Path) -> Iterator[List[Sim]]:
+    started: List[Sim] = []
+
+    def start(ids: str) -> Sim:
+        s = Sim(tmp_path, ids, f"sim{len(started)}")
+        started.append(s)
+        return s
+
+    yield start  # type: ignore[misc]
+    for s in started:
+        s.stop()
+
+
+def write_config(tmp: Path, ptys: List[str]) -> Path:
+    lines = ["buses:"]
+    for k, pty in enumerate(ptys):
+        lines += [f"  - name: leg{k}", f"    port: {pty}", f"    margin_us: {MARGIN}"]
+    lines.append("joints:")
+    for k in range(len(ptys)):
+        for i in (1, 2, 3):
+            lines += [f"  - name: leg{k}_{i}", f"    bus: leg{k}", f"    id: {i}",
+                      "    limits: [-3.0, 3.0]", "    kp: 5.0", "    kd: 0.1"]
+    path = tmp / "robot.yaml"
+    path.write_text("\n".join(lines) + "\n")
+    return path
+
+
+def cycle_until_known(robot: j288.Robot) -> None:
+    for _ in range(100):
+        robot.cycle()
+        if all(robot.read()[3]):
+            return
+    pytest.fail("the joints' angles never became known")
+
+
+# ---- the package ----------------------------------------------------------------------------
+
+def test_version_is_the_library_s() -> None:
+    header = (ROOT / "lib/include/j288/j288.h").read_text()
+    assert j288.__version__ == re.search(r'J288_VERSION_STRING "(.*)"', header).group(1)
+
+
+def test_error_names_match_the_header() -> None:
+    header = (ROOT / "lib/include/j288/error.h").read_text()
+    codes = {int(v): n for n, v in re.findall(r"(J288_(?:OK|ERR_\w+))\s*=\s*(-?\d+)", header)}
+    assert j288.errors.NAMES == codes
+
+
+def test_pinned_scan_command(sims) -> None:
+    sim = sims("2,7")
+    out = subprocess.run(
+        [sys.executable, "-c", f"import j288; print(sorted(j288.Bus({sim.pty!r}).scan()))"],
+        env=dict(os.environ, PYTHONPATH=str(ROOT / "python")), capture_output=True, text=True,
+        timeout=120)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout == "[2, 7]\n"
+
+
+# ---- Bus ------------------------------------------------------------------------------------
+
+def test_bus_status_and_command(sims) -> None:
+    sim = sims("2,7")
+    with j288.Bus(sim.pty, margin_us=MARGIN) as bus:
+        st = bus.status(7)
+        assert st.id == 7 and st.mode == j288.MODE_LOCK
+        assert st.voltage_v == 24.0 and 0.0 <= st.out_pos < 6.2832
+        st = bus.command(2, pos=st.pos, kp=1.0, kd=0.01)
+        assert st.mode == j288.MODE_FOC
+        with pytest.raises(j288.J288Error) as e:
+            bus.command(2, kp=-1.0)
+        assert e.value.name == "J288_ERR_NEG_GAIN" and e.value.code == -4
+        with pytest.raises(j288.J288Error) as e:
+            bus.command(2, pos=1e9)
+        assert e.value.name == "J288_ERR_RANGE_POS"
+    assert sim.logged(" id=2 status=1 wd=1")
+    sim.stop()
+    assert sim.logged(" id=15 status=0 wd=1"), "the with block's exit sends the broadcast lock"
+
+
+def test_bus_errors(sims) -> None:
+    with pytest.raises(j288.OfflineError) as e:
+        j288.Bus("/dev/j288-no-such")
+    assert e.value.name == "J288_ERR_OFFLINE" and "/dev/j288-no-such" in str(e.value)
+    sim = sims("1")
+    with j288.Bus(sim.pty, margin_us=20000) as bus:
+        with pytest.raises(j288.NoReplyError) as e2:
+            bus.status(9)
+        assert e2.value.name == "J288_ERR_TIMEOUT"
+        with pytest.raises(j288.J288Error) as e3:
+            j288.Bus(sim.pty)
+        assert e3.value.name == "J288_ERR_BUSY" and "already open" in str(e3.value)
+    bus.close()
+    with pytest.raises(ValueError):
+        bus.status(1)
+
+
+# ---- Robot ----------------------------------------------------------------------------------
+
+def test_robot_two_buses(sims, tmp_path: Path) -> None:
+    s0, s1 = sims("1,2,3"), sims("1,2,3")
+    cfg = write_config(tmp_path, [s0.pty, s1.pty])
+    with j288.Robot(str(cfg)) as robot:
+        assert robot.joints == ["leg0_1", "leg0_2", "leg0_3", "leg1_1", "leg1_2", "leg1_3"]
+        assert robot.buses == ["leg0", "leg1"]
+        c = robot.cycle()
+        assert c.complete and c.fresh == 6 and c.number == 1
+        with pytest.raises(j288.J288Error) as e:
+            robot.set_target("leg0_1", 0.0)
+        assert e.value.name == "J288_ERR_ANGLE_UNKNOWN"
+        cycle_until_known(robot)
+        pos, speed, torque, known = robot.read()
+        assert len(pos) == 6 and all(known)
+        if j288.robot._np is not None:
+            import numpy as np
+            assert isinstance(pos, np.ndarray) and pos.dtype == np.float64
+        st = robot.state("leg1_2")
+        assert st.known and st.fresh and st.online and st.voltage_v == 24.0
+        robot.hold()
+        robot.set_targets(pos, kp=[2.0] * 6)
+        bad = list(pos)
+        bad[4] = 10.0  # outside [-3, 3]
+        with pytest.raises(j288.J288Error) as e:
+            robot.set_targets(bad)
+        assert e.value.name == "J288_ERR_LIMIT_POS" and "leg1_2" in str(e.value)
+        robot.set_target("leg1_3", float(pos[5]), kp=3.0)
+        assert robot.cycle().complete
+        robot.run(cycles=20)
+        stats = robot.stats()
+        assert stats["cycles"] == stats["complete_cycles"] >= 22
+        assert robot.bus_stats("leg1")["sweeps"] == stats["cycles"]
+        assert robot.joint_stats("leg0_1")["fresh_cycles"] == stats["cycles"]
+    for s in (s0, s1):
+        assert s.logged(" id=2 status=1 wd=1")
+        s.stop()
+        assert s.logged(" id=15 status=0 wd=1")
+
+
+def test_robot_stop_on_exception(sims, tmp_path: Path) -> None:
+    s0 = sims("1,2,3")
+    cfg = write_config(tmp_path, [s0.pty])
+    with pytest.raises(RuntimeError):
+        with j288.Robot(str(cfg)) as robot:
+            cycle_until_known(robot)
+            robot.hold()
+            robot.cycle()
+            raise RuntimeError("the controller failed")
+    s0.stop()
+    assert s0.logged(" id=15 status=0 wd=1")
+
+
+def test_robot_bad_config(sims, tmp_path: Path) -> None:
+    s0 = sims("1")
+    path = tmp_path / "twice.yaml"
+    path.write_text(textwrap.dedent(f"""\
+        buses:
+          - {{name: a, port: {s0.pty}}}
+        joints:
+          - {{name: j, bus: a, id: 1}}
+          - {{name: k, bus: a, id: 1}}
+        """))
+    with pytest.raises(j288.J288Error) as e:
+        j288.Robot(str(path))
+    assert e.value.name == "J288_ERR_BAD_CONFIG" and "twice.yaml:5" in str(e.value)
+    with pytest.raises(j288.J288Error) as e:
+        j288.Robot(str(tmp_path / "missing.yaml"))
+    assert e.value.name == "J288_ERR_BAD_CONFIG"
+
+
+def test_robot_bus_gone(sims, tmp_path: Path) -> None:
+    s0, s1 = sims("1,2,3"), sims("1,2,3")
+    cfg = write_config(tmp_path, [s0.pty, s1.pty])
+    with j288.Robot(str(cfg)) as robot:
+        assert robot.cycle().complete
+        s1.stop()
+        fresh = [robot.cycle().fresh for _ in range(4)]
+        assert fresh[-1] == 3
+        assert robot.bus_stats("leg1")["gone"]
+        s0.stop()
+        with pytest.raises(j288.OfflineError):
+            for _ in range(4):
+                robot.cycle()

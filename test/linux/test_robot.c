@@ -1,0 +1,583 @@
+/*
+ * The multi-bus runner against several j288-sim buses, each on its own pseudo-terminal:
+ * cycles over every bus from one loop, fresh state per joint, the bad configs, a device
+ * that is gone, a bus that stops answering while the others go on, the safe stop.
+ *
+ * Each test starts its simulators (fork/exec, --exit-after as a backstop); tearDown kills
+ * and reaps them. The simulator binary: $J288_SIM, else the path compiled in. No check
+ * depends on the machine's speed (valgrind runs this too): replies that must come in time
+ * get a 250 ms margin, and the checks count events, never time taken.
+ */
+#define _GNU_SOURCE 1
+
+#include "unity.h"
+
+#include <errno.h>
+#include <poll.h>
+#include <signal.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include "j288/j288.h"
+#include "j288_robot.h"
+
+#ifndef J288_SIM_DEFAULT
+#define J288_SIM_DEFAULT "build/bin/j288-sim"
+#endif
+
+#define NSIM 4
+#define LOADED_MARGIN_US 250000u
+
+typedef struct {
+    pid_t pid;
+    bool stopped; /* SIGSTOP'ed */
+    char pty[128];
+    char log[80];
+} sim_t;
+
+static sim_t g_sim[NSIM];
+static j288_robot_t g_robot;
+static j288_robot_config_t g_cfg;
+
+/* ---- simulators ------------------------------------------------------------------------- */
+
+static const char *sim_path(void)
+{
+    const char *p = getenv("J288_SIM");
+    return (p != NULL && *p != '\0') ? p : J288_SIM_DEFAULT;
+}
+
+/* Start simulator k with servos ids (e.g. "1,2,3") and read its pty path. */
+static void sim_start(int k, const char *ids)
+{
+    sim_t *s = &g_sim[k];
+    const char *argv[16];
+    int n = 0, fds[2];
+    size_t got = 0;
+    struct pollfd pfd;
+
+    argv[n++] = sim_path();
+    argv[n++] = "--quiet";
+    argv[n++] = "--exit-after";
+    argv[n++] = "60";
+    argv[n++] = "--ids";
+    argv[n++] = ids;
+    argv[n++] = "--log";
+    argv[n++] = s->log;
+    argv[n] = NULL;
+    TEST_ASSERT_EQUAL_INT(0, pipe(fds));
+    s->pid = fork();
+    TEST_ASSERT_TRUE(s->pid >= 0);
+    if (s->pid == 0) {
+        (void)dup2(fds[1], 1);
+        (void)close(fds[0]);
+        (void)close(fds[1]);
+        execv(argv[0], (char *const *)argv);
+        fprintf(stderr, "cannot run %s: %s\n", argv[0], strerror(errno));
+        _exit(127);
+    }
+    (void)close(fds[1]);
+    pfd.fd = fds[0];
+    pfd.events = POLLIN;
+    while (got < sizeof s->pty - 1u) {
+        ssize_t r;
+        if (poll(&pfd, 1, 30000) <= 0)
+            break;
+        r = read(fds[0], s->pty + got, 1);
+        if (r <= 0 || s->pty[got] == '\n')
+            break;
+        got++;
+    }
+    s->pty[got] = '\0';
+    (void)close(fds[0]);
+    if (strncmp(s->pty, "/dev/", 5) != 0)
+        TEST_FAIL_MESSAGE("j288-sim did not print its pty path (is it built?)");
+}
+
+static void sim_stop(int k)
+{
+    sim_t *s = &g_sim[k];
+    int status, i;
+    if (s->pid <= 0)
+        return;
+    if (s->stopped)
+        (void)kill(s->pid, SIGCONT);
+    (void)kill(s->pid, SIGTERM);
+    for (i = 0; i < 2000; i++) {
+        if (waitpid(s->pid, &status, WNOHANG) == s->pid) {
+            s->pid = -1;
+            return;
+        }
+        usleep(10000);
+    }
+    (void)kill(s->pid, SIGKILL);
+    (void)waitpid(s->pid, &status, 0);
+    s->pid = -1;
+}
+
+static bool log_contains(int k, const char *needle)
+{
+    char line[256];
+    bool found = false;
+    FILE *f = fopen(g_sim[k].log, "r");
+    if (f == NULL)
+        return false;
+    while (!found && fgets(line, sizeof line, f) != NULL)
+        found = strstr(line, needle) != NULL;
+    fclose(f);
+    return found;
+}
+
+/* ---- configs -------------------------------------------------------------------------- */
+
+/* nbuses buses, each on simulator k's pty, with joints ids 1, 2, 3 named <bus>_<id>. */
+static void make_config(int nbuses, uint32_t margin_us)
+{
+    int b, i;
+    memset(&g_cfg, 0, sizeof g_cfg);
+    for (b = 0; b < nbuses; b++) {
+        j288_robot_config_bus_t *cb = &g_cfg.bus[b];
+        (void)snprintf(cb->name, sizeof cb->name, "leg%d", b);
+        (void)snprintf(cb->port, sizeof cb->port, "%s", g_sim[b].pty);
+        cb->has_margin_us = true;
+        cb->margin_us = margin_us;
+        for (i = 1; i <= 3; i++) {
+            j288_robot_config_joint_t *j = &g_cfg.joint[g_cfg.njoints++];
+            (void)snprintf(j->name, sizeof j->name, "leg%d_%d", b, i);
+            j->bus = b;
+            j->id = (uint8_t)i;
+            j->direction = 1;
+            j->pos_min = -3.14159;
+            j->pos_max = 3.14159;
+        }
+    }
+    g_cfg.nbuses = (size_t)nbuses;
+}
+
+/* ---- events ---------------------------------------------------------------------------- */
+
+static unsigned g_ev_count[5];
+static unsigned g_ev_bus[5];
+static unsigned g_cycles_seen;
+
+static void count_event(void *user, const j288_robot_event_t *ev)
+{
+    (void)user;
+    g_ev_count[ev->kind]++;
+    g_ev_bus[ev->kind] = ev->bus;
+}
+
+static void count_cycle(void *user, j288_robot_t *r, const j288_robot_cycle_t *c)
+{
+    (void)user;
+    (void)r;
+    (void)c;
+    g_cycles_seen++;
+}
+
+static j288_robot_options_t counting_options(void)
+{
+    j288_robot_options_t o;
+    memset(&o, 0, sizeof o);
+    o.on_event = count_event;
+    o.on_cycle = count_cycle;
+    return o;
+}
+
+/* Cycle until every joint's angle is known (the joint layer's start takes 8 replies). */
+static void cycle_until_known(void)
+{
+    unsigned j, tries;
+    for (tries = 0; tries < 100; tries++) {
+        bool all = true;
+        (void)j288_robot_cycle(&g_robot, 0, NULL);
+        for (j = 0; j < j288_robot_njoints(&g_robot); j++) {
+            j288_robot_state_t st;
+            TEST_ASSERT_EQUAL_INT(J288_OK, j288_robot_read(&g_robot, j, &st));
+            all = all && st.known;
+        }
+        if (all)
+            return;
+    }
+    TEST_FAIL_MESSAGE("the joints' angles never became known");
+}
+
+void setUp(void)
+{
+    int k;
+    for (k = 0; k < NSIM; k++) {
+        g_sim[k].pid = -1;
+        g_sim[k].stopped = false;
+        g_sim[k].pty[0] = '\0';
+        (void)snprintf(g_sim[k].log, sizeof g_sim[k].log, "/tmp/j288-robot-test-%ld-%d.log",
+                       (long)getpid(), k);
+    }
+    memset(g_ev_count, 0, sizeof g_ev_count);
+    g_cycles_seen = 0;
+    memset(&g_robot, 0, sizeof g_robot);
+}
+
+void tearDown(void)
+{
+    int k;
+    j288_robot_close(&g_robot);
+    for (k = 0; k < NSIM; k++) {
+        sim_stop(k);
+        (void)unlink(g_sim[k].log);
+    }
+}
+
+/* ---- tests ------------------------------------------------------------------------------ */
+
+static void test_four_buses_one_loop(void)
+{
+    j288_robot_options_t o = counting_options();
+    j288_robot_cycle_t info;
+    j288_robot_stats_t rs;
+    j288_robot_bus_stats_t bs;
+    j288_robot_joint_stats_t js;
+    unsigned j;
+    int k;
+    for (k = 0; k < NSIM; k++)
+        sim_start(k, "1,2,3");
+    make_config(NSIM, LOADED_MARGIN_US);
+    TEST_ASSERT_EQUAL_INT_MESSAGE(J288_OK, j288_robot_open(&g_robot, &g_cfg, &o),
+                                  j288_robot_error(&g_robot));
+    TEST_ASSERT_EQUAL_UINT(4, j288_robot_nbuses(&g_robot));
+    TEST_ASSERT_EQUAL_UINT(12, j288_robot_njoints(&g_robot));
+    TEST_ASSERT_EQUAL_INT(7, j288_robot_find_joint(&g_robot, "leg2_2"));
+    TEST_ASSERT_EQUAL_INT(2, j288_robot_joint_bus(&g_robot, 7));
+    TEST_ASSERT_EQUAL_INT(2, j288_robot_joint_id(&g_robot, 7));
+    TEST_ASSERT_EQUAL_STRING("leg3", j288_robot_bus_name(&g_robot, 3));
+    TEST_ASSERT_EQUAL_INT(-1, j288_robot_find_joint(&g_robot, "tail"));
+
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_robot_cycle(&g_robot, 0, &info));
+    TEST_ASSERT_TRUE(info.complete);
+    TEST_ASSERT_EQUAL_UINT(12, info.fresh);
+    TEST_ASSERT_EQUAL_UINT32(1, info.cycle);
+    TEST_ASSERT_EQUAL_UINT(1, g_cycles_seen);
+    /* Until the start is done the joints are unknown and targets are refused. */
+    {
+        j288_robot_target_t t = {0.1, 0, 0, 5, 0.2};
+        TEST_ASSERT_EQUAL_INT(J288_ERR_ANGLE_UNKNOWN, j288_robot_set_target(&g_robot, 0, &t));
+    }
+    cycle_until_known();
+    /* Every servo came online, each joint's state is fresh from the latest cycle. */
+    TEST_ASSERT_TRUE(g_ev_count[J288_ROBOT_EV_SERVO] >= 12u);
+    for (j = 0; j < 12; j++) {
+        j288_robot_state_t st;
+        TEST_ASSERT_EQUAL_INT(J288_OK, j288_robot_read(&g_robot, j, &st));
+        TEST_ASSERT_TRUE(st.fresh);
+        TEST_ASSERT_TRUE(st.online);
+        TEST_ASSERT_EQUAL_DOUBLE(24.0, st.voltage_v);
+    }
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_robot_stats(&g_robot, &rs));
+    TEST_ASSERT_EQUAL_UINT32(rs.cycles, rs.complete_cycles);
+    TEST_ASSERT_EQUAL_UINT32(g_cycles_seen, rs.cycles);
+    for (k = 0; k < NSIM; k++) {
+        TEST_ASSERT_EQUAL_INT(J288_OK, j288_robot_bus_stats(&g_robot, (unsigned)k, &bs));
+        TEST_ASSERT_EQUAL_UINT32(rs.cycles, bs.sweeps);
+        TEST_ASSERT_TRUE(bs.up);
+        TEST_ASSERT_EQUAL_UINT32(3u * rs.cycles, j288_robot_bus_wire_stats(&g_robot, (unsigned)k)->ok);
+    }
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_robot_joint_stats(&g_robot, 11, &js));
+    TEST_ASSERT_EQUAL_UINT32(rs.cycles, js.fresh_cycles);
+    TEST_ASSERT_EQUAL_UINT32(rs.cycles, js.servo.successes);
+
+    /* Targets in the joint frame go out in the next cycle: the simulators see FOC. */
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_robot_hold(&g_robot, 4));
+    {
+        double pos[12];
+        unsigned bad = 99;
+        TEST_ASSERT_EQUAL_INT(J288_OK, j288_robot_read_all(&g_robot, 12, pos, NULL, NULL, NULL));
+        pos[5] = 100.0; /* outside the limits: nothing changes */
+        TEST_ASSERT_EQUAL_INT(J288_ERR_LIMIT_POS,
+                              j288_robot_set_targets(&g_robot, 12, pos, NULL, NULL, NULL, NULL, &bad));
+        TEST_ASSERT_EQUAL_UINT(5, bad);
+        TEST_ASSERT_EQUAL_INT(J288_ERR_BAD_ARG,
+                              j288_robot_set_targets(&g_robot, 11, pos, NULL, NULL, NULL, NULL, &bad));
+    }
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_robot_cycle(&g_robot, 0, NULL));
+    TEST_ASSERT_TRUE(log_contains(1, " id=2 status=1 wd=1"));
+    TEST_ASSERT_FALSE(log_contains(0, " id=2 status=1"));
+    /* Close stops every bus: the broadcast lock reaches each simulator. */
+    j288_robot_close(&g_robot);
+    for (k = 0; k < NSIM; k++) {
+        sim_stop(k);
+        TEST_ASSERT_TRUE(log_contains(k, " id=15 status=0 wd=1"));
+    }
+}
+
+/* The reader refuses a bus named twice and an id used twice; so does the runner given such
+ * a config built by hand (and two buses on one device). */
+static void test_bad_configs(void)
+{
+    char err[J288_ROBOT_CONFIG_ERROR_MAX];
+    static const char two_names[] = "buses:\n"
+                                    "  - {name: a, port: /dev/null}\n"
+                                    "  - {name: a, port: /dev/zero}\n"
+                                    "joints:\n"
+                                    "  - {name: j, bus: a, id: 1}\n";
+    static const char two_ids[] = "buses:\n"
+                                  "  - {name: a, port: /dev/null}\n"
+                                  "joints:\n"
+                                  "  - {name: j, bus: a, id: 1}\n"
+                                  "  - {name: k, bus: a, id: 1}\n";
+    j288_robot_options_t o;
+    memset(&o, 0, sizeof o);
+    TEST_ASSERT_EQUAL_INT(-1, j288_robot_config_parse(two_names, sizeof two_names - 1u, "r.yaml",
+                                                      &g_cfg, err, sizeof err));
+    TEST_ASSERT_NOT_NULL(strstr(err, "r.yaml:3"));
+    TEST_ASSERT_EQUAL_INT(-1, j288_robot_config_parse(two_ids, sizeof two_ids - 1u, "r.yaml",
+                                                      &g_cfg, err, sizeof err));
+    TEST_ASSERT_NOT_NULL(strstr(err, "r.yaml:5"));
+
+    sim_start(0, "1,2,3");
+    sim_start(1, "1,2,3");
+    make_config(2, LOADED_MARGIN_US);
+    (void)snprintf(g_cfg.bus[1].name, sizeof g_cfg.bus[1].name, "leg0");
+    TEST_ASSERT_EQUAL_INT(J288_ERR_BAD_CONFIG, j288_robot_open(&g_robot, &g_cfg, &o));
+    TEST_ASSERT_EQUAL_STRING("bus 'leg0' is named twice", j288_robot_error(&g_robot));
+
+    make_config(2, LOADED_MARGIN_US);
+    g_cfg.joint[4].bus = 0; /* leg1_2 onto leg0, where id 2 is taken */
+    TEST_ASSERT_EQUAL_INT(J288_ERR_BAD_CONFIG, j288_robot_open(&g_robot, &g_cfg, &o));
+    TEST_ASSERT_EQUAL_STRING("joints 'leg0_2' and 'leg1_2' both use id 2 on one bus",
+                             j288_robot_error(&g_robot));
+
+    make_config(2, LOADED_MARGIN_US);
+    (void)snprintf(g_cfg.bus[1].port, sizeof g_cfg.bus[1].port, "%s", g_sim[0].pty);
+    TEST_ASSERT_EQUAL_INT(J288_ERR_BAD_CONFIG, j288_robot_open(&g_robot, &g_cfg, &o));
+    TEST_ASSERT_NOT_NULL(strstr(j288_robot_error(&g_robot), "are both on"));
+
+    /* The same device under two names: refused, not opened twice. */
+    make_config(2, LOADED_MARGIN_US);
+    {
+        char link[96];
+        (void)snprintf(link, sizeof link, "/tmp/j288-robot-test-%ld.link", (long)getpid());
+        (void)unlink(link);
+        TEST_ASSERT_EQUAL_INT(0, symlink(g_sim[0].pty, link));
+        (void)snprintf(g_cfg.bus[1].port, sizeof g_cfg.bus[1].port, "%s", link);
+        TEST_ASSERT_EQUAL_INT(J288_ERR_BAD_CONFIG, j288_robot_open(&g_robot, &g_cfg, &o));
+        (void)unlink(link);
+    }
+    TEST_ASSERT_EQUAL_STRING("buses 'leg0' and 'leg1' are the same device", j288_robot_error(&g_robot));
+
+    make_config(2, LOADED_MARGIN_US);
+    g_cfg.joint[0].bus = 7;
+    TEST_ASSERT_EQUAL_INT(J288_ERR_BAD_CONFIG, j288_robot_open(&g_robot, &g_cfg, &o));
+    TEST_ASSERT_EQUAL_STRING("joint 'leg0_1' names no bus of the config", j288_robot_error(&g_robot));
+
+    /* After every failure nothing stays open: a good open of the same devices works. */
+    make_config(2, LOADED_MARGIN_US);
+    TEST_ASSERT_EQUAL_INT_MESSAGE(J288_OK, j288_robot_open(&g_robot, &g_cfg, &o),
+                                  j288_robot_error(&g_robot));
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_robot_cycle(&g_robot, 0, NULL));
+
+    /* No bus and no port. */
+    j288_robot_close(&g_robot);
+    memset(&g_cfg, 0, sizeof g_cfg);
+    TEST_ASSERT_EQUAL_INT(J288_ERR_BAD_CONFIG, j288_robot_open(&g_robot, &g_cfg, &o));
+    TEST_ASSERT_EQUAL_INT(J288_ERR_NULL, j288_robot_open(NULL, &g_cfg, &o));
+    TEST_ASSERT_EQUAL_INT(J288_ERR_NULL, j288_robot_open(&g_robot, NULL, &o));
+}
+
+/* A device that does not exist: a clear error naming it, nothing left open. */
+static void test_missing_device(void)
+{
+    j288_robot_options_t o;
+    memset(&o, 0, sizeof o);
+    sim_start(0, "1");
+    make_config(2, LOADED_MARGIN_US);
+    (void)snprintf(g_cfg.bus[1].port, sizeof g_cfg.bus[1].port, "/dev/j288-no-such");
+    TEST_ASSERT_EQUAL_INT(J288_ERR_OFFLINE, j288_robot_open(&g_robot, &g_cfg, &o));
+    TEST_ASSERT_NOT_NULL(strstr(j288_robot_error(&g_robot), "bus 'leg1': "));
+    TEST_ASSERT_NOT_NULL(strstr(j288_robot_error(&g_robot), "/dev/j288-no-such"));
+    /* leg0 was closed again: it opens. */
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_robot_open_port(&g_robot, g_sim[0].pty, &o));
+    TEST_ASSERT_EQUAL_INT(J288_ERR_BAD_CONFIG, j288_robot_open_file(&g_robot, "/nonexistent.yaml", &o));
+    TEST_ASSERT_NOT_NULL(strstr(j288_robot_error(&g_robot), "/nonexistent.yaml"));
+}
+
+/* One bus of four stops answering (its simulator frozen): it goes down after down_after
+ * empty sweeps, the others keep every cycle fresh, nothing hangs; it comes back up. Then a
+ * simulator exits: that bus is gone, the others go on. */
+static void test_one_bus_stops_answering(void)
+{
+    j288_robot_options_t o = counting_options();
+    j288_robot_bus_stats_t bs;
+    unsigned i, j;
+    int k;
+    for (k = 0; k < NSIM; k++)
+        sim_start(k, "1,2,3");
+    make_config(NSIM, LOADED_MARGIN_US);
+    g_cfg.bus[2].margin_us = 20000u; /* the one that will not answer: shorter waits */
+    TEST_ASSERT_EQUAL_INT_MESSAGE(J288_OK, j288_robot_open(&g_robot, &g_cfg, &o),
+                                  j288_robot_error(&g_robot));
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_robot_cycle(&g_robot, 0, NULL));
+
+    TEST_ASSERT_EQUAL_INT(0, kill(g_sim[2].pid, SIGSTOP));
+    g_sim[2].stopped = true;
+    for (i = 0; i < 3; i++)
+        TEST_ASSERT_EQUAL_INT(J288_ERR_TIMEOUT, j288_robot_cycle(&g_robot, 0, NULL));
+    TEST_ASSERT_EQUAL_UINT(1, g_ev_count[J288_ROBOT_EV_BUS_DOWN]);
+    TEST_ASSERT_EQUAL_UINT(2, g_ev_bus[J288_ROBOT_EV_BUS_DOWN]);
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_robot_bus_stats(&g_robot, 2, &bs));
+    TEST_ASSERT_FALSE(bs.up);
+    /* The others go on: their joints fresh in every cycle, bus 2's not. */
+    for (i = 0; i < 5; i++) {
+        j288_robot_cycle_t info;
+        TEST_ASSERT_EQUAL_INT(J288_ERR_TIMEOUT, j288_robot_cycle(&g_robot, 0, &info));
+        TEST_ASSERT_EQUAL_UINT(9, info.fresh);
+        for (j = 0; j < 12; j++) {
+            j288_robot_state_t st;
+            TEST_ASSERT_EQUAL_INT(J288_OK, j288_robot_read(&g_robot, j, &st));
+            TEST_ASSERT_EQUAL(j288_robot_joint_bus(&g_robot, j) != 2, st.fresh);
+        }
+    }
+    /* It answers again: up, and cycles complete again. */
+    TEST_ASSERT_EQUAL_INT(0, kill(g_sim[2].pid, SIGCONT));
+    g_sim[2].stopped = false;
+    for (i = 0; i < 200 && g_ev_count[J288_ROBOT_EV_BUS_UP] == 0; i++)
+        (void)j288_robot_cycle(&g_robot, 0, NULL);
+    TEST_ASSERT_EQUAL_UINT(1, g_ev_count[J288_ROBOT_EV_BUS_UP]);
+    {
+        int rc = J288_ERR_TIMEOUT;
+        for (i = 0; i < 10 && rc != J288_OK; i++)
+            rc = j288_robot_cycle(&g_robot, 0, NULL);
+        TEST_ASSERT_EQUAL_INT(J288_OK, rc);
+    }
+
+    /* A simulator exits: its bus is gone (once), the others go on. */
+    sim_stop(1);
+    for (i = 0; i < 5; i++) {
+        j288_robot_cycle_t info;
+        TEST_ASSERT_EQUAL_INT(J288_ERR_TIMEOUT, j288_robot_cycle(&g_robot, 0, &info));
+        if (i > 0)
+            TEST_ASSERT_EQUAL_UINT(9, info.fresh);
+    }
+    TEST_ASSERT_EQUAL_UINT(1, g_ev_count[J288_ROBOT_EV_BUS_GONE]);
+    TEST_ASSERT_EQUAL_UINT(1, g_ev_bus[J288_ROBOT_EV_BUS_GONE]);
+    TEST_ASSERT_NOT_NULL(strstr(j288_robot_error(&g_robot), "vanished"));
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_robot_bus_stats(&g_robot, 1, &bs));
+    TEST_ASSERT_TRUE(bs.gone);
+    {
+        j288_robot_target_t t = {0, 0, 0, 0, 0};
+        TEST_ASSERT_EQUAL_INT(J288_ERR_OFFLINE, j288_robot_set_target(&g_robot, 3, &t));
+    }
+    /* Every bus gone: the cycle says so at once. */
+    sim_stop(0);
+    sim_stop(2);
+    sim_stop(3);
+    (void)j288_robot_cycle(&g_robot, 0, NULL);
+    (void)j288_robot_cycle(&g_robot, 0, NULL);
+    TEST_ASSERT_EQUAL_INT(J288_ERR_OFFLINE, j288_robot_cycle(&g_robot, 0, NULL));
+    TEST_ASSERT_EQUAL_INT(J288_ERR_OFFLINE, j288_robot_run(&g_robot, 0, 0, 0));
+}
+
+/* The stop flag (a SIGINT handler's): the run stops every bus and returns ABORTED. */
+static volatile sig_atomic_t g_stop;
+static void stop_after_five(void *user, j288_robot_t *r, const j288_robot_cycle_t *c)
+{
+    (void)user;
+    (void)r;
+    if (c->cycle == 5)
+        g_stop = 1;
+}
+
+static void test_stop_flag_stops_every_bus(void)
+{
+    j288_robot_options_t o;
+    j288_robot_stats_t rs;
+    int k;
+    memset(&o, 0, sizeof o);
+    o.on_cycle = stop_after_five;
+    g_stop = 0;
+    for (k = 0; k < 3; k++)
+        sim_start(k, "1,2,3");
+    make_config(3, LOADED_MARGIN_US);
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_robot_open(&g_robot, &g_cfg, &o));
+    j288_robot_set_stop_flag(&g_robot, &g_stop);
+    TEST_ASSERT_EQUAL_INT(J288_ERR_ABORTED, j288_robot_run(&g_robot, 2000, 0, 0));
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_robot_stats(&g_robot, &rs));
+    TEST_ASSERT_EQUAL_UINT32(5, rs.cycles);
+    for (k = 0; k < 3; k++) {
+        sim_stop(k);
+        TEST_ASSERT_TRUE(log_contains(k, " id=15 status=0 wd=1"));
+    }
+    /* A bounded run ends by itself. */
+    TEST_ASSERT_EQUAL_INT(J288_ERR_NULL, j288_robot_run(NULL, 0, 1, 0));
+}
+
+/* A stop while a silent bus waits out a long reply margin: the stop waits for that
+ * transaction's deadline (longer than J288_ROBOT_STOP_TIMEOUT_US), then the broadcast goes out
+ * there too. */
+static void test_stop_waits_for_a_long_margin(void)
+{
+    j288_robot_options_t o;
+    j288_robot_cycle_t info;
+    memset(&o, 0, sizeof o);
+    sim_start(0, "1,2,3");
+    sim_start(1, "1,2,3");
+    make_config(2, LOADED_MARGIN_US);
+    g_cfg.bus[1].margin_us = 400000u; /* beyond J288_ROBOT_STOP_TIMEOUT_US */
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_robot_open(&g_robot, &g_cfg, &o));
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_robot_cycle(&g_robot, 0, NULL));
+    TEST_ASSERT_EQUAL_INT(0, kill(g_sim[1].pid, SIGSTOP));
+    g_sim[1].stopped = true;
+    /* The cycle gives up after 50 ms; bus 1's transaction is still waiting for its reply. */
+    TEST_ASSERT_EQUAL_INT(J288_ERR_TIMEOUT, j288_robot_cycle(&g_robot, 50000u, &info));
+    TEST_ASSERT_EQUAL_UINT(3, info.fresh);
+    TEST_ASSERT_EQUAL_INT_MESSAGE(J288_OK, j288_robot_stop(&g_robot), j288_robot_error(&g_robot));
+    TEST_ASSERT_EQUAL_UINT32(1, j288_robot_bus_wire_stats(&g_robot, 1)->estops);
+    TEST_ASSERT_EQUAL_UINT32(0, j288_robot_bus_wire_stats(&g_robot, 1)->estop_failures);
+    j288_robot_close(&g_robot);
+    TEST_ASSERT_EQUAL_INT(0, kill(g_sim[1].pid, SIGCONT));
+    g_sim[1].stopped = false;
+    sim_stop(1);
+    TEST_ASSERT_TRUE(log_contains(1, " id=15 status=0 wd=1"));
+}
+
+/* Servo level on one bus without a config: scan-like exchanges. */
+static void test_exchange_on_one_port(void)
+{
+    j288_robot_servo_t sv;
+    j288_robot_target_t foc = {0.0, 0.0, 0.0, 0.0, 0.0};
+    j288_robot_options_t o;
+    memset(&o, 0, sizeof o);
+    o.margin_us = LOADED_MARGIN_US;
+    sim_start(0, "2,7");
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_robot_open_port(&g_robot, g_sim[0].pty, &o));
+    TEST_ASSERT_EQUAL_UINT(0, j288_robot_njoints(&g_robot));
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_robot_exchange(&g_robot, 0, 7, NULL, &sv));
+    TEST_ASSERT_EQUAL_UINT(7, sv.id);
+    TEST_ASSERT_EQUAL_DOUBLE(24.0, sv.voltage_v);
+    TEST_ASSERT_EQUAL_INT(J288_ERR_BAD_ID, j288_robot_exchange(&g_robot, 0, 15, NULL, &sv));
+    TEST_ASSERT_EQUAL_INT(J288_ERR_BAD_ARG, j288_robot_exchange(&g_robot, 1, 2, NULL, &sv));
+    foc.kp = -1.0;
+    TEST_ASSERT_EQUAL_INT(J288_ERR_NEG_GAIN, j288_robot_exchange(&g_robot, 0, 2, &foc, &sv));
+    foc.kp = 1.0;
+    foc.pos = sv.pos;
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_robot_exchange(&g_robot, 0, 2, &foc, &sv));
+    TEST_ASSERT_EQUAL_UINT(J288_MODE_FOC, sv.mode);
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_robot_exchange(&g_robot, 0, 7, NULL, &sv));
+    TEST_ASSERT_EQUAL_STRING(J288_VERSION_STRING, j288_robot_version());
+    TEST_ASSERT_TRUE(j288_robot_sizeof() == sizeof(j288_robot_t));
+}
+
+int main(void)
+{
+    UNITY_BEGIN();
+    RUN_TEST(test_four_buses_one_loop);
+    RUN_TEST(test_bad_configs);
+    RUN_TEST(test_missing_device);
+    RUN_TEST(test_one_bus_stops_answering);
+    RUN_TEST(test_stop_flag_stops_every_bus);
+    RUN_TEST(test_stop_waits_for_a_long_margin);
+    RUN_TEST(test_exchange_on_one_port);
+    return UNITY_END();
+}

@@ -1,0 +1,425 @@
+/* `j288 --config robot.yaml log|status|hold|stop`: every bus and joint of a robot config from
+ * one loop (port/linux/j288_robot.h), when no --id or --joint picks one servo. */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cli_bus.h"
+#include "j288_robot.h"
+#include "json.h"
+
+static const char robot_help[] =
+    "usage: j288 --config FILE log|status|hold|stop [options]\n"
+    "\n"
+    "Without --id or --joint, these commands drive every bus and joint of the robot config\n"
+    "FILE from one loop: each cycle sends every joint its command on every bus at once and\n"
+    "ends when every bus that answers is done. Joint frame (the file's zero, direction and\n"
+    "limits), SI units.\n"
+    "  status         read every joint once its angle is known; one line per joint\n"
+    "  log            cycles at --rate for --duration; --csv FILE writes one row per joint\n"
+    "                 per cycle (time_s, cycle, joint, bus, id, fresh, known, pos_rad,\n"
+    "                 speed_rad_s, torque_nm); --hold holds every joint meanwhile\n"
+    "  hold           hold every joint where it is (the file's kp, kd) for --duration, or\n"
+    "                 until Ctrl-C\n"
+    "  stop           broadcast lock on every bus\n"
+    "options:\n"
+    "  --config FILE  the robot config (also accepted before the command)\n"
+    "  --port DEV     the device when the file names no bus\n"
+    "  --margin-us N  reply margin for buses whose entry gives none (default 20000)\n"
+    "  --rate HZ      cycles per second (log, hold; default 500; 0: back to back)\n"
+    "  --duration S   seconds (log: default 1; hold: default until Ctrl-C)\n"
+    "  --csv FILE     (log) per-joint rows\n"
+    "  --hold         (log) hold every joint while logging\n"
+    "  --json         (status, log) machine-readable output\n"
+    "A bus that stops answering is left behind (its joints go stale, reported at the end);\n"
+    "Ctrl-C or SIGTERM sends the broadcast lock on every bus before exiting (130 / 143).\n"
+    "Exit status: 0 done; 1 a device or config error, or a joint that never answered;\n"
+    "2 bad arguments.\n";
+
+enum { OPT_CONFIG = 0, OPT_PORT, OPT_MARGIN, OPT_RATE, OPT_DURATION, OPT_CSV, OPT_HOLD, OPT_JSON };
+static const cli_opt_t robot_opts[] = {
+    {"--config", true, OPT_CONFIG}, {"--port", true, OPT_PORT},   {"--margin-us", true, OPT_MARGIN},
+    {"--rate", true, OPT_RATE},     {"--duration", true, OPT_DURATION}, {"--csv", true, OPT_CSV},
+    {"--hold", false, OPT_HOLD},    {"--json", false, OPT_JSON}, {NULL, false, 0}};
+
+typedef struct {
+    const char *config, *port, *csv;
+    uint32_t margin_us;
+    double rate_hz, duration_s;
+    bool have_duration, hold, json;
+} robot_args_t;
+
+typedef struct {
+    FILE *csv;
+    uint32_t t0;
+    unsigned joint_events, bus_events;
+} robot_run_t;
+
+static const char *const robot_commands[] = {"log", "status", "hold", "stop", NULL};
+
+bool cli_robot_takes(const char *command, int argc, char **argv, const cli_global_t *g)
+{
+    bool config = g->config != NULL, named = false;
+    int i, k;
+    for (k = 0; robot_commands[k] != NULL && strcmp(robot_commands[k], command) != 0; k++) {
+    }
+    if (robot_commands[k] == NULL)
+        return false;
+    for (i = 1; i < argc && strcmp(argv[i], "--") != 0; i++) {
+        if (strcmp(argv[i], "--id") == 0 || strncmp(argv[i], "--id=", 5) == 0 ||
+            strcmp(argv[i], "--joint") == 0 || strncmp(argv[i], "--joint=", 8) == 0)
+            named = true;
+        if (strcmp(argv[i], "--config") == 0 || strncmp(argv[i], "--config=", 9) == 0)
+            config = true;
+    }
+    return config && !named;
+}
+
+static int parse_real_in(const char *opt, const char *v, double lo, double hi, double *out)
+{
+    if (cli_parse_real(opt, v, out) != 0)
+        return -1;
+    if (*out < lo || *out > hi) {
+        cli_error("%s: %s is out of range %g..%g", opt, v, lo, hi);
+        return -1;
+    }
+    return 0;
+}
+
+static int parse_robot_args(int argc, char **argv, const cli_global_t *g, robot_args_t *a,
+                            int *exit_code)
+{
+    cli_args_t p;
+    const char *v;
+    long long n;
+    int key;
+    memset(a, 0, sizeof *a);
+    a->config = g->config;
+    a->port = g->port;
+    a->rate_hz = 500.0;
+    a->duration_s = 1.0;
+    cli_args_init(&p, argc, argv);
+    while ((key = cli_args_next(&p, robot_opts, &v)) != CLI_ARG_END) {
+        int rc = 0;
+        switch (key) {
+        case CLI_ARG_HELP:
+            fputs(robot_help, stdout);
+            *exit_code = CLI_EXIT_OK;
+            return -1;
+        case CLI_ARG_ERROR:
+            *exit_code = CLI_EXIT_USAGE;
+            return -1;
+        case CLI_ARG_POSITIONAL:
+            cli_error("unexpected argument '%s'", v);
+            rc = -1;
+            break;
+        case OPT_CONFIG:
+            a->config = v;
+            break;
+        case OPT_PORT:
+            a->port = v;
+            break;
+        case OPT_MARGIN:
+            rc = cli_parse_int("--margin-us", v, 1, 1000000, &n);
+            a->margin_us = (uint32_t)n;
+            break;
+        case OPT_RATE:
+            rc = parse_real_in("--rate", v, 0.0, 100000.0, &a->rate_hz);
+            break;
+        case OPT_DURATION:
+            rc = parse_real_in("--duration", v, 0.001, 86400.0, &a->duration_s);
+            a->have_duration = true;
+            break;
+        case OPT_CSV:
+            a->csv = v;
+            break;
+        case OPT_HOLD:
+            a->hold = true;
+            break;
+        default: /* OPT_JSON */
+            a->json = true;
+            break;
+        }
+        if (rc != 0) {
+            *exit_code = CLI_EXIT_USAGE;
+            return -1;
+        }
+    }
+    if (a->config == NULL) {
+        cli_error("--config FILE is needed without --id or --joint");
+        *exit_code = CLI_EXIT_USAGE;
+        return -1;
+    }
+    return 0;
+}
+
+static void on_event(void *user, const j288_robot_event_t *ev)
+{
+    robot_run_t *run = user;
+    if (ev->kind == J288_ROBOT_EV_BUS_DOWN || ev->kind == J288_ROBOT_EV_BUS_UP ||
+        ev->kind == J288_ROBOT_EV_BUS_GONE) {
+        static const char *const what[] = {"", "", "stopped answering", "answers again",
+                                           "is gone"};
+        run->bus_events++;
+        fprintf(stderr, "j288: bus %u %s\n", ev->bus, what[ev->kind]);
+    } else if (ev->kind == J288_ROBOT_EV_JOINT) {
+        run->joint_events++;
+    }
+}
+
+static void on_cycle(void *user, j288_robot_t *r, const j288_robot_cycle_t *c)
+{
+    robot_run_t *run = user;
+    unsigned j;
+    if (run->csv == NULL)
+        return;
+    for (j = 0; j < j288_robot_njoints(r); j++) {
+        j288_robot_state_t st;
+        (void)j288_robot_read(r, j, &st);
+        fprintf(run->csv, "%.6f,%u,%s,%s,%d,%d,%d,%.9g,%.9g,%.9g\n",
+                (double)(c->start_us - run->t0) * 1e-6, (unsigned)c->cycle,
+                j288_robot_joint_name(r, j),
+                j288_robot_bus_name(r, (unsigned)j288_robot_joint_bus(r, j)),
+                j288_robot_joint_id(r, j), st.fresh ? 1 : 0, st.known ? 1 : 0, st.pos, st.speed,
+                st.torque);
+    }
+}
+
+/* Cycle until every joint's angle is known (or 200 cycles). Returns the number unknown. */
+static unsigned acquire(j288_robot_t *r)
+{
+    unsigned tries, j, unknown = 0;
+    for (tries = 0; tries < 200; tries++) {
+        int rc = j288_robot_cycle(r, 0, NULL);
+        if (rc == J288_ERR_ABORTED || rc == J288_ERR_OFFLINE)
+            break;
+        unknown = 0;
+        for (j = 0; j < j288_robot_njoints(r); j++) {
+            j288_robot_state_t st;
+            (void)j288_robot_read(r, j, &st);
+            unknown += st.known ? 0u : 1u;
+        }
+        if (unknown == 0u)
+            return 0;
+    }
+    return (unknown == 0u) ? j288_robot_njoints(r) : unknown;
+}
+
+static void print_status(j288_robot_t *r, bool json)
+{
+    unsigned j;
+    cli_json_t jw;
+    if (json) {
+        cli_json_init(&jw, stdout);
+        cli_json_begin_array(&jw, NULL);
+    } else {
+        printf("%-16s %-10s %3s  %-7s %12s %12s %10s %7s %8s  %s\n", "joint", "bus", "id", "state",
+               "pos_rad", "speed_rad_s", "torque_nm", "case_C", "voltage", "faults");
+    }
+    for (j = 0; j < j288_robot_njoints(r); j++) {
+        j288_robot_state_t st;
+        const char *bus = j288_robot_bus_name(r, (unsigned)j288_robot_joint_bus(r, j));
+        (void)j288_robot_read(r, j, &st);
+        if (json) {
+            cli_json_begin_object(&jw, NULL);
+            cli_json_str(&jw, "joint", j288_robot_joint_name(r, j));
+            cli_json_str(&jw, "bus", bus);
+            cli_json_int(&jw, "id", j288_robot_joint_id(r, j));
+            cli_json_bool(&jw, "online", st.online);
+            cli_json_bool(&jw, "known", st.known);
+            if (st.known)
+                cli_json_real(&jw, "pos", st.pos);
+            cli_json_real(&jw, "speed", st.speed);
+            cli_json_real(&jw, "torque", st.torque);
+            cli_json_real(&jw, "case_temp_c", st.case_temp_c);
+            cli_json_real(&jw, "voltage_v", st.voltage_v);
+            cli_json_uint(&jw, "faults", st.faults);
+            cli_json_end_object(&jw);
+        } else if (!st.online) {
+            printf("%-16s %-10s %3d  %-7s\n", j288_robot_joint_name(r, j), bus,
+                   j288_robot_joint_id(r, j), "silent");
+        } else {
+            printf("%-16s %-10s %3d  %-7s %12.6f %12.6f %10.4f %7.1f %7.1fV  0x%x\n",
+                   j288_robot_joint_name(r, j), bus, j288_robot_joint_id(r, j),
+                   st.known ? "known" : "unknown", st.pos, st.speed, st.torque, st.case_temp_c,
+                   st.voltage_v, (unsigned)st.faults);
+        }
+    }
+    if (json) {
+        cli_json_end_array(&jw);
+        cli_json_newline(&jw);
+    }
+}
+
+/* The summary of a run: rate, complete cycles, each bus and each joint that missed cycles. */
+static void print_summary(j288_robot_t *r, double seconds, uint32_t cycles, uint32_t complete,
+                          FILE *f)
+{
+    j288_robot_stats_t rs;
+    unsigned b, j;
+    (void)j288_robot_stats(r, &rs);
+    fprintf(f, "robot: %u cycles in %.3f s: %.1f cycles/s, %u complete, worst cycle %u us\n",
+            (unsigned)cycles, seconds, seconds > 0 ? (double)cycles / seconds : 0.0,
+            (unsigned)complete, (unsigned)rs.worst_cycle_us);
+    for (b = 0; b < j288_robot_nbuses(r); b++) {
+        j288_robot_bus_stats_t bs;
+        const j288_bus_stats_t *ws = j288_robot_bus_wire_stats(r, b);
+        (void)j288_robot_bus_stats(r, b, &bs);
+        fprintf(f, "bus %s: %u sweeps (%u without a reply), %u ok, %u failed, %u timeouts%s%s\n",
+                j288_robot_bus_name(r, b), (unsigned)bs.sweeps, (unsigned)bs.empty_sweeps,
+                (unsigned)ws->ok, (unsigned)ws->failed, (unsigned)ws->timeouts,
+                bs.gone ? ", gone" : "", (!bs.gone && !bs.up) ? ", not answering" : "");
+    }
+    for (j = 0; j < j288_robot_njoints(r); j++) {
+        j288_robot_joint_stats_t js;
+        (void)j288_robot_joint_stats(r, j, &js);
+        if (js.stale_cycles != 0u)
+            fprintf(f, "joint %s: fresh in %u cycles, stale in %u\n", j288_robot_joint_name(r, j),
+                    (unsigned)js.fresh_cycles, (unsigned)js.stale_cycles);
+    }
+}
+
+static int hold_all(j288_robot_t *r)
+{
+    unsigned j;
+    for (j = 0; j < j288_robot_njoints(r); j++) {
+        int rc = j288_robot_hold(r, j);
+        if (rc != J288_OK) {
+            cli_error("joint %s: %s", j288_robot_joint_name(r, j), j288_strerror(rc));
+            return -1;
+        }
+    }
+    return 0;
+}
+
+static FILE *g_csv_open; /* closed by finish() when a command ends before its run */
+
+static int finish(j288_robot_t *r, int code)
+{
+    if (g_csv_open != NULL) {
+        (void)fclose(g_csv_open);
+        g_csv_open = NULL;
+    }
+    if (cli_stop_signal != 0) {
+        (void)j288_robot_stop(r);
+        code = cli_signal_exit_code();
+    }
+    j288_robot_close(r);
+    return code;
+}
+
+int cli_cmd_robot(int argc, char **argv, const cli_global_t *g)
+{
+    static j288_robot_t robot; /* large: not on the stack */
+    const char *cmd = argv[0];
+    robot_args_t a;
+    robot_run_t run;
+    FILE *csv = NULL;
+    j288_robot_options_t o;
+    uint32_t period_us, t_end;
+    int exit_code = CLI_EXIT_OK, rc;
+
+    if (parse_robot_args(argc, argv, g, &a, &exit_code) != 0)
+        return exit_code;
+    memset(&run, 0, sizeof run);
+    memset(&o, 0, sizeof o);
+    o.port = a.port != NULL ? a.port : getenv("J288_PORT");
+    o.margin_us = a.margin_us;
+    o.on_event = on_event;
+    o.on_cycle = on_cycle;
+    o.user = &run;
+    if (a.csv != NULL && strcmp(cmd, "log") == 0) {
+        csv = fopen(a.csv, "w");
+        if (csv == NULL) {
+            cli_error("%s: cannot write", a.csv);
+            return CLI_EXIT_FAIL;
+        }
+        fputs("time_s,cycle,joint,bus,id,fresh,known,pos_rad,speed_rad_s,torque_nm\n", csv);
+        g_csv_open = csv;
+    }
+    cli_signals_install();
+    rc = j288_robot_open_file(&robot, a.config, &o);
+    if (rc != J288_OK) {
+        cli_error("%s", j288_robot_error(&robot));
+        if (csv != NULL)
+            fclose(csv);
+        return CLI_EXIT_FAIL;
+    }
+    j288_robot_set_stop_flag(&robot, &cli_stop_signal);
+
+    if (strcmp(cmd, "stop") == 0) {
+        rc = j288_robot_stop(&robot);
+        if (rc != J288_OK)
+            cli_error("%s", j288_robot_error(&robot));
+        else
+            printf("broadcast lock sent on %u buses\n", j288_robot_nbuses(&robot));
+        return finish(&robot, rc == J288_OK ? CLI_EXIT_OK : CLI_EXIT_FAIL);
+    }
+    {
+        unsigned unknown = acquire(&robot);
+        if (cli_stop_signal != 0)
+            return finish(&robot, CLI_EXIT_OK);
+        if (strcmp(cmd, "status") == 0) {
+            print_status(&robot, a.json);
+            return finish(&robot, unknown == 0u ? CLI_EXIT_OK : CLI_EXIT_FAIL);
+        }
+        if (unknown != 0u && (a.hold || strcmp(cmd, "hold") == 0)) {
+            print_status(&robot, false);
+            cli_error("%u joints have no known angle: nothing to hold", unknown);
+            return finish(&robot, CLI_EXIT_FAIL);
+        }
+    }
+    if ((a.hold || strcmp(cmd, "hold") == 0) && hold_all(&robot) != 0)
+        return finish(&robot, CLI_EXIT_FAIL);
+
+    /* log and hold: cycles at the rate; the statistics restart here (the start's cycles). */
+    period_us = (a.rate_hz > 0.0) ? (uint32_t)(1e6 / a.rate_hz + 0.5) : 0u;
+    if (period_us == 0u && a.rate_hz > 0.0)
+        period_us = 1u;
+    {
+        j288_robot_stats_t before, after;
+        uint32_t t0 = j288_linux_now_us(), dur_us;
+        bool forever = strcmp(cmd, "hold") == 0 && !a.have_duration;
+        (void)j288_robot_stats(&robot, &before);
+        run.t0 = t0;
+        run.csv = csv; /* from the first cycle after the start */
+        g_csv_open = NULL;
+        dur_us = (uint32_t)(a.duration_s * 1e6);
+        t_end = t0 + dur_us;
+        do {
+            /* Runs of at most 10 min keep the 32-bit clock's comparisons valid. */
+            uint32_t left = forever ? 600000000u : t_end - j288_linux_now_us();
+            if (!forever && (int32_t)left <= 0)
+                break;
+            rc = j288_robot_run(&robot, period_us, 0, left > 600000000u ? 600000000u : left);
+        } while (rc == J288_OK && (forever || (int32_t)(t_end - j288_linux_now_us()) > 0));
+        (void)j288_robot_stats(&robot, &after);
+        run.csv = NULL;
+        if (csv != NULL && fclose(csv) != 0)
+            cli_error("%s: write failed", a.csv);
+        if (rc == J288_ERR_OFFLINE)
+            cli_error("%s", j288_robot_error(&robot));
+        if (rc != J288_ERR_ABORTED || cli_stop_signal != 0) {
+            double secs = (double)(j288_linux_now_us() - t0) * 1e-6;
+            if (a.json && strcmp(cmd, "log") == 0) {
+                cli_json_t jw;
+                cli_json_init(&jw, stdout);
+                cli_json_begin_object(&jw, NULL);
+                cli_json_uint(&jw, "cycles", after.cycles - before.cycles);
+                cli_json_uint(&jw, "complete_cycles", after.complete_cycles - before.complete_cycles);
+                cli_json_real(&jw, "seconds", secs);
+                cli_json_real(&jw, "cycles_per_s", (double)(after.cycles - before.cycles) / secs);
+                cli_json_uint(&jw, "joints", j288_robot_njoints(&robot));
+                cli_json_uint(&jw, "buses", j288_robot_nbuses(&robot));
+                cli_json_end_object(&jw);
+                cli_json_newline(&jw);
+            } else {
+                print_summary(&robot, secs, after.cycles - before.cycles,
+                              after.complete_cycles - before.complete_cycles, stdout);
+            }
+        }
+        if (strcmp(cmd, "hold") == 0 || a.hold)
+            (void)j288_robot_stop(&robot);
+        return finish(&robot, rc == J288_OK || rc == J288_ERR_ABORTED ? CLI_EXIT_OK : CLI_EXIT_FAIL);
+    }
+}
