@@ -24,6 +24,8 @@ typedef struct {
     uint32_t count;
 } board_fault_t;
 extern volatile board_fault_t board_fault;
+/* The system clock runs from the external clock (true) or fell back to the HSI (false). */
+extern volatile bool board_clock_hse;
 
 /* Clocks, pins, DMA, NVIC, UART, timer, CRC unit; board_fatal() on any failure. */
 void board_init(void);

@@ -69,6 +69,7 @@ void board_init(void)
 }
 
 volatile board_fault_t board_fault;
+volatile bool board_clock_hse;
 
 bool board_estop_pressed(void)
 {

@@ -1,7 +1,8 @@
 /*
- * Minimal startup for the example on an STM32F405/407: vector table with the interrupts the
- * example uses, .data copy, .bss clear, FPU enable, main(). (CubeMX projects bring their own
- * startup_stm32f4xx.s; this one exists so that the example links without ST's files.)
+ * Minimal startup for the link check of the example against the HAL stub (an STM32F4: F405,
+ * F407, F446 share these vectors): vector table with the interrupts the example uses, .data
+ * copy, .bss clear, FPU enable, main(). The firmware (`make firmware`) and CubeMX projects use
+ * ST's startup_stm32f4xx.s; this one exists so that the example links without ST's files.
  */
 #include <stdint.h>
 

@@ -2,9 +2,10 @@
  * board.c - NUCLEO-G474RE bring-up for the j288 example, against ST's real STM32G4 HAL: the
  * second family (a configurable CRC unit, DMAMUX, a USART with its own baud formula).
  *
- * Clock tree (exact 6 Mbps): HSE 24 MHz crystal (-DBOARD_CLOCK_HSI=1: the internal 16 MHz),
- * PLL M=6 (HSI: 4), N=84, R=2 -> SYSCLK 168 MHz (range 1 boost, 4 flash wait states; 168
- * rather than the 170 maximum because 170 MHz gives no exact 6 Mbps); AHB, APB1, APB2 168 MHz.
+ * Clock tree (exact 6 Mbps): HSE 24 MHz crystal (without it, or with -DBOARD_CLOCK_HSI=1, the
+ * internal 16 MHz), PLL M=6 (HSI: 4), N=84, R=2 -> SYSCLK 168 MHz (range 1 boost, 4 flash
+ * wait states; 168 rather than the 170 maximum because 170 MHz gives no exact 6 Mbps); AHB,
+ * APB1, APB2 168 MHz.
  * USART1 on PCLK2 with 16x oversampling: USARTDIV = 168 MHz / 6 Mbps = 28 exactly (BRR 28),
  * checked at init. (The G4's USART reaches 6 Mbps with OVER16 where the F4's at 90 MHz
  * cannot, and 16x sampling tolerates more noise.)
@@ -34,6 +35,7 @@ CRC_HandleTypeDef hcrc;
 #endif
 
 volatile board_fault_t board_fault;
+volatile bool board_clock_hse;
 
 void board_fatal(void)
 {
@@ -42,32 +44,35 @@ void board_fatal(void)
     }
 }
 
-static void clock_init(void)
+/* The PLL from the 24 MHz crystal or from the 16 MHz HSI, to 4 MHz at its input, VCO
+ * 336 MHz, 168 MHz out. */
+static HAL_StatusTypeDef pll_start(bool hse)
 {
     RCC_OscInitTypeDef osc = {0};
+    osc.OscillatorType = RCC_OSCILLATORTYPE_HSE | RCC_OSCILLATORTYPE_HSI;
+    osc.HSEState = hse ? RCC_HSE_ON : RCC_HSE_OFF;
+    osc.HSIState = RCC_HSI_ON;
+    osc.HSICalibrationValue = RCC_HSICALIBRATION_DEFAULT;
+    osc.PLL.PLLState = RCC_PLL_ON;
+    osc.PLL.PLLSource = hse ? RCC_PLLSOURCE_HSE : RCC_PLLSOURCE_HSI;
+    osc.PLL.PLLM = hse ? RCC_PLLM_DIV6 : RCC_PLLM_DIV4;
+    osc.PLL.PLLN = 84u;
+    osc.PLL.PLLP = RCC_PLLP_DIV2;
+    osc.PLL.PLLQ = RCC_PLLQ_DIV2;
+    osc.PLL.PLLR = RCC_PLLR_DIV2;
+    return HAL_RCC_OscConfig(&osc);
+}
+
+static void clock_init(void)
+{
     RCC_ClkInitTypeDef clk = {0};
 
     if (HAL_PWREx_ControlVoltageScaling(PWR_REGULATOR_VOLTAGE_SCALE1_BOOST) != HAL_OK) {
         board_fatal();
     }
-#if BOARD_CLOCK_HSI
-    osc.OscillatorType = RCC_OSCILLATORTYPE_HSI;
-    osc.HSIState = RCC_HSI_ON;
-    osc.HSICalibrationValue = RCC_HSICALIBRATION_DEFAULT;
-    osc.PLL.PLLSource = RCC_PLLSOURCE_HSI;
-    osc.PLL.PLLM = RCC_PLLM_DIV4;
-#else
-    osc.OscillatorType = RCC_OSCILLATORTYPE_HSE;
-    osc.HSEState = RCC_HSE_ON;
-    osc.PLL.PLLSource = RCC_PLLSOURCE_HSE;
-    osc.PLL.PLLM = RCC_PLLM_DIV6;
-#endif
-    osc.PLL.PLLState = RCC_PLL_ON;
-    osc.PLL.PLLN = 84u; /* VCO 336 MHz */
-    osc.PLL.PLLP = RCC_PLLP_DIV2;
-    osc.PLL.PLLQ = RCC_PLLQ_DIV2;
-    osc.PLL.PLLR = RCC_PLLR_DIV2;
-    if (HAL_RCC_OscConfig(&osc) != HAL_OK) {
+    /* Without the crystal the board still boots, on the HSI (board_clock_hse says which). */
+    board_clock_hse = !BOARD_CLOCK_HSI && (pll_start(true) == HAL_OK);
+    if (!board_clock_hse && (pll_start(false) != HAL_OK)) {
         board_fatal();
     }
     clk.ClockType = RCC_CLOCKTYPE_HCLK | RCC_CLOCKTYPE_SYSCLK | RCC_CLOCKTYPE_PCLK1 | RCC_CLOCKTYPE_PCLK2;

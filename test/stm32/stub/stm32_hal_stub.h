@@ -262,7 +262,8 @@ uint32_t HAL_CRC_Calculate(CRC_HandleTypeDef *hcrc, uint32_t pBuffer[], uint32_t
 uint32_t HAL_CRC_Accumulate(CRC_HandleTypeDef *hcrc, uint32_t pBuffer[], uint32_t BufferLength);
 
 /* ---- system ---------------------------------------------------------------------------- */
-/* Interrupt numbers and peripheral addresses of an STM32F405/407 (the example's board). */
+/* Interrupt numbers and peripheral addresses of an STM32F4 (F405/407/446 share them): the
+ * link check of the example (board_stub.c). */
 typedef enum {
     TIM2_IRQn = 28,
     USART1_IRQn = 37,
