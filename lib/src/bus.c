@@ -364,13 +364,18 @@ static void start_attempt(j288_bus_t *bus, uint32_t now)
 static void begin_txn(j288_bus_t *bus, uint8_t id, j288_bus_done_fn done, void *user)
 {
     j288_txn_t *t;
+    unsigned i;
 
     bus->cur ^= 1u;
     t = &bus->txn[bus->cur];
     t->id = id;
     t->result = J288_ERR_BUSY;
     t->attempts = 0u;
-    (void)memset(t->attempt_result, 0, sizeof t->attempt_result);
+    /* Element by element: a few stores, where some targets' compilers (RV32) would call
+     * memset for these 16 bytes. */
+    for (i = 0u; i < (J288_CONFIG_MAX_RETRIES + 1u); i++) {
+        t->attempt_result[i] = J288_OK;
+    }
     t->start_us = 0u;
     t->latency_us = 0u;
     bus->tx_id = id;
