@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # usage: [BUILD=build] [BIN=$BUILD/bin] scripts/demo.sh
 # `make demo`: the j288 tool against the built-in servo simulator, no hardware needed.
-# Starts j288-sim with servos 1, 2, 3 on a pseudo-terminal, scans the bus, moves the three
+# Starts j288-sim with servos 1, 2, 3 on a pseudo-terminal, scans the bus, reads servo 1's
+# absolute joint angle (status --json: joint_pos), moves the three
 # servos through a 2-second swing at 1 kHz while logging (achieved loop rate, tracking error
 # and bus statistics are printed), writes the CSV (and a PNG when gnuplot is installed) under
 # $BUILD/demo/, then stops the simulator. Every step is bounded in time; the simulator is
@@ -40,7 +41,9 @@ run() { # show the command as a user would type it (without the timeout), then r
 
 echo "== starting the simulator: servos 1, 2, 3 on a pseudo-terminal"
 # --exit-after is a backstop only: the trap stops it as soon as the demo ends.
-timeout -k 2 90 "$SIM" --ids 1,2,3 --link "$DEV" --exit-after 80 \
+# Start angles inside [-pi, pi - 0.5]: the swing below stays inside the joints' default range.
+timeout -k 2 90 "$SIM" --ids 1,2,3 --start-angle 1:-0.8 --start-angle 2:0.3 --start-angle 3:1.9 \
+    --link "$DEV" --exit-after 80 \
     >"$OUT/sim.out" 2>"$OUT/sim.err" &
 SIM_PID=$!
 for _ in $(seq 1 100); do
@@ -52,7 +55,10 @@ echo "simulator on $(head -n 1 "$OUT/sim.out"), linked as $DEV"
 
 run timeout -k 2 20 "$J288" --port "$DEV" scan
 
-# A 2-second swing of 0.5 rad (output side) and back, at 1 kHz over the three servos.
+# The absolute joint angle (the output encoder's, wrapped to [-pi, pi), without a config).
+run timeout -k 2 20 "$J288" --port "$DEV" status --id 1 --json
+
+# A 2-second swing of 0.5 rad (joint frame) and back, at 1 kHz over the three servos.
 run timeout -k 2 30 "$J288" --port "$DEV" log --id 1,2,3 --rate 1000 --duration 2 \
     --swing 0.5 --kp 100 --kd 5.7 --csv "$OUT/log.csv"
 

@@ -204,6 +204,14 @@ t_wrap_high_range() {
     "$J288" move --joint j --config "$cfg" --pos 6.2 --speed 1 --duration 1.5 >/dev/null || return 1
     truth_now && near "$(truth_val 1 theta)" "$(python3 -c 'import math; print(6.2 - 2 * math.pi)')" 0.005 || return 1
     status_joint j "$cfg" && near "$(jget "$E2E_TMP/st.json" joint_pos)" 6.2 0.005 || return 1
+    # log: the CSV in the joint frame; a swing leaving the limits is refused before it starts.
+    "$J288" log --config "$cfg" --id 1 --rate 50 --duration 0.2 --csv "$E2E_TMP/w1.csv" "${M[@]}" >/dev/null || return 1
+    python3 -c '
+import csv, sys
+rows = [r for r in csv.DictReader(open(sys.argv[1])) if r["ok"] == "1"]
+assert rows and all(abs(float(r["pos_rad"]) - 6.2) < 0.005 for r in rows), rows[:3]' "$E2E_TMP/w1.csv" || return 1
+    expect_bad log_swing_refused 2 "^j288 log: joint j: --swing: target position outside the joint's limits \[5.8, 6.8\]" \
+        "$J288" log --config "$cfg" --id 1 --swing 1 --duration 1 "${M[@]}"
     stop_sim
 }
 # direction -1, zero 0.1: q = -(theta - 0.1).

@@ -9,6 +9,7 @@
  * dropped reply or a restarted collection does not fail it. */
 #define ACQUIRE_TRIES_PER_SAMPLE 4u
 #define ACQUIRE_TRIES_MIN 40u
+#define ACQUIRE_MAX_FAILS 5u /* failed exchanges in a row */
 
 int cli_robot_load(cli_robot_t *r, const char *path)
 {
@@ -158,6 +159,7 @@ int cli_joint_acquire(cli_bus_t *b, j288_joint_t *j, const char *name, j288_txn_
     unsigned tries = samples * ACQUIRE_TRIES_PER_SAMPLE, n;
     j288_cmd_raw_t cmd;
     j288_txn_t txn;
+    unsigned fails = 0;
     int rc = J288_ERR_TIMEOUT;
     if (tries < ACQUIRE_TRIES_MIN) {
         tries = ACQUIRE_TRIES_MIN;
@@ -166,7 +168,13 @@ int cli_joint_acquire(cli_bus_t *b, j288_joint_t *j, const char *name, j288_txn_
     cli_lock_cmd(j->cfg.id, &cmd);
     for (n = 0; n < tries && !st->known; n++) {
         rc = cli_bus_transfer(b, &cmd, &txn);
-        if (rc == J288_ERR_OFFLINE || cli_stop_signal != 0) {
+        /* A servo that does not answer the first exchange (after the bus's retries) is
+         * treated as absent, as a single exchange would be; later, a run of failures ends it. */
+        if (rc == J288_ERR_OFFLINE || cli_stop_signal != 0 || (rc != J288_OK && *replies == 0u)) {
+            break;
+        }
+        fails = rc == J288_OK ? 0u : fails + 1u;
+        if (fails >= ACQUIRE_MAX_FAILS) {
             break;
         }
         if (rc == J288_OK) {
@@ -186,7 +194,7 @@ int cli_joint_acquire(cli_bus_t *b, j288_joint_t *j, const char *name, j288_txn_
     if (cli_stop_signal != 0) {
         return cli_signal_exit_code();
     }
-    if (*replies == 0u || rc == J288_ERR_OFFLINE) {
+    if (*replies == 0u || rc == J288_ERR_OFFLINE || (report_unknown && rc != J288_OK)) {
         cli_report_txn_failure(b, j->cfg.id, rc);
     } else if (report_unknown) {
         char why[400];

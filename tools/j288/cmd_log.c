@@ -15,7 +15,7 @@
 static const char log_help[] =
     "usage: j288 [--port DEV] log --id N[,M..] --rate HZ --duration S [--csv FILE]\n"
     "                [--hold | --swing AMP [--period S]] [--kp NM_RAD] [--kd NMS_RAD]\n"
-    "                [--side output|rotor] [--json]\n"
+    "                [--side joint|rotor|output] [--config FILE] [--json]\n"
     "\n"
     "Run the cycle scheduler: every 1/HZ seconds one sweep sends each listed servo its\n"
     "command and takes its reply. Without --hold or --swing each servo is sent lock\n"
@@ -26,14 +26,19 @@ static const char log_help[] =
     "  --csv FILE     one row per servo per cycle: time_s, id, ok (1 reply, 0 none),\n"
     "                 pos_rad, speed_rad_s, torque_nm (on --side), case_temp_c,\n"
     "                 winding_temp_c, voltage_v, faults, latency_us, pos_des_rad; a cycle\n"
-    "                 without a reply leaves the measured columns empty\n"
+    "                 without a reply leaves the measured columns empty, and so does a\n"
+    "                 joint angle not known (pos_rad)\n"
     "  --hold         hold each servo where it starts (FOC, kp/kd)\n"
     "  --swing AMP    move each servo from where it starts through\n"
     "                 p0 + AMP (1 - cos(2 pi t / period)) / 2 and back, speed fed forward\n"
     "  --period S     period of the swing (default: --duration, one swing)\n"
     "  --kp, --kd     gains for --hold/--swing (default output side 20 N*m/rad, 2.5 N*m*s/rad)\n"
     "  --watchdog W   on (default when driving) or off\n"
-    "  --side S       units of AMP, gains and CSV: output (default) or rotor\n"
+    "  --side S       frame of AMP, gains and CSV: joint (default: the absolute joint angle,\n"
+    "                 the output encoder's wrapped to [-pi, pi) or the --config joints'),\n"
+    "                 rotor (raw), or output (rotor / N from where the rotor started)\n"
+    "  --config FILE  the joints of the listed ids: zero, direction, limits (a swing\n"
+    "                 leaving them is refused before it starts), phase\n"
     "Prints the achieved rate, missed deadlines (sweeps that ended after the next tick was\n"
     "due: that tick starts late; ticks a whole period behind are skipped, never bunched),\n"
     "bus statistics and, when driving, the tracking error. Ctrl-C or SIGTERM: every driven\n"
@@ -67,6 +72,9 @@ typedef struct {
     bool watchdog;
 } log_args_t;
 
+enum { SIDE_ROTOR = 0, SIDE_OUTPUT = 1, SIDE_JOINT = 2 };
+#define PROBE_SWEEPS_JOINT 40 /* the joints' starts take 8 replies each */
+
 /* Per-servo running figures. */
 typedef struct {
     int32_t p0;
@@ -91,7 +99,7 @@ static int parse_positive(const char *opt, const char *v, double lo, double hi, 
 
 static int parse_log_opt(log_args_t *a, int key, const char *v)
 {
-    static const char *const sides[] = {"rotor", "output", NULL};
+    static const char *const sides[] = {"rotor", "output", "joint", NULL};
     static const char *const onoff[] = {"off", "on", NULL};
     int choice;
     switch (key) {
@@ -128,7 +136,14 @@ static int parse_log_opt(log_args_t *a, int key, const char *v)
         a->have_kd = true;
         return cli_parse_real("--kd", v, &a->kd);
     case OPT_SIDE:
-        return cli_parse_choice("--side", v, sides, &a->side);
+        for (choice = 0; sides[choice] != NULL; choice++) {
+            if (strcmp(v, sides[choice]) == 0) {
+                a->side = choice;
+                return 0;
+            }
+        }
+        cli_error("--side: '%s' is not joint, rotor or output", v);
+        return -1;
     case OPT_WATCHDOG:
         if (cli_parse_choice("--watchdog", v, onoff, &choice) != 0) {
             return -1;
@@ -194,7 +209,7 @@ static int parse_args(int argc, char **argv, log_args_t *a, cli_bus_opts_t *o, i
 /* The base command of a driven servo: FOC, gains, watchdog. */
 static int base_command(const log_args_t *a, j288_cmd_raw_t *cmd)
 {
-    j288_side_t side = a->side == 0 ? J288_SIDE_ROTOR : J288_SIDE_OUTPUT;
+    j288_side_t side = a->side == SIDE_ROTOR ? J288_SIDE_ROTOR : J288_SIDE_OUTPUT;
     double kp = a->have_kp ? a->kp : 20.0;
     double kd = a->have_kd ? a->kd : 2.5;
     int rc;
@@ -241,6 +256,21 @@ static void csv_header(FILE *f)
     fputs("time_s,id,ok,pos_rad,speed_rad_s,torque_nm,case_temp_c,winding_temp_c,voltage_v,"
           "faults,latency_us,pos_des_rad\n",
           f);
+}
+
+static void csv_row_joint(FILE *f, double t, uint8_t id, const j288_slot_t *sl,
+                          const j288_joint_t *j, double pos_des)
+{
+    const j288_reply_raw_t *r = &sl->reply;
+    const j288_joint_state_t *st = j288_joint_state(j);
+    char pos[32] = "";
+    if (st->known) {
+        snprintf(pos, sizeof pos, "%.7g", (double)st->pos);
+    }
+    fprintf(f, "%.6f,%u,1,%s,%.7g,%.7g,%d,%u,%.1f,%lu,%lu,%.7g\n", t, (unsigned)id, pos,
+            (double)st->speed, (double)st->torque, (int)r->case_temp_c,
+            (unsigned)r->winding_temp_c, (double)r->voltage_raw * J288_SCALE_VOLTAGE,
+            (unsigned long)r->faults, (unsigned long)sl->stats.last_latency_us, pos_des);
 }
 
 static void csv_row(FILE *f, double t, uint8_t id, const j288_slot_t *sl, bool fresh,
@@ -301,6 +331,11 @@ typedef struct {
     FILE *csv;              /* NULL without --csv, and once closed */
     servo_acc_t acc[J288_MAX_ID + 1u];
     double pos_des[J288_MAX_ID + 1u];
+    cli_robot_t robot;                 /* --config */
+    cli_joint_sel_t sel[J288_MAX_ID + 1u];
+    j288_joint_t joint[J288_MAX_ID + 1u]; /* side joint */
+    double q0[J288_MAX_ID + 1u];       /* joint angle at the start */
+    uint16_t lost;                     /* ids whose joint angle was lost: locked */
     uint32_t t0;            /* when the cycles began */
     uint32_t sweep_timeout_us;
     run_stats_t rs;
@@ -362,7 +397,7 @@ static void print_summary_json(const log_run_t *r, double achieved)
         cli_json_end_object(&j);
     }
     cli_json_end_array(&j);
-    cli_json_str(&j, "side", r->a.side == 0 ? "rotor" : "output");
+    cli_json_str(&j, "side", r->a.side == SIDE_ROTOR ? "rotor" : (r->a.side == SIDE_OUTPUT ? "output" : "joint"));
     cli_json_end_object(&j);
     cli_json_newline(&j);
 }
@@ -392,13 +427,30 @@ static void print_summary_text(const log_run_t *r, double achieved)
                mean_latency(x), (unsigned long)x->latency_max);
         if (r->a.motion != MOTION_NONE && x->err_n != 0u) {
             printf("; tracking error rms %.4g rad, max %.4g rad (%s side)",
-                   sqrt(x->err_sq_sum / x->err_n), x->err_max, r->a.side == 0 ? "rotor" : "output");
+                   sqrt(x->err_sq_sum / x->err_n), x->err_max,
+                   r->a.side == SIDE_ROTOR ? "rotor" : (r->a.side == SIDE_OUTPUT ? "output" : "joint"));
         }
         printf("\n");
     }
     if (r->a.csv != NULL) {
         printf("csv: %s (%lu rows)\n", r->a.csv, (unsigned long)r->rs.rows);
     }
+}
+
+/* --config and the listed ids: each servo's joint (the file's, or the library's defaults). */
+static int log_select_joints(log_run_t *r)
+{
+    uint8_t id;
+    if (cli_robot_load(&r->robot, r->o.config) != 0) {
+        return -1;
+    }
+    for (id = 0; id <= J288_MAX_ID; id++) {
+        if (listed(r, id) && (cli_joint_select(&r->robot, NULL, id, &r->o, &r->sel[id]) != 0 ||
+                              j288_joint_init(&r->joint[id], &r->sel[id].jc) != J288_OK)) {
+            return -1;
+        }
+    }
+    return 0;
 }
 
 /* Parse and check everything that needs no bus. Returns 0, or -1 with *ec the exit status
@@ -408,7 +460,7 @@ static int log_prepare(log_run_t *r, int argc, char **argv, const cli_global_t *
     log_args_t *a = &r->a;
     a->rate_hz = 100.0;
     a->duration_s = 1.0;
-    a->side = 1;
+    a->side = SIDE_JOINT;
     a->watchdog = true;
     cli_bus_opts_init(&r->o, g);
     if (parse_args(argc, argv, a, &r->o, ec) != 0) {
@@ -417,8 +469,11 @@ static int log_prepare(log_run_t *r, int argc, char **argv, const cli_global_t *
     if (!a->have_period) {
         a->period_s = a->duration_s;
     }
-    r->side = a->side == 0 ? J288_SIDE_ROTOR : J288_SIDE_OUTPUT;
+    r->side = a->side == SIDE_ROTOR ? J288_SIDE_ROTOR : J288_SIDE_OUTPUT;
     *ec = CLI_EXIT_USAGE;
+    if (log_select_joints(r) != 0) {
+        return -1;
+    }
     if (a->motion != MOTION_NONE && base_command(a, &r->base) != 0) {
         return -1;
     }
@@ -470,6 +525,35 @@ static int log_open(log_run_t *r)
     return CLI_EXIT_OK;
 }
 
+/* Whether every listed joint knows its angle, or cannot (encoder fault), on the joint side. */
+static bool all_known(const log_run_t *r)
+{
+    uint8_t id;
+    if (r->a.side != SIDE_JOINT) {
+        return true;
+    }
+    for (id = 0; id <= J288_MAX_ID; id++) {
+        const j288_joint_state_t *st = j288_joint_state(&r->joint[id]);
+        if (listed(r, id) && !st->known && !st->encoder_fault) {
+            return false;
+        }
+    }
+    return true;
+}
+
+/* The probe's fresh replies into the joints (seen: each slot's success count so far). */
+static void probe_feed_joints(log_run_t *r, uint32_t *seen)
+{
+    uint8_t id;
+    for (id = 0; id <= J288_MAX_ID; id++) {
+        const j288_slot_t *sl = j288_sched_slot(&r->s, id);
+        if (listed(r, id) && sl->stats.successes != seen[id]) {
+            seen[id] = sl->stats.successes;
+            (void)j288_joint_take_reply(&r->joint[id], &sl->reply, NULL);
+        }
+    }
+}
+
 /* First sweeps: who is there and where each starts; a few tries so that one dropped reply
  * does not fail the whole log. Returns CLI_EXIT_OK, or the exit status when a servo never
  * answered, the device went away or a stop signal came. */
@@ -477,8 +561,11 @@ static int log_probe(log_run_t *r)
 {
     uint8_t id;
     int i;
-    for (i = 0; i < PROBE_SWEEPS && !all_answered(&r->s, r->a.ids); i++) {
+    uint32_t seen[J288_MAX_ID + 1u] = {0};
+    int sweeps = r->a.side == SIDE_JOINT ? PROBE_SWEEPS_JOINT : PROBE_SWEEPS;
+    for (i = 0; i < sweeps && !(all_answered(&r->s, r->a.ids) && all_known(r)); i++) {
         int rc = sweep(&r->b, &r->s, r->sweep_timeout_us, false);
+        probe_feed_joints(r, seen);
         if (rc == J288_ERR_ABORTED) {
             return cli_signal_exit_code();
         }
@@ -498,12 +585,59 @@ static int log_probe(log_run_t *r)
             return CLI_EXIT_FAIL;
         }
         r->acc[id].p0 = sl->reply.pos;
+        if (r->a.side == SIDE_JOINT && r->a.motion != MOTION_NONE) {
+            const j288_joint_state_t *st = j288_joint_state(&r->joint[id]);
+            if (!st->known) {
+                char why[400];
+                cli_joint_why_unknown(&r->joint[id], r->sel[id].name, 0u, why, sizeof why);
+                cli_error("%s", why);
+                return CLI_EXIT_FAIL;
+            }
+            r->q0[id] = (double)st->pos;
+            if (r->a.motion == MOTION_SWING &&
+                !cli_joint_pos_allowed(&r->sel[id].jc, r->q0[id] + r->a.amp)) {
+                cli_joint_target_error(&r->joint[id], r->sel[id].name, "--swing", J288_ERR_LIMIT_POS);
+                return CLI_EXIT_USAGE;
+            }
+        }
         r->acc[id].seen_successes = sl->stats.successes;
         if (r->a.motion != MOTION_NONE) {
             r->b.driven = (uint16_t)(r->b.driven | (1u << id));
         }
     }
     return CLI_EXIT_OK;
+}
+
+/* Side joint: the joint's target at time t through the joint layer; a joint that lost its
+ * angle (or is refused) is locked for the rest of the run. */
+static void joint_cycle_command(log_run_t *r, uint8_t id, double t)
+{
+    j288_joint_target_t tg;
+    j288_cmd_raw_t cmd;
+    double w = 2.0 * J288_PI / r->a.period_s;
+    int rc;
+    memset(&tg, 0, sizeof tg);
+    tg.kp = (j288_real_t)(r->a.have_kp ? r->a.kp : (r->sel[id].rj != NULL && r->sel[id].rj->has_kp ? r->sel[id].rj->kp : 20.0));
+    tg.kd = (j288_real_t)(r->a.have_kd ? r->a.kd : (r->sel[id].rj != NULL && r->sel[id].rj->has_kd ? r->sel[id].rj->kd : 2.5));
+    tg.pos = (j288_real_t)r->q0[id];
+    if (r->a.motion == MOTION_SWING) {
+        tg.pos = (j288_real_t)(r->q0[id] + r->a.amp * 0.5 * (1.0 - cos(w * t)));
+        tg.speed = (j288_real_t)(r->a.amp * 0.5 * w * sin(w * t));
+    }
+    if ((r->lost & (1u << id)) == 0u) {
+        rc = j288_joint_command(&r->joint[id], &tg, &cmd, NULL);
+        if (rc == J288_OK) {
+            cmd.watchdog = r->a.watchdog;
+            r->pos_des[id] = (double)tg.pos;
+            j288_sched_set_cmd(&r->s, &cmd);
+            return;
+        }
+        cli_joint_target_error(&r->joint[id], r->sel[id].name, "target", rc);
+        r->lost = (uint16_t)(r->lost | (1u << id));
+    }
+    cli_lock_cmd(id, &cmd);
+    r->pos_des[id] = NAN;
+    j288_sched_set_cmd(&r->s, &cmd);
 }
 
 /* This cycle's commands: hold where each servo started, or the swing at time t. Observed
@@ -521,6 +655,10 @@ static void set_cycle_commands(log_run_t *r, double t)
         }
         cmd = r->base;
         cmd.id = id;
+        if (r->a.side == SIDE_JOINT) {
+            joint_cycle_command(r, id, t);
+            continue;
+        }
         if (r->a.motion == MOTION_HOLD) {
             cmd.pos = r->acc[id].p0;
         } else {
@@ -542,7 +680,17 @@ static void account_reply(log_run_t *r, uint8_t id, const j288_slot_t *sl)
     if (lat > x->latency_max) {
         x->latency_max = lat;
     }
-    if (r->a.motion != MOTION_NONE) {
+    if (r->a.side == SIDE_JOINT) {
+        const j288_joint_state_t *st = j288_joint_state(&r->joint[id]);
+        if (r->a.motion != MOTION_NONE && st->known && !isnan(r->pos_des[id])) {
+            double e = fabs(r->pos_des[id] - (double)st->pos);
+            x->err_sq_sum += e * e;
+            x->err_n++;
+            if (e > x->err_max) {
+                x->err_max = e;
+            }
+        }
+    } else if (r->a.motion != MOTION_NONE) {
         double e = fabs(r->pos_des[id] - (double)j288_pos_from_raw(sl->reply.pos, r->side));
         x->err_sq_sum += e * e;
         x->err_n++;
@@ -566,13 +714,20 @@ static void account_cycle(log_run_t *r, double t)
         fresh = sl->stats.successes != x->seen_successes;
         x->seen_successes = sl->stats.successes;
         if (fresh) {
+            if (r->a.side == SIDE_JOINT) {
+                (void)j288_joint_take_reply(&r->joint[id], &sl->reply, NULL);
+            }
             account_reply(r, id, sl);
         } else {
             x->failures++;
         }
         if (r->csv != NULL) {
             double rt = fresh ? (double)(uint32_t)(sl->reply_us - r->t0) / 1e6 : t;
-            csv_row(r->csv, rt, id, sl, fresh, r->side, r->pos_des[id]);
+            if (fresh && r->a.side == SIDE_JOINT) {
+                csv_row_joint(r->csv, rt, id, sl, &r->joint[id], r->pos_des[id]);
+            } else {
+                csv_row(r->csv, rt, id, sl, fresh, r->side, r->pos_des[id]);
+            }
             r->rs.rows++;
         }
     }
@@ -669,7 +824,7 @@ static int log_finish(log_run_t *r, log_end_t end)
     if (end == LOG_INTERRUPTED) {
         return cli_signal_exit_code();
     }
-    return failed ? CLI_EXIT_FAIL : CLI_EXIT_OK;
+    return failed || r->lost != 0u ? CLI_EXIT_FAIL : CLI_EXIT_OK;
 }
 
 int cli_cmd_log(int argc, char **argv, const cli_global_t *g)

@@ -14,7 +14,8 @@ static const char plot_help[] =
     "usage: j288 plot FILE.csv --png OUT.png\n"
     "\n"
     "Draw position (with the commanded position dashed), speed and torque against time,\n"
-    "one line per servo, from a CSV written by `j288 log`, using gnuplot.\n"
+    "one line per servo, from a CSV written by `j288 log`, using gnuplot, in the frame the\n"
+    "log was written in (the joint frame unless log was given --side rotor or output).\n"
     "Exit status: 0 PNG written; 1 unreadable CSV or gnuplot failed; 2 bad arguments;\n"
     "3 gnuplot is not installed (install the Debian package gnuplot-nox).\n";
 
@@ -112,7 +113,9 @@ static int write_datablock(FILE *gp, const char *file, unsigned id)
             strtol(field[1], NULL, 10) != (long)id) {
             continue;
         }
-        fprintf(gp, "%s %s %s %s %s\n", field[0], field[3], field[4], field[5],
+        /* A joint angle not yet known is an empty pos_rad: a gap, not a shifted column. */
+        fprintf(gp, "%s %s %s %s %s\n", field[0], field[3][0] != '\0' ? field[3] : "NaN",
+                field[4], field[5],
                 field[11][0] != '\0' ? field[11] : "NaN");
     }
     fprintf(gp, "EOD\n");
