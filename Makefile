@@ -130,7 +130,7 @@ install: $(LIB_A) $(J288_BIN) $(SIM_BIN)
 	install -m 755 $(J288_BIN) $(SIM_BIN) $(DESTDIR)$(BINDIR)/
 	bash scripts/cmake-config.sh $(DESTDIR)$(LIBDIR)/cmake/j288 $(J288_VERSION) \
 	    $(patsubst $(PREFIX)/%,%,$(LIBDIR)) $(patsubst $(PREFIX)/%,%,$(INCLUDEDIR))
-	@# (a pkg-config file and a shared library, once the build makes them, install here)
+	@# (mk/release.mk adds the shared library, j288.pc, the port headers, the Python package)
 
 clean:
 	rm -rf $(BUILD)
