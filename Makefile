@@ -130,7 +130,7 @@ install: $(LIB_A) $(J288_BIN) $(SIM_BIN)
 	install -m 755 $(J288_BIN) $(SIM_BIN) $(DESTDIR)$(BINDIR)/
 	bash scripts/cmake-config.sh $(DESTDIR)$(LIBDIR)/cmake/j288 $(J288_VERSION) \
 	    $(patsubst $(PREFIX)/%,%,$(LIBDIR)) $(patsubst $(PREFIX)/%,%,$(INCLUDEDIR))
-	@# (a pkg-config file and a shared library, once the build makes them, install here)
+	@# (mk/release.mk adds the shared library, j288.pc, the port headers, the Python package)
 
 clean:
 	rm -rf $(BUILD)
@@ -139,7 +139,9 @@ help:
 	@echo "make                build library, tools, example and host tests into $(BUILD)/"
 	@echo "make test           every host test (fetches Unity on first use)"
 	@echo "make demo           the CLI against the built-in servo simulator"
-	@echo "make install        library, headers, CMake package, j288, j288-sim (PREFIX, DESTDIR)"
+	@echo "make install        static and shared library, headers, CMake package, j288.pc, j288,"
+	@echo "                    j288-sim, Python package (PREFIX, DESTDIR)"
+	@echo "make shared python  libj288.so; and a copy in python/j288 (the Python package in place)"
 	@echo "make arm            lib/ for each Cortex-M, size table, STM32 example, port template"
 	@echo "make firmware       STM32 firmware per board against ST's HAL (bash scripts/fetch-st.sh first)"
 	@echo "make test-target    unit tests on each CPU under QEMU ($(CPUS))"

@@ -11,6 +11,7 @@ import re
 import subprocess
 import sys
 import textwrap
+import time
 from pathlib import Path
 from typing import Iterator, List
 
@@ -44,8 +45,15 @@ class Sim:
                 self.proc.kill()
                 self.proc.wait()
 
-    def logged(self, needle: str) -> bool:
-        return self.log.exists() and needle in self.log.read_text()
+    def logged(self, needle: str, wait: float = 20.0) -> bool:
+        """Whether the simulator logged needle, waiting up to `wait` s for it to read."""
+        deadline = time.monotonic() + wait
+        while True:
+            if self.log.exists() and needle in self.log.read_text():
+                return True
+            if time.monotonic() >= deadline or self.proc.poll() is not None:
+                return self.log.exists() and needle in self.log.read_text()
+            time.sleep(0.05)
 
 
 @pytest.fixture
@@ -124,7 +132,6 @@ def test_bus_status_and_command(sims) -> None:
             bus.command(2, pos=1e9)
         assert e.value.name == "J288_ERR_RANGE_POS"
     assert sim.logged(" id=2 status=1 wd=1")
-    sim.stop()
     assert sim.logged(" id=15 status=0 wd=1"), "the with block's exit sends the broadcast lock"
 
 
@@ -182,7 +189,6 @@ def test_robot_two_buses(sims, tmp_path: Path) -> None:
         assert robot.joint_stats("leg0_1")["fresh_cycles"] == stats["cycles"]
     for s in (s0, s1):
         assert s.logged(" id=2 status=1 wd=1")
-        s.stop()
         assert s.logged(" id=15 status=0 wd=1")
 
 
@@ -195,7 +201,6 @@ def test_robot_stop_on_exception(sims, tmp_path: Path) -> None:
             robot.hold()
             robot.cycle()
             raise RuntimeError("the controller failed")
-    s0.stop()
     assert s0.logged(" id=15 status=0 wd=1")
 
 

@@ -21,7 +21,8 @@ static const char robot_help[] =
     "                 speed_rad_s, torque_nm); --hold holds every joint meanwhile\n"
     "  hold           hold every joint where it is (the file's kp, kd) for --duration, or\n"
     "                 until Ctrl-C\n"
-    "  stop           broadcast lock on every bus\n"
+    "  stop           broadcast lock on every bus (each on its own: a bus that cannot be\n"
+    "                 opened is reported, the others are stopped)\n"
     "options:\n"
     "  --config FILE  the robot config (also accepted before the command)\n"
     "  --port DEV     the device when the file names no bus\n"
@@ -292,6 +293,50 @@ static int hold_all(j288_robot_t *r)
     return 0;
 }
 
+/* stop: every bus on its own, so that a bus that cannot be opened does not keep the
+ * broadcast lock from the others. */
+static int stop_each_bus(const robot_args_t *a, const j288_robot_options_t *o)
+{
+    static j288_robot_config_t cfg;
+    static j288_robot_t one;
+    char err[J288_ROBOT_CONFIG_ERROR_MAX];
+    size_t i, n, failed = 0;
+    if (j288_robot_config_load(a->config, &cfg, err, sizeof err) != 0) {
+        cli_error("%s", err);
+        return CLI_EXIT_FAIL;
+    }
+    n = (cfg.nbuses == 0u) ? 1u : cfg.nbuses;
+    for (i = 0; i < n; i++) {
+        j288_robot_options_t bo = *o;
+        const char *port = o->port;
+        int rc;
+        bo.on_event = NULL;
+        bo.on_cycle = NULL;
+        if (cfg.nbuses != 0u) {
+            port = cfg.bus[i].port;
+            if (cfg.bus[i].has_baud)
+                bo.baud = cfg.bus[i].baud;
+            if (cfg.bus[i].has_margin_us)
+                bo.margin_us = cfg.bus[i].margin_us;
+        }
+        if (port == NULL) {
+            cli_error("the config names no bus and no --port was given");
+            return CLI_EXIT_USAGE;
+        }
+        rc = j288_robot_open_port(&one, port, &bo);
+        if (rc == J288_OK)
+            rc = j288_robot_stop(&one);
+        if (rc != J288_OK) {
+            cli_error("bus %s: %s", cfg.nbuses != 0u ? cfg.bus[i].name : port,
+                      j288_robot_error(&one));
+            failed++;
+        }
+        j288_robot_close(&one);
+    }
+    printf("broadcast lock sent on %zu of %zu buses\n", n - failed, n);
+    return failed == 0u ? CLI_EXIT_OK : CLI_EXIT_FAIL;
+}
+
 static FILE *g_csv_open; /* closed by finish() when a command ends before its run */
 
 static int finish(j288_robot_t *r, int code)
@@ -338,6 +383,8 @@ int cli_cmd_robot(int argc, char **argv, const cli_global_t *g)
         g_csv_open = csv;
     }
     cli_signals_install();
+    if (strcmp(cmd, "stop") == 0)
+        return stop_each_bus(&a, &o);
     rc = j288_robot_open_file(&robot, a.config, &o);
     if (rc != J288_OK) {
         cli_error("%s", j288_robot_error(&robot));
@@ -347,14 +394,6 @@ int cli_cmd_robot(int argc, char **argv, const cli_global_t *g)
     }
     j288_robot_set_stop_flag(&robot, &cli_stop_signal);
 
-    if (strcmp(cmd, "stop") == 0) {
-        rc = j288_robot_stop(&robot);
-        if (rc != J288_OK)
-            cli_error("%s", j288_robot_error(&robot));
-        else
-            printf("broadcast lock sent on %u buses\n", j288_robot_nbuses(&robot));
-        return finish(&robot, rc == J288_OK ? CLI_EXIT_OK : CLI_EXIT_FAIL);
-    }
     {
         unsigned unknown = acquire(&robot);
         if (cli_stop_signal != 0)
