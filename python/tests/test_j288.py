@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import os
 import re
+import signal
 import subprocess
 import sys
 import textwrap
@@ -235,3 +236,53 @@ def test_robot_bus_gone(sims, tmp_path: Path) -> None:
         with pytest.raises(j288.OfflineError):
             for _ in range(4):
                 robot.cycle()
+
+
+def test_robot_without_numpy(sims, tmp_path: Path, monkeypatch) -> None:
+    s0 = sims("1,2,3")
+    cfg = write_config(tmp_path, [s0.pty])
+    monkeypatch.setattr(j288.robot, "_np", None)
+    with j288.Robot(str(cfg)) as robot:
+        cycle_until_known(robot)
+        pos, speed, torque, known = robot.read()
+        assert isinstance(pos, list) and len(pos) == 3 and known == [True] * 3
+        robot.set_targets(pos)
+        with pytest.raises(ValueError):
+            robot.set_targets(pos[:2])
+        assert robot.cycle().complete
+
+
+def test_ctrl_c_stops_every_bus(sims, tmp_path: Path) -> None:
+    """KeyboardInterrupt in a controller's loop: the with block sends the broadcast lock."""
+    s0, s1 = sims("1,2,3"), sims("1,2,3")
+    cfg = write_config(tmp_path, [s0.pty, s1.pty])
+    ready = tmp_path / "ready"
+    script = textwrap.dedent(f"""\
+        import pathlib, j288
+        with j288.Robot({str(cfg)!r}) as robot:
+            while not all(robot.read()[3]):
+                robot.cycle()
+            robot.hold()
+            robot.cycle()
+            pathlib.Path({str(ready)!r}).write_text("1")
+            while True:
+                robot.cycle()
+        """)
+    proc = subprocess.Popen([sys.executable, "-c", script],
+                            env=dict(os.environ, PYTHONPATH=str(ROOT / "python")),
+                            stderr=subprocess.PIPE, text=True)
+    try:
+        for _ in range(600):
+            if ready.exists() or proc.poll() is not None:
+                break
+            time.sleep(0.05)
+        assert ready.exists(), "the controller did not start"
+        proc.send_signal(signal.SIGINT)
+        _, err = proc.communicate(timeout=60)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+    assert proc.returncode != 0 and "KeyboardInterrupt" in err
+    for s in (s0, s1):
+        assert s.logged(" id=15 status=0 wd=1")
