@@ -140,32 +140,6 @@ static void reset_robot(j288_robot_t *r, const j288_robot_options_t *opt)
     r->cycle = 1;
 }
 
-/* The joint layer's configuration from a config file's joint. */
-static void joint_config_from(const j288_robot_config_joint_t *cj, j288_joint_config_t *jc)
-{
-    memset(jc, 0, sizeof *jc);
-    jc->id = cj->id;
-    jc->direction = (int8_t)cj->direction;
-    jc->clamp = cj->clamp;
-    jc->zero = (j288_real_t)cj->zero;
-    if (cj->has_limits) {
-        jc->pos_min = (j288_real_t)cj->pos_min;
-        jc->pos_max = (j288_real_t)cj->pos_max;
-    }
-    if (cj->has_max_speed)
-        jc->max_speed = (j288_real_t)cj->max_speed;
-    if (cj->has_max_torque)
-        jc->max_torque = (j288_real_t)cj->max_torque;
-    if (cj->has_kp)
-        jc->kp = (j288_real_t)cj->kp;
-    if (cj->has_kd)
-        jc->kd = (j288_real_t)cj->kd;
-    if (cj->has_phase) {
-        jc->has_phase = true;
-        jc->phase = (j288_real_t)cj->phase;
-    }
-}
-
 /* Names, devices and ids are checked here too: a config may be built by hand. */
 static int check_config(j288_robot_t *r, const j288_robot_config_t *cfg)
 {
@@ -301,7 +275,7 @@ static int add_joint(j288_robot_t *r, const j288_robot_config_joint_t *cj, unsig
     unsigned j = r->njoints;
     j288_joint_config_t jc;
     int rc;
-    joint_config_from(cj, &jc);
+    j288_robot_config_joint_config(cj, &jc);
     rc = j288_joint_init(&r->joint[j], &jc);
     if (rc == J288_OK)
         rc = j288_joint_bus_add(&b->jb, &r->joint[j]);
