@@ -15,6 +15,18 @@ add_executable(j288_cli ${_j288_cli_sources})
 # The tools are POSIX programs (signals, realpath, popen); lib/ stays pure C99.
 target_compile_definitions(j288_cli PRIVATE _XOPEN_SOURCE=700)
 target_link_libraries(j288_cli PRIVATE j288_linux)
+# The robot config reader (--config): with libyaml when found (Debian's libyaml-dev), else
+# built as stubs that say robot config files need it.
+target_sources(j288_cli PRIVATE "${PROJECT_SOURCE_DIR}/port/linux/j288_robot_config.c")
+find_path(J288_YAML_INCLUDE yaml.h)
+find_library(J288_YAML_LIB yaml)
+if(J288_YAML_INCLUDE AND J288_YAML_LIB)
+    target_compile_definitions(j288_cli PRIVATE J288_HAVE_LIBYAML)
+    target_include_directories(j288_cli PRIVATE "${J288_YAML_INCLUDE}")
+    target_link_libraries(j288_cli PRIVATE "${J288_YAML_LIB}")
+else()
+    message(STATUS "j288: libyaml not found: j288 --config is unavailable (install libyaml-dev)")
+endif()
 
 add_executable(j288_sim "${PROJECT_SOURCE_DIR}/tools/j288-sim/servo_model.c"
                         "${PROJECT_SOURCE_DIR}/tools/j288-sim/sim_main.c")
