@@ -99,7 +99,13 @@ status_json() {
     timeout -k 2 60 "$J288" --port "$DEV" status --id "$id" --json "${M[@]}" "$@" >"$E2E_TMP/st.json" 2>"$E2E_TMP/st.err"
 }
 status_joint() { # NAME CONFIG: status --joint NAME --config CONFIG (the port from the file)
-    timeout -k 2 60 "$J288" status --joint "$1" --config "$2" --json "${M[@]}" >"$E2E_TMP/st.json" 2>"$E2E_TMP/st.err"
+    timeout -k 2 60 "$J288" status --joint "$1" --config "$2" --json "${M[@]}" >"$E2E_TMP/st.json" 2>"$E2E_TMP/st.err" ||
+        { echo "status --joint $1: exit $?: $(cat "$E2E_TMP/st.err")"; return 1; }
+}
+move_joint() { # NAME CONFIG MOVE-OPTIONS...: move --joint NAME --config CONFIG, quiet unless it fails
+    local name=$1 cfg=$2; shift 2
+    timeout -k 2 60 "$J288" move --joint "$name" --config "$cfg" "${M[@]}" "$@" >/dev/null 2>"$E2E_TMP/mv.err" ||
+        { echo "move --joint $name $*: exit $?: $(cat "$E2E_TMP/mv.err")"; return 1; }
 }
 foc_frames() { grep -c "id=$1 status=1 " "$SLOG"; }
 # config NAME BODY...: a robot config on this simulator's bus with one joint (BODY lines).
@@ -187,10 +193,10 @@ t_wrap_around_zero() {
     cfg=$(config w0 "  - name: j" "    id: 1" "    limits: [-0.5, 0.5]")
     status_joint j "$cfg" || return 1
     near "$(jget "$E2E_TMP/st.json" joint_pos)" 0.01 0.0004 || return 1
-    "$J288" move --joint j --config "$cfg" --pos -0.03 --speed 1 --duration 1 >/dev/null || return 1
+    move_joint j "$cfg" --pos -0.03 --speed 1 --duration 1 || return 1
     truth_now && near "$(truth_val 1 theta)" -0.03 0.005 || return 1
     status_joint j "$cfg" && near "$(jget "$E2E_TMP/st.json" joint_pos)" -0.03 0.005 || return 1
-    "$J288" move --joint j --config "$cfg" --pos 0.03 --speed 1 --duration 1 >/dev/null || return 1
+    move_joint j "$cfg" --pos 0.03 --speed 1 --duration 1 || return 1
     truth_now && near "$(truth_val 1 theta)" 0.03 0.005 || return 1
     stop_sim
 }
@@ -201,7 +207,7 @@ t_wrap_high_range() {
     cfg=$(config w1 "  - name: j" "    id: 1" "    limits: [5.8, 6.8]")
     status_joint j "$cfg" || return 1
     near "$(jget "$E2E_TMP/st.json" joint_pos)" "$(python3 -c 'import math; print(0.3 + 2 * math.pi)')" 0.0004 || return 1
-    "$J288" move --joint j --config "$cfg" --pos 6.2 --speed 1 --duration 1.5 >/dev/null || return 1
+    move_joint j "$cfg" --pos 6.2 --speed 1 --duration 1.5 || return 1
     truth_now && near "$(truth_val 1 theta)" "$(python3 -c 'import math; print(6.2 - 2 * math.pi)')" 0.005 || return 1
     status_joint j "$cfg" && near "$(jget "$E2E_TMP/st.json" joint_pos)" 6.2 0.005 || return 1
     # log: the CSV in the joint frame; a swing leaving the limits is refused before it starts.
@@ -220,7 +226,7 @@ t_direction() {
     start_sim dir --ids 1 --start-angle 1:0.05 --quiet || return 1
     cfg=$(config d "  - name: j" "    id: 1" "    direction: -1" "    zero: 0.1" "    limits: [-0.5, 0.5]")
     status_joint j "$cfg" && near "$(jget "$E2E_TMP/st.json" joint_pos)" 0.05 0.0004 || return 1
-    "$J288" move --joint j --config "$cfg" --pos 0.2 --speed 1 --duration 1 >/dev/null || return 1
+    move_joint j "$cfg" --pos 0.2 --speed 1 --duration 1 || return 1
     truth_now && near "$(truth_val 1 theta)" -0.1 0.005 || return 1
     stop_sim
 }
