@@ -293,9 +293,18 @@ t_config_errors() {
     # --id with --config takes the file's joint for that id (its limits apply).
     printf 'joints:\n  - name: j\n    id: 1\n    limits: [-0.1, 0.1]\n' >"$E2E_TMP/id.yaml"
     expect_bad config_by_id 2 'limits \[-0.1, 0.1\]' "$J288" --port "$DEV" move --config "$E2E_TMP/id.yaml" --id 1 --pos 0.5
+    # Two buses use id 1: --id needs --port to say which (or --joint); the file's port is used.
+    printf 'buses:\n  - {name: a, port: %s}\n  - {name: b, port: /nonexistent/j288}\njoints:\n  - {name: ja, bus: a, id: 1, limits: [-0.1, 0.1]}\n  - {name: jb, bus: b, id: 1}\n' "$DEV" >"$E2E_TMP/two.yaml"
+    expect_bad config_id_two_buses 2 'id 1 is used on 2 buses: name the joint with --joint or the bus with --port' \
+        "$J288" status --config "$E2E_TMP/two.yaml" --id 1
+    expect_bad config_id_by_port 2 'joint ja: --pos: .*\[-0.1, 0.1\]' \
+        "$J288" --port "$DEV" move --config "$E2E_TMP/two.yaml" --id 1 --pos 0.5
+    status_joint ja "$E2E_TMP/two.yaml" || return 1
     # Without a config joint, zero and calibrate print the value.
     e2e_run "$J288" --port "$DEV" zero --id 1 "${M[@]}"
     [ "$E2E_RC" -eq 0 ] && grep -q "^servo 1: zero -\?[0-9.]* rad (put 'zero: " <<<"$E2E_OUT" || { echo "zero: $E2E_OUT $E2E_ERR"; return 1; }
+    e2e_run "$J288" --port "$DEV" calibrate --id 1 --range 0.04 --speed 0.04 "${M[@]}"
+    [ "$E2E_RC" -eq 0 ] && grep -q "^put 'phase: " <<<"$E2E_OUT" || { echo "calibrate: $E2E_OUT $E2E_ERR"; return 1; }
     stop_sim
 }
 
