@@ -211,7 +211,7 @@ t_wrap_high_range() {
     truth_now && near "$(truth_val 1 theta)" "$(python3 -c 'import math; print(6.2 - 2 * math.pi)')" 0.005 || return 1
     status_joint j "$cfg" && near "$(jget "$E2E_TMP/st.json" joint_pos)" 6.2 0.005 || return 1
     # log: the CSV in the joint frame; a swing leaving the limits is refused before it starts.
-    "$J288" log --config "$cfg" --id 1 --rate 50 --duration 0.2 --csv "$E2E_TMP/w1.csv" "${M[@]}" >/dev/null || return 1
+    "$J288" log --config "$cfg" --joint j --rate 50 --duration 0.2 --csv "$E2E_TMP/w1.csv" "${M[@]}" >/dev/null || return 1
     python3 -c '
 import csv, sys
 rows = [r for r in csv.DictReader(open(sys.argv[1])) if r["ok"] == "1"]
