@@ -231,6 +231,27 @@ t_direction() {
     stop_sim
 }
 
+# A power cycle while hold drives the joint: the rotor restarts inside [0, 2 pi) (here some 45
+# turns from where it was), the joint sees its angle lost, locks the servo and fails.
+t_power_cycle_while_driving() {
+    local pid i rc
+    start_sim drive --ids 1 --start-angle 1:0 --power-off-ms 100 --quiet || return 1
+    "$J288" --port "$DEV" move --id 1 --pos 1.0 --speed 4 --duration 1 "${M[@]}" >/dev/null || return 1
+    timeout -k 2 60 "$J288" --port "$DEV" hold --id 1 --duration 30 "${M[@]}" >"$E2E_TMP/hold.out" 2>"$E2E_TMP/hold.err" &
+    pid=$!
+    for i in $(seq 1 400); do [ "$(foc_frames 1)" -gt 400 ] && break; sleep 0.05; done # the move's, then hold's
+    kill -s PWR "$SIM_PID"
+    wait "$pid"; rc=$?
+    [ "$rc" = 1 ] || { echo "hold exit $rc: $(cat "$E2E_TMP/hold.err")"; return 1; }
+    grep -q '^j288 hold: servo 1: the joint angle was lost .*; lock sent$' "$E2E_TMP/hold.err" ||
+        { echo "hold: $(cat "$E2E_TMP/hold.err")"; return 1; }
+    [ ! -s "$E2E_TMP/hold.out" ] || { echo "stdout: $(cat "$E2E_TMP/hold.out")"; return 1; }
+    grep 'id=1 ' "$SLOG" | tail -n 1 | grep -q 'status=0' || { echo "last frame not a lock"; return 1; }
+    # And the angle is found again, right, after the power cycle.
+    status_json 1 && truth_now && near "$(jget "$E2E_TMP/st.json" joint_pos)" "$(truth_val 1 theta)" 0.0004 || return 1
+    stop_sim
+}
+
 # ---- refusals: nothing is sent ---------------------------------------------------------------
 t_limits() {
     local cfg frames
@@ -323,7 +344,7 @@ run_check() { # NAME FUNCTION ARGS...
 for s in $SEEDS; do
     run_check "seed_$s" t_seed "$s"
 done
-for t in t_wrap_around_zero t_wrap_high_range t_direction t_limits t_encoder_fault t_wrong_phase t_config_errors; do
+for t in t_wrap_around_zero t_wrap_high_range t_direction t_power_cycle_while_driving t_limits t_encoder_fault t_wrong_phase t_config_errors; do
     run_check "${t#t_}" "$t"
 done
 e2e_summary
