@@ -71,6 +71,18 @@ truth_val() {
     awk -v id="$1" -v key="$2" '$1 == "id=" id {
         for (i = 2; i <= NF; i++) { n = index($i, "="); if (substr($i, 1, n - 1) == key) print substr($i, n + 1) } }' "$TRUTH"
 }
+# wait_settled ID: up to 20 s for servo ID's true angle to stop changing.
+wait_settled() {
+    local prev= cur i
+    for i in $(seq 1 100); do
+        truth_now || return 1
+        cur=$(truth_val "$1" theta)
+        [ -n "$prev" ] && near "$cur" "$prev" 0.000001 >/dev/null && return 0
+        prev=$cur
+        sleep 0.2
+    done
+    echo "servo $1 did not come to rest"; return 1
+}
 # wait_power_on: the truth file says the power cycle is over.
 wait_power_on() {
     local i
@@ -247,7 +259,9 @@ t_power_cycle_while_driving() {
         { echo "hold: $(cat "$E2E_TMP/hold.err")"; return 1; }
     [ ! -s "$E2E_TMP/hold.out" ] || { echo "stdout: $(cat "$E2E_TMP/hold.out")"; return 1; }
     grep 'id=1 ' "$SLOG" | tail -n 1 | grep -q 'status=0' || { echo "last frame not a lock"; return 1; }
-    # And the angle is found again, right, after the power cycle.
+    # And the angle is found again, right, after the power cycle (once the joint, locked while
+    # the stale command moved it, has come to rest).
+    wait_settled 1 || return 1
     status_json 1 && truth_now && near "$(jget "$E2E_TMP/st.json" joint_pos)" "$(truth_val 1 theta)" 0.0004 || return 1
     stop_sim
 }
