@@ -140,7 +140,7 @@ static int take_exclusive(j288_linux_t *lp, const char *dev)
     }
     /* TIOCEXCL makes further open() calls fail with EBUSY (except for root, which the
      * flock above still stops). */
-    if (ioctl(lp->fd, TIOCEXCL) != 0) {
+    if (ioctl(lp->fd, TIOCEXCL, NULL) != 0) {
         if (errno == ENOTTY || errno == EINVAL) {
             set_err(lp, "%s is not a serial device", dev);
             return J288_ERR_BAD_CONFIG;
@@ -310,7 +310,7 @@ int j288_linux_open(j288_linux_t *lp, const char *dev, uint32_t baud,
     if (rc == J288_OK)
         rc = set_raw_baud(lp, dev, lp->baud);
     if (rc != J288_OK) {
-        (void)ioctl(lp->fd, TIOCNXCL);
+        (void)ioctl(lp->fd, TIOCNXCL, NULL);
         (void)close(lp->fd); /* also drops our flock */
         lp->fd = -1;
         return rc;
@@ -327,8 +327,9 @@ void j288_linux_close(j288_linux_t *lp)
     if (lp == NULL || lp->fd < 0)
         return;
     /* The exclusive flag belongs to the tty, not to our descriptor: clear it, or the next
-     * program is refused while someone else (the simulator) keeps the tty open. */
-    (void)ioctl(lp->fd, TIOCNXCL);
+     * program is refused while someone else (the simulator) keeps the tty open. The unused
+     * argument is given: without it memcheck sees whatever the register held. */
+    (void)ioctl(lp->fd, TIOCNXCL, NULL);
     (void)flock(lp->fd, LOCK_UN);
     (void)close(lp->fd);
     lp->fd = -1;

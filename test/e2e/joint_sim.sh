@@ -71,6 +71,18 @@ truth_val() {
     awk -v id="$1" -v key="$2" '$1 == "id=" id {
         for (i = 2; i <= NF; i++) { n = index($i, "="); if (substr($i, 1, n - 1) == key) print substr($i, n + 1) } }' "$TRUTH"
 }
+# wait_settled ID: up to 20 s for servo ID's true angle to stop changing.
+wait_settled() {
+    local prev= cur i
+    for i in $(seq 1 100); do
+        truth_now || return 1
+        cur=$(truth_val "$1" theta)
+        [ -n "$prev" ] && near "$cur" "$prev" 0.000001 >/dev/null && return 0
+        prev=$cur
+        sleep 0.2
+    done
+    echo "servo $1 did not come to rest"; return 1
+}
 # wait_power_on: the truth file says the power cycle is over.
 wait_power_on() {
     local i
@@ -99,7 +111,13 @@ status_json() {
     timeout -k 2 60 "$J288" --port "$DEV" status --id "$id" --json "${M[@]}" "$@" >"$E2E_TMP/st.json" 2>"$E2E_TMP/st.err"
 }
 status_joint() { # NAME CONFIG: status --joint NAME --config CONFIG (the port from the file)
-    timeout -k 2 60 "$J288" status --joint "$1" --config "$2" --json "${M[@]}" >"$E2E_TMP/st.json" 2>"$E2E_TMP/st.err"
+    timeout -k 2 60 "$J288" status --joint "$1" --config "$2" --json "${M[@]}" >"$E2E_TMP/st.json" 2>"$E2E_TMP/st.err" ||
+        { echo "status --joint $1: exit $?: $(cat "$E2E_TMP/st.err")"; return 1; }
+}
+move_joint() { # NAME CONFIG MOVE-OPTIONS...: move --joint NAME --config CONFIG, quiet unless it fails
+    local name=$1 cfg=$2; shift 2
+    timeout -k 2 60 "$J288" move --joint "$name" --config "$cfg" "${M[@]}" "$@" >/dev/null 2>"$E2E_TMP/mv.err" ||
+        { echo "move --joint $name $*: exit $?: $(cat "$E2E_TMP/mv.err")"; return 1; }
 }
 foc_frames() { grep -c "id=$1 status=1 " "$SLOG"; }
 # config NAME BODY...: a robot config on this simulator's bus with one joint (BODY lines).
@@ -187,10 +205,10 @@ t_wrap_around_zero() {
     cfg=$(config w0 "  - name: j" "    id: 1" "    limits: [-0.5, 0.5]")
     status_joint j "$cfg" || return 1
     near "$(jget "$E2E_TMP/st.json" joint_pos)" 0.01 0.0004 || return 1
-    "$J288" move --joint j --config "$cfg" --pos -0.03 --speed 1 --duration 1 >/dev/null || return 1
+    move_joint j "$cfg" --pos -0.03 --speed 1 --duration 1 || return 1
     truth_now && near "$(truth_val 1 theta)" -0.03 0.005 || return 1
     status_joint j "$cfg" && near "$(jget "$E2E_TMP/st.json" joint_pos)" -0.03 0.005 || return 1
-    "$J288" move --joint j --config "$cfg" --pos 0.03 --speed 1 --duration 1 >/dev/null || return 1
+    move_joint j "$cfg" --pos 0.03 --speed 1 --duration 1 || return 1
     truth_now && near "$(truth_val 1 theta)" 0.03 0.005 || return 1
     stop_sim
 }
@@ -201,11 +219,11 @@ t_wrap_high_range() {
     cfg=$(config w1 "  - name: j" "    id: 1" "    limits: [5.8, 6.8]")
     status_joint j "$cfg" || return 1
     near "$(jget "$E2E_TMP/st.json" joint_pos)" "$(python3 -c 'import math; print(0.3 + 2 * math.pi)')" 0.0004 || return 1
-    "$J288" move --joint j --config "$cfg" --pos 6.2 --speed 1 --duration 1.5 >/dev/null || return 1
+    move_joint j "$cfg" --pos 6.2 --speed 1 --duration 1.5 || return 1
     truth_now && near "$(truth_val 1 theta)" "$(python3 -c 'import math; print(6.2 - 2 * math.pi)')" 0.005 || return 1
     status_joint j "$cfg" && near "$(jget "$E2E_TMP/st.json" joint_pos)" 6.2 0.005 || return 1
     # log: the CSV in the joint frame; a swing leaving the limits is refused before it starts.
-    "$J288" log --config "$cfg" --id 1 --rate 50 --duration 0.2 --csv "$E2E_TMP/w1.csv" "${M[@]}" >/dev/null || return 1
+    "$J288" log --config "$cfg" --joint j --rate 50 --duration 0.2 --csv "$E2E_TMP/w1.csv" "${M[@]}" >/dev/null || return 1
     python3 -c '
 import csv, sys
 rows = [r for r in csv.DictReader(open(sys.argv[1])) if r["ok"] == "1"]
@@ -220,8 +238,31 @@ t_direction() {
     start_sim dir --ids 1 --start-angle 1:0.05 --quiet || return 1
     cfg=$(config d "  - name: j" "    id: 1" "    direction: -1" "    zero: 0.1" "    limits: [-0.5, 0.5]")
     status_joint j "$cfg" && near "$(jget "$E2E_TMP/st.json" joint_pos)" 0.05 0.0004 || return 1
-    "$J288" move --joint j --config "$cfg" --pos 0.2 --speed 1 --duration 1 >/dev/null || return 1
+    move_joint j "$cfg" --pos 0.2 --speed 1 --duration 1 || return 1
     truth_now && near "$(truth_val 1 theta)" -0.1 0.005 || return 1
+    stop_sim
+}
+
+# A power cycle while hold drives the joint: the rotor restarts inside [0, 2 pi) (here some 45
+# turns from where it was), the joint sees its angle lost, locks the servo and fails.
+t_power_cycle_while_driving() {
+    local pid i rc
+    start_sim drive --ids 1 --start-angle 1:0 --power-off-ms 100 --quiet || return 1
+    "$J288" --port "$DEV" move --id 1 --pos 1.0 --speed 4 --duration 1 "${M[@]}" >/dev/null || return 1
+    timeout -k 2 60 "$J288" --port "$DEV" hold --id 1 --duration 30 "${M[@]}" >"$E2E_TMP/hold.out" 2>"$E2E_TMP/hold.err" &
+    pid=$!
+    for i in $(seq 1 400); do [ "$(foc_frames 1)" -gt 400 ] && break; sleep 0.05; done # the move's, then hold's
+    kill -s PWR "$SIM_PID"
+    wait "$pid"; rc=$?
+    [ "$rc" = 1 ] || { echo "hold exit $rc: $(cat "$E2E_TMP/hold.err")"; return 1; }
+    grep -q '^j288 hold: servo 1: the joint angle was lost .*; lock sent$' "$E2E_TMP/hold.err" ||
+        { echo "hold: $(cat "$E2E_TMP/hold.err")"; return 1; }
+    [ ! -s "$E2E_TMP/hold.out" ] || { echo "stdout: $(cat "$E2E_TMP/hold.out")"; return 1; }
+    grep 'id=1 ' "$SLOG" | tail -n 1 | grep -q 'status=0' || { echo "last frame not a lock"; return 1; }
+    # And the angle is found again, right, after the power cycle (once the joint, locked while
+    # the stale command moved it, has come to rest).
+    wait_settled 1 || return 1
+    status_json 1 && truth_now && near "$(jget "$E2E_TMP/st.json" joint_pos)" "$(truth_val 1 theta)" 0.0004 || return 1
     stop_sim
 }
 
@@ -287,9 +328,18 @@ t_config_errors() {
     # --id with --config takes the file's joint for that id (its limits apply).
     printf 'joints:\n  - name: j\n    id: 1\n    limits: [-0.1, 0.1]\n' >"$E2E_TMP/id.yaml"
     expect_bad config_by_id 2 'limits \[-0.1, 0.1\]' "$J288" --port "$DEV" move --config "$E2E_TMP/id.yaml" --id 1 --pos 0.5
+    # Two buses use id 1: --id needs --port to say which (or --joint); the file's port is used.
+    printf 'buses:\n  - {name: a, port: %s}\n  - {name: b, port: /nonexistent/j288}\njoints:\n  - {name: ja, bus: a, id: 1, limits: [-0.1, 0.1]}\n  - {name: jb, bus: b, id: 1}\n' "$DEV" >"$E2E_TMP/two.yaml"
+    expect_bad config_id_two_buses 2 'id 1 is used on 2 buses: name the joint with --joint or the bus with --port' \
+        "$J288" status --config "$E2E_TMP/two.yaml" --id 1
+    expect_bad config_id_by_port 2 'joint ja: --pos: .*\[-0.1, 0.1\]' \
+        "$J288" --port "$DEV" move --config "$E2E_TMP/two.yaml" --id 1 --pos 0.5
+    status_joint ja "$E2E_TMP/two.yaml" || return 1
     # Without a config joint, zero and calibrate print the value.
     e2e_run "$J288" --port "$DEV" zero --id 1 "${M[@]}"
     [ "$E2E_RC" -eq 0 ] && grep -q "^servo 1: zero -\?[0-9.]* rad (put 'zero: " <<<"$E2E_OUT" || { echo "zero: $E2E_OUT $E2E_ERR"; return 1; }
+    e2e_run "$J288" --port "$DEV" calibrate --id 1 --range 0.04 --speed 0.04 "${M[@]}"
+    [ "$E2E_RC" -eq 0 ] && grep -q "^put 'phase: " <<<"$E2E_OUT" || { echo "calibrate: $E2E_OUT $E2E_ERR"; return 1; }
     stop_sim
 }
 
@@ -308,7 +358,7 @@ run_check() { # NAME FUNCTION ARGS...
 for s in $SEEDS; do
     run_check "seed_$s" t_seed "$s"
 done
-for t in t_wrap_around_zero t_wrap_high_range t_direction t_limits t_encoder_fault t_wrong_phase t_config_errors; do
+for t in t_wrap_around_zero t_wrap_high_range t_direction t_power_cycle_while_driving t_limits t_encoder_fault t_wrong_phase t_config_errors; do
     run_check "${t#t_}" "$t"
 done
 e2e_summary

@@ -113,8 +113,9 @@ wait_err() {
     done
     return 1
 }
-# status_ok / status_fails: one status exchange with servo 1, no retries (status_ok with a
-# 250 ms margin: a slow machine must not make a good exchange fail).
+# status_ok / status_fails: status of servo 1, no retries (status_ok with a 250 ms margin: a
+# slow machine must not make a good exchange fail). A status that gets replies takes 8
+# exchanges (the joint angle's start); one whose first exchange fails stops there.
 status_ok() {
     timeout 30 "$J288" --port "$SIM_PTY" status --id 1 --retries 0 --margin-us 250000 >/dev/null 2>"$tmp/st"
 }
@@ -133,10 +134,10 @@ t_fault_switch() {
     status_ok || { echo "status failed after SIGUSR1: $(cat "$tmp/st")"; return 1; }
     status_ok || return 1
     kill -s USR2 "$SIM_PID"
-    wait_err '^j288-sim: faults on: stats: .* replies 2 dropped 1 ' || return 1
+    wait_err '^j288-sim: faults on: stats: .* replies 16 dropped 1 ' || return 1
     status_fails || { echo "status succeeded after SIGUSR2"; return 1; }
     kill -s TERM "$SIM_PID"; wait_exit "$SIM_PID" || return 1
-    grep -q '^j288-sim: stats: .* commands 4 .* replies 2 dropped 2 ' "$tmp/err"
+    grep -q '^j288-sim: stats: .* commands 18 .* replies 16 dropped 2 ' "$tmp/err"
 }
 # A reply delayed before SIGUSR1 still goes out when due (counted as sent); it does not
 # disturb the clean exchanges after the switch.
@@ -150,7 +151,7 @@ t_fault_switch_late_in_flight() {
     sleep 0.5 # the late reply is out now
     status_ok || { echo "status failed after the late reply: $(cat "$tmp/st")"; return 1; }
     kill -s TERM "$SIM_PID"; wait_exit "$SIM_PID" || return 1
-    grep -q '^j288-sim: stats: .* commands 3 .* replies 3 dropped 0 corrupted 0 late 1 ' "$tmp/err"
+    grep -q '^j288-sim: stats: .* commands 17 .* replies 17 dropped 0 corrupted 0 late 1 ' "$tmp/err"
 }
 
 # ---- the joint and the truth file ---------------------------------------------------------

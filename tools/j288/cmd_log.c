@@ -20,7 +20,8 @@ static const char log_help[] =
     "Run the cycle scheduler: every 1/HZ seconds one sweep sends each listed servo its\n"
     "command and takes its reply. Without --hold or --swing each servo is sent lock\n"
     "(watchdog bit 0) and only observed.\n"
-    "  --id LIST      servo ids 0-14, comma-separated (required)\n"
+    "  --id LIST      servo ids 0-14, comma-separated (this or --joint is required)\n"
+    "  --joint NAMES  joints of the --config file, comma-separated, instead of --id\n"
     "  --rate HZ      sweeps per second, 1..5000 (default 100)\n"
     "  --duration S   how long, seconds (default 1)\n"
     "  --csv FILE     one row per servo per cycle: time_s, id, ok (1 reply, 0 none),\n"
@@ -57,7 +58,8 @@ enum {
     OPT_KP,
     OPT_KD,
     OPT_SIDE,
-    OPT_WATCHDOG
+    OPT_WATCHDOG,
+    OPT_JOINTS
 };
 
 typedef enum { MOTION_NONE, MOTION_HOLD, MOTION_SWING } motion_t;
@@ -67,6 +69,7 @@ typedef struct {
     double rate_hz, duration_s, amp, period_s, kp, kd;
     bool have_kp, have_kd, have_period;
     const char *csv;
+    const char *joints; /* --joint NAME[,NAME..] */
     motion_t motion;
     int side;
     bool watchdog;
@@ -144,6 +147,9 @@ static int parse_log_opt(log_args_t *a, int key, const char *v)
         }
         cli_error("--side: '%s' is not joint, rotor or output", v);
         return -1;
+    case OPT_JOINTS:
+        a->joints = v;
+        return 0;
     case OPT_WATCHDOG:
         if (cli_parse_choice("--watchdog", v, onoff, &choice) != 0) {
             return -1;
@@ -168,6 +174,7 @@ static int parse_args(int argc, char **argv, log_args_t *a, cli_bus_opts_t *o, i
                                      {"--kd", true, OPT_KD},
                                      {"--side", true, OPT_SIDE},
                                      {"--watchdog", true, OPT_WATCHDOG},
+                                     {"--joint", true, OPT_JOINTS},
                                      CLI_BUS_COMMON_OPTS,
                                      {NULL, false, 0}};
     cli_args_t args;
@@ -198,8 +205,13 @@ static int parse_args(int argc, char **argv, log_args_t *a, cli_bus_opts_t *o, i
             return -1;
         }
     }
-    if (a->ids == 0u) {
-        cli_error("--id is required (e.g. --id 1,2,3)");
+    if (a->ids != 0u && a->joints != NULL) {
+        cli_error("--id and --joint exclude each other");
+        *ec = CLI_EXIT_USAGE;
+        return -1;
+    }
+    if (a->ids == 0u && a->joints == NULL) {
+        cli_error("--id is required (e.g. --id 1,2,3), or --joint NAMES with --config");
         *ec = CLI_EXIT_USAGE;
         return -1;
     }
@@ -437,11 +449,49 @@ static void print_summary_text(const log_run_t *r, double achieved)
     }
 }
 
+/* --joint NAMES: the ids of those joints of the file (one bus: the port of the first). */
+static int joints_to_ids(log_run_t *r)
+{
+    char name[J288_ROBOT_CONFIG_NAME_MAX];
+    const char *p = r->a.joints;
+    if (p == NULL) {
+        return 0;
+    }
+    for (;;) {
+        const char *comma = strchr(p, ',');
+        size_t n = comma != NULL ? (size_t)(comma - p) : strlen(p);
+        cli_joint_sel_t sel;
+        if (n == 0u || n >= sizeof name) {
+            cli_error("--joint: '%s' is not a comma-separated list of joint names", r->a.joints);
+            return -1;
+        }
+        memcpy(name, p, n);
+        name[n] = '\0';
+        if (cli_joint_select(&r->robot, name, -1, &r->o, &sel) != 0) {
+            return -1;
+        }
+        if (sel.rj->bus >= 0 && strcmp(r->robot.cfg.bus[sel.rj->bus].port, r->o.port) != 0) {
+            cli_error("--joint: %s is on bus %s, not on %s (one bus per log)", name,
+                      r->robot.cfg.bus[sel.rj->bus].name, r->o.port);
+            return -1;
+        }
+        if ((r->a.ids & (1u << sel.id)) != 0u) {
+            cli_error("--joint: %s and another listed joint share id %u", name, (unsigned)sel.id);
+            return -1;
+        }
+        r->a.ids |= 1u << sel.id;
+        if (comma == NULL) {
+            return 0;
+        }
+        p = comma + 1;
+    }
+}
+
 /* --config and the listed ids: each servo's joint (the file's, or the library's defaults). */
 static int log_select_joints(log_run_t *r)
 {
     uint8_t id;
-    if (cli_robot_load(&r->robot, r->o.config) != 0) {
+    if (cli_robot_load(&r->robot, r->o.config) != 0 || joints_to_ids(r) != 0) {
         return -1;
     }
     for (id = 0; id <= J288_MAX_ID; id++) {
