@@ -211,7 +211,10 @@ typedef struct j288_stm32 {
 int j288_stm32_init(j288_stm32_t *p, const j288_stm32_config_t *cfg,
                     const j288_bus_config_t *bus_cfg);
 
-/* Unregister p (the callbacks ignore its handles from now on). Thread only. */
+/* Unregister p: the callbacks ignore its handles from now on, a transfer in flight is
+ * aborted (a command on the wire is cut short; its transaction gets no completion
+ * callback), the timer channel's interrupt is disabled and the DE pin made inactive. p may
+ * then be initialised again. Does nothing for a p that is not registered. Thread only. */
 void j288_stm32_deinit(j288_stm32_t *p);
 
 /* The bus driven by p, for j288_bus_* and j288_sched_*. */
