@@ -18,13 +18,17 @@ families=("$@")
 [ ${#families[@]} -eq 0 ] && families=(f4 g4 h7)
 
 # The pinned versions (components of STM32CubeF4 1.28, STM32CubeG4 1.6, STM32CubeH7 1.11).
-# "name tag folders...": only these folders are kept.
-repos=("cmsis_core v5.9.0 Include")
+# "name tag commit folders...": the tag must name that commit (a moved tag or a mirror holding
+# something else stops the fetch); only these folders are kept.
+repos=("cmsis_core v5.9.0 1a2f783395dd72778a98ebe7771f36ca1c30a35e Include")
 for f in "${families[@]}"; do
     case $f in
-    f4) repos+=("stm32f4xx_hal_driver v1.8.3 Inc Src" "cmsis_device_f4 v2.6.9 Include Source/Templates") ;;
-    g4) repos+=("stm32g4xx_hal_driver v1.2.4 Inc Src" "cmsis_device_g4 v1.2.4 Include Source/Templates") ;;
-    h7) repos+=("stm32h7xx_hal_driver v1.11.3 Inc Src" "cmsis_device_h7 v1.10.4 Include Source/Templates") ;;
+    f4) repos+=("stm32f4xx_hal_driver v1.8.3 c2e1406d7ea4b73aa42b98ddeb75a8670b1a5a16 Inc Src"
+                "cmsis_device_f4 v2.6.9 3b64b7b0b546cefe84f13c65508126eea58b97d8 Include Source/Templates") ;;
+    g4) repos+=("stm32g4xx_hal_driver v1.2.4 63c724f62a299f976ab8e413865f439cf0402168 Inc Src"
+                "cmsis_device_g4 v1.2.4 f4ee399953e3b5c437788526e93b10efa5fad4fa Include Source/Templates") ;;
+    h7) repos+=("stm32h7xx_hal_driver v1.11.3 fec141ce999da655a48e1a15db83a72d564a1312 Inc Src"
+                "cmsis_device_h7 v1.10.4 faccfec37f82f7a1319c21638111b0f7335de7fe Include Source/Templates") ;;
     *) echo "fetch-st: unknown family '$f' (f4, g4, h7)" >&2; exit 2 ;;
     esac
 done
@@ -44,9 +48,17 @@ source_of() { # $1: repository name -> a URL or a local git directory
 tmp=
 trap '[ -n "$tmp" ] && rm -rf "$tmp"' EXIT
 
-fetch_one() { # $1 name, $2 tag, $3... folders
-    local name=$1 tag=$2 out=$dest/$1 src
-    shift 2
+# $1 name, $2 tag, $3 the commit it must be, $4 the commit found
+check_commit() {
+    if [ "$3" != "$4" ]; then
+        echo "fetch-st: $1 $2 is commit ${4:-(none)}, not the pinned $3: refusing it" >&2
+        exit 1
+    fi
+}
+
+fetch_one() { # $1 name, $2 tag, $3 commit, $4... folders
+    local name=$1 tag=$2 commit=$3 out=$dest/$1 src
+    shift 3
     if [ -f "$out/.tag" ] && [ "$(cat "$out/.tag")" = "$tag" ]; then
         echo "fetch-st: $name $tag already in $out"
         return
@@ -54,9 +66,11 @@ fetch_one() { # $1 name, $2 tag, $3... folders
     src=$(source_of "$name")
     tmp=$(mktemp -d "$dest/.fetch.XXXXXX")
     if [ -d "$src" ]; then
+        check_commit "$name" "$tag" "$commit" "$(git -C "$src" rev-parse --verify -q "$tag^{commit}")"
         git -C "$src" archive --format=tar "$tag" -- "$@" | tar -x -C "$tmp"
     else
         git -c advice.detachedHead=false clone --quiet --depth 1 --branch "$tag" "$src" "$tmp/clone"
+        check_commit "$name" "$tag" "$commit" "$(git -C "$tmp/clone" rev-parse HEAD)"
         (cd "$tmp/clone" && tar -c -- "$@") | tar -x -C "$tmp"
         rm -rf "$tmp/clone"
     fi
@@ -69,6 +83,6 @@ fetch_one() { # $1 name, $2 tag, $3... folders
 
 mkdir -p "$dest"
 for r in "${repos[@]}"; do
-    # shellcheck disable=SC2086 # "name tag"
+    # shellcheck disable=SC2086 # "name tag commit folders..."
     fetch_one $r
 done

@@ -6,7 +6,7 @@
  *
  * Hardware (as configured in the board file, the part CubeMX would generate):
  *   USART1 in single-wire half-duplex mode on PA9 (Arduino D8) at exactly 6 Mbps, a DMA
- *   stream/channel each way, normal mode, byte width; TIM2 free running at 1 MHz (32 bits):
+ *   stream/channel each way (TX normal mode, RX circular), byte width; TIM2 free running at 1 MHz (32 bits):
  *   the microsecond tick and, on channel 1, the reply timeout; the CRC unit in its reset
  *   configuration; the blue user button B1 (PC13) as emergency stop.
  *

@@ -443,6 +443,9 @@ void j288_stm32_deinit(j288_stm32_t *p)
             if (p->cfg.htim != NULL) {
                 __HAL_TIM_DISABLE_IT(p->cfg.htim, channel_it(p->cfg.tim_channel));
             }
+            /* A command still on the wire is cut short rather than left to finish after
+             * the transceiver has been released. */
+            (void)HAL_UART_AbortTransmit(p->cfg.huart);
             (void)HAL_UART_AbortReceive(p->cfg.huart);
             de_write(p, false);
         }

@@ -142,9 +142,13 @@ typedef struct {
     uint16_t de_pin;
     bool de_active_low;
 
-    /* Time. now_us: the application's monotonic microsecond tick (any context, wraps at
-     * 2^32); pass the same clock to submit and poll (j288_stm32_now_us()). When NULL, htim's counter is the tick; it must then count at 1 MHz with a 32-bit
-     * reload of 0xFFFFFFFF (TIM2/TIM5 on the F4), which init checks. */
+    /* Time. now_us: the application's monotonic microsecond tick (callable from any
+     * context, wraps at 2^32). When NULL, htim's counter is the tick; it must then count at
+     * 1 MHz with a 32-bit reload of 0xFFFFFFFF (TIM2/TIM5 on the F4), which init checks.
+     * Either way this one clock sets every transaction's start, deadline and guard: pass
+     * j288_stm32_now_us() (or the same now_us) to j288_bus_submit/poll/estop and j288_sched_*.
+     * With both now_us and htim, the timer only times the wait: the compare is set to the
+     * deadline's distance from now_us, so both must count microseconds. */
     uint32_t (*now_us)(void);
 
     /* Optional response timeout: a timer counting at 1 MHz, started by the application
@@ -197,7 +201,9 @@ typedef struct j288_stm32 {
 /* ---- functions ------------------------------------------------------------------------- */
 
 /* Set up p, register it and initialise its bus (j288_bus_init with bus_cfg, which may be
- * NULL for defaults). Leaves the line in receive direction with the DE pin inactive.
+ * NULL for defaults). cfg and bus_cfg are copied; what cfg points to must outlive the bus.
+ * The application initialises the UART, its DMA streams, the timer (started) and the CRC
+ * unit before. Leaves the line in receive direction with the DE pin inactive.
  * Errors: J288_ERR_NULL (p, cfg, huart or dma), J288_ERR_BUSY (this UART is registered
  * already, or J288_STM32_MAX_BUSES are), J288_ERR_BAD_CONFIG for any of:
  *   - no now_us and no 32-bit 1 MHz timer, or a tim_channel that is no TIM_CHANNEL_n;
@@ -211,10 +217,14 @@ typedef struct j288_stm32 {
 int j288_stm32_init(j288_stm32_t *p, const j288_stm32_config_t *cfg,
                     const j288_bus_config_t *bus_cfg);
 
-/* Unregister p (the callbacks ignore its handles from now on). Thread only. */
+/* Unregister p: the callbacks ignore its handles from now on, a transfer in flight is
+ * aborted (a command on the wire is cut short; its transaction gets no completion
+ * callback), the timer channel's interrupt is disabled and the DE pin made inactive. p may
+ * then be initialised again. Does nothing for a p that is not registered. Thread only. */
 void j288_stm32_deinit(j288_stm32_t *p);
 
-/* The bus driven by p, for j288_bus_* and j288_sched_*. */
+/* The bus driven by p (NULL for NULL), for j288_bus_* and j288_sched_*; valid as long as p.
+ * Any context. */
 j288_bus_t *j288_stm32_bus(j288_stm32_t *p);
 
 /* The microsecond tick p uses (its now_us, or the timer counter). Any context. This is the
@@ -222,26 +232,34 @@ j288_bus_t *j288_stm32_bus(j288_stm32_t *p);
  * passes to j288_bus_submit/poll/estop and j288_sched_* must come from it too (bus.h). */
 uint32_t j288_stm32_now_us(const j288_stm32_t *p);
 
+/* p's counters (NULL for NULL), valid as long as p. Any context; the interrupts keep
+ * updating them, so two fields read one after the other may be from different moments. */
 const j288_stm32_stats_t *j288_stm32_stats(const j288_stm32_t *p);
 
-/* Callback forwarding, ISR-safe. Each returns false (and does nothing) when the handle
- * belongs to no registered bus. */
+/* Callback forwarding, ISR-safe; call them from the HAL callbacks named at the top, i.e. from
+ * the bus's UART, DMA and timer interrupts, never from two priorities at once. Each returns
+ * false (and does nothing) when the handle belongs to no registered bus (or is NULL). Bytes
+ * of a receive event are handed to the bus during the call; the port's DMA buffer is not
+ * read after it returns. */
 bool j288_stm32_on_tx_cplt(UART_HandleTypeDef *huart);
 bool j288_stm32_on_rx_event(UART_HandleTypeDef *huart, uint16_t size);
 bool j288_stm32_on_error(UART_HandleTypeDef *huart);
 bool j288_stm32_on_timer(TIM_HandleTypeDef *htim);
 
 #if J288_STM32_HW_CRC
-/* The manual's crc32_core over nwords little-endian words at data (any alignment) on the CRC
- * unit hcrc, inside J288_STM32_CRC_LOCK. Words are assembled from bytes into an aligned
- * scratch buffer (never a cast of data), 8 words at a time: HAL_CRC_Calculate for the first
- * chunk (it resets the unit), HAL_CRC_Accumulate for the rest. A frame is 4 or 5 words.
- * Returns the CRC. ISR-safe. */
+/* The manual's crc32_core over nwords little-endian words at data (any alignment; read only
+ * during the call) on the CRC unit hcrc, inside J288_STM32_CRC_LOCK. Words are assembled from
+ * bytes into an aligned scratch buffer (never a cast of data), 8 words at a time:
+ * HAL_CRC_Calculate for the first chunk (it resets the unit), HAL_CRC_Accumulate for the rest.
+ * A frame is 4 or 5 words. hcrc NULL: computed in software instead; data NULL: the CRC of no
+ * words. Returns the CRC. ISR-safe. */
 uint32_t j288_stm32_crc32(CRC_HandleTypeDef *hcrc, const uint8_t *data, size_t nwords);
 
 /* The same as a context-free function for J288_CONFIG_CRC_BACKEND = J288_CRC_BACKEND_HW with
  * J288_CONFIG_CRC_HW_FUNCTION=j288_stm32_crc32_default, after j288_stm32_crc_attach(). Before
- * an attach (or with NULL) it computes in software, bit-identically. */
+ * an attach (or with NULL) it computes in software, bit-identically. attach: thread, before
+ * the buses start (hcrc must outlive its use, in the reset configuration as for
+ * j288_stm32_config_t.hcrc; attach does not check it). crc32_default: ISR-safe. */
 void j288_stm32_crc_attach(CRC_HandleTypeDef *hcrc);
 uint32_t j288_stm32_crc32_default(const uint8_t *data, size_t nwords);
 #endif

@@ -815,6 +815,23 @@ static void test_turnaround_to_receive_failure_is_a_line_error(void)
 }
 
 /* The receiver is off while we transmit, so no echo can come: the port refuses echo. */
+/* Unregistering a bus whose command is still on the wire: the transfer stops, the
+ * transceiver is released, and its completion no longer reaches the bus. */
+static void test_deinit_during_a_transmit_stops_it_and_releases_the_line(void)
+{
+    j288_cmd_raw_t cmd = foc3_cmd();
+    init_port1(NULL, false, true);
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_bus_submit(j288_stm32_bus(&port1), &cmd, fake_now, on_done, NULL));
+    TEST_ASSERT_TRUE(fake_hal_tx_busy(&huart1));
+    TEST_ASSERT_EQUAL_INT(1, fake_hal_gpio_level(&gpioa, DE_PIN));
+    j288_stm32_deinit(&port1);
+    TEST_ASSERT_FALSE(fake_hal_tx_busy(&huart1));
+    TEST_ASSERT_FALSE(fake_hal_rx_armed(&huart1));
+    TEST_ASSERT_EQUAL_INT(0, fake_hal_gpio_level(&gpioa, DE_PIN));
+    TEST_ASSERT_FALSE(j288_stm32_on_tx_cplt(&huart1));
+    TEST_ASSERT_EQUAL_INT(0, done_count);
+}
+
 static void test_echo_is_refused(void)
 {
     j288_stm32_config_t c = base_config(&huart1, &dma1);
@@ -941,6 +958,7 @@ int main(void)
     RUN_TEST(test_receive_stream_left_busy_is_recovered);
     RUN_TEST(test_turnaround_to_transmit_failure_is_a_port_error);
     RUN_TEST(test_turnaround_to_receive_failure_is_a_line_error);
+    RUN_TEST(test_deinit_during_a_transmit_stops_it_and_releases_the_line);
     RUN_TEST(test_echo_is_refused);
     RUN_TEST(test_reply_split_by_a_gap_at_any_position_is_heard_whole);
     RUN_TEST(test_reply_stopping_at_a_gap_is_truncated_at_the_deadline);

@@ -173,7 +173,7 @@ static void button_init(void)
     __HAL_RCC_GPIOC_CLK_ENABLE();
     pin.Pin = GPIO_PIN_13;
     pin.Mode = GPIO_MODE_INPUT;
-    pin.Pull = GPIO_NOPULL; /* B1 has its own resistor */
+    pin.Pull = GPIO_PULLDOWN; /* B1 pulls PC13 high when pressed; never let the pin float */
     HAL_GPIO_Init(GPIOC, &pin);
 }
 
