@@ -78,6 +78,7 @@ quiet cmake --install "$root/host" --prefix "$root/cmake-prefix"
 installed "$root/cmake-prefix"
 quiet make -j"$jobs" BUILD="${BUILD:-build}" PREFIX=/usr DESTDIR="$root/make-destdir" install
 installed "$root/make-destdir/usr"
+installed_python "$root/make-destdir/usr"
 consumer add_subdirectory -DJ288_SOURCE_DIR="$PWD"
 
 bash scripts/need.sh arm-none-eabi-gcc gcc-arm-none-eabi || exit $(($? == 1 ? 0 : 1))
