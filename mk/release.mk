@@ -40,7 +40,8 @@ ALL_TARGETS += $(SO_LIB)
 
 # What `make install` adds to the static library, headers, CMake package and tools (the
 # Makefile's install rule): the shared library and its links, the Linux port's and the
-# runner's headers, pkg-config file, the Python package.
+# runner's headers, pkg-config file, the Python package (with _installed.py: where its
+# prefix's shared library is, relative to the package).
 PYTHONDIR ?= $(PREFIX)/lib/python3/dist-packages
 PORT_HDR := port/linux/j288_linux.h port/linux/j288_robot.h port/linux/j288_robot_config.h
 .PHONY: install-release
@@ -52,4 +53,7 @@ install-release: $(SO_LIB)
 	install -m 644 $(PORT_HDR) $(DESTDIR)$(INCLUDEDIR)/j288/
 	$(call PC_GEN,$(patsubst $(PREFIX)/%,%,$(LIBDIR)),$(patsubst $(PREFIX)/%,%,$(INCLUDEDIR)),$(DESTDIR)$(LIBDIR)/pkgconfig/j288.pc)
 	install -m 644 python/j288/*.py python/j288/py.typed $(DESTDIR)$(PYTHONDIR)/j288/
+	printf '# Written by make install: the shared library, relative to this package.\nLIBRARY = "%s"\n' \
+	    "$$(realpath -m -s --relative-to=$(PYTHONDIR)/j288 $(LIBDIR)/$(SO_NAME))" \
+	    >$(DESTDIR)$(PYTHONDIR)/j288/_installed.py
 install: install-release

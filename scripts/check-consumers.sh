@@ -5,8 +5,10 @@
 # `make install DESTDIR=...` into temporary prefixes (the tools installed with them must run),
 # add_subdirectory, and the library cross-built with cmake/arm-none-eabi.cmake for Cortex-M4F
 # and Cortex-M0 (SI off), and a pkg-config consumer (test/e2e/pkgconfig_consumer.c, against
-# the shared library of both installs). Needs cmake; the cross build needs arm-none-eabi-gcc,
-# the pkg-config consumer pkg-config.
+# the shared library of both installs). Every install's j288, j288-sim and j288.pc, and the
+# Python package `make install` adds (imported with PYTHONPATH alone), say the header's
+# version. Needs cmake; the cross build needs arm-none-eabi-gcc, the pkg-config consumer
+# pkg-config.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/need.sh cmake cmake || exit $(($? == 1 ? 0 : 1))
@@ -14,6 +16,12 @@ root=${BUILD:-build}/consumers
 rm -rf "$root" && mkdir -p "$root" && root=$(cd "$root" && pwd)
 jobs=$(nproc 2>/dev/null || echo 2)
 quiet() { "$@" >"$root/last.log" 2>&1 || { cat "$root/last.log" >&2; return 1; }; }
+version=$(sed -n 's/.*J288_VERSION_STRING "\(.*\)"/\1/p' lib/include/j288/j288.h)
+# same_version WHAT TEXT: TEXT ends in the header's version.
+same_version() {
+    case "$2" in *" $version" | "$version") ;;
+        *) echo "check-consumers: $1 says '$2', the header $version" >&2; exit 1 ;; esac
+}
 
 # consumer NAME CMAKE_ARGS...: configure, build and run test/cmake_consumer.
 consumer() {
@@ -29,8 +37,8 @@ installed() {
         lib/pkgconfig/j288.pc lib/cmake/j288/j288Config.cmake bin/j288 bin/j288-sim; do
         [ -f "$p/$f" ] || { echo "check-consumers: $p/$f not installed" >&2; exit 1; }
     done
-    quiet "$p/bin/j288" --version
-    quiet "$p/bin/j288-sim" --help
+    same_version "$p/bin/j288 --version" "$("$p/bin/j288" --version 2>&1)"
+    same_version "$p/bin/j288-sim --version" "$("$p/bin/j288-sim" --version 2>&1)"
     consumer "find_package-$(basename "$p")" -DCMAKE_PREFIX_PATH="$p"
     pkgconfig_consumer "$p"
 }
@@ -46,6 +54,22 @@ pkgconfig_consumer() {
     local out
     out=$(LD_LIBRARY_PATH="$p/lib" "$exe")
     echo "pkg-config-$(basename "$p"): $out"
+    same_version "$p/lib/pkgconfig/j288.pc" "$(PKG_CONFIG_PATH="$p/lib/pkgconfig" pkg-config --modversion j288)"
+}
+# installed_python PREFIX: the package `make install` puts in PREFIX/lib/python3/dist-packages
+# loads the shared library of its own prefix, with PYTHONPATH and nothing else set (each of
+# python3 and Debian's /usr/bin/python3 that exists).
+installed_python() {
+    local p=$1 py out
+    for py in python3 /usr/bin/python3; do
+        command -v "$py" >/dev/null 2>&1 || continue
+        out=$(cd / && env -u LD_LIBRARY_PATH -u J288_LIB PYTHONPATH="$p/lib/python3/dist-packages" \
+            PYTHONDONTWRITEBYTECODE=1 "$py" -c 'import j288; print(j288.__file__, j288.__version__)' 2>&1) ||
+            { echo "check-consumers: $py cannot import the installed package: $out" >&2; exit 1; }
+        case "$out" in "$p/"*) ;; *) echo "check-consumers: $py imported $out, not $p's" >&2; exit 1 ;; esac
+        same_version "python ($py) j288.__version__" "$out"
+        echo "python-$(basename "$p") ($py): j288 $version"
+    done
 }
 
 quiet cmake -S . -B "$root/host" -DCMAKE_BUILD_TYPE=RelWithDebInfo
@@ -54,6 +78,7 @@ quiet cmake --install "$root/host" --prefix "$root/cmake-prefix"
 installed "$root/cmake-prefix"
 quiet make -j"$jobs" BUILD="${BUILD:-build}" PREFIX=/usr DESTDIR="$root/make-destdir" install
 installed "$root/make-destdir/usr"
+installed_python "$root/make-destdir/usr"
 consumer add_subdirectory -DJ288_SOURCE_DIR="$PWD"
 
 bash scripts/need.sh arm-none-eabi-gcc gcc-arm-none-eabi || exit $(($? == 1 ? 0 : 1))

@@ -7,7 +7,9 @@ here: the calls are few and coarse (one per cycle), so their per-call cost is wh
 and it is measured in docs/performance.md.
 
 The library is looked for, in order: $J288_LIB (a path), libj288.so next to this file (what
-``make python`` puts there), then the system's (``make install``: ldconfig's libj288.so.0).
+``make python`` puts there), the one of the prefix ``make install`` put this package in (the
+path _installed.py holds, relative to this directory, so that DESTDIR and a moved prefix
+work), then the system's (ldconfig's libj288.so.0).
 """
 
 from __future__ import annotations
@@ -98,9 +100,16 @@ def _find() -> str:
     env = os.environ.get("J288_LIB")
     if env:
         return env
-    here = os.path.join(os.path.dirname(os.path.abspath(__file__)), "libj288.so")
+    pkg = os.path.dirname(os.path.abspath(__file__))
+    here = os.path.join(pkg, "libj288.so")
     if os.path.exists(here):
         return here
+    try:  # written by `make install` only
+        from ._installed import LIBRARY  # type: ignore[import-not-found,unused-ignore]
+    except ImportError:
+        LIBRARY = None
+    if LIBRARY is not None and os.path.exists(os.path.join(pkg, LIBRARY)):
+        return os.path.join(pkg, LIBRARY)
     found = ctypes.util.find_library("j288")
     if found:
         return found

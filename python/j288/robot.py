@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import ctypes
+import time
 from dataclasses import dataclass
 from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
 
@@ -17,6 +18,8 @@ except ImportError:  # pragma: no cover - depends on the machine
     _np = None
 
 Vector = Union[Sequence[float], Any]  # a sequence of floats or a NumPy array
+
+_RUN_SLICE_US = 100000  # run(): Python's signal handlers get their turn this often
 
 
 @dataclass(frozen=True)
@@ -144,9 +147,33 @@ class Robot:
 
     def run(self, cycles: int = 0, rate_hz: float = 0.0, duration: float = 0.0) -> None:
         """Cycles in C (no Python per cycle): `cycles` of them (0: no limit) or for `duration`
-        seconds (0: no limit), at rate_hz (0: back to back), with the targets set before."""
+        seconds (0: no limit), at rate_hz (0: back to back), with the targets set before.
+
+        The C loop runs in slices of about 0.1 s (whole periods at rate_hz, so the schedule
+        goes on evenly): Ctrl-C (KeyboardInterrupt) and other signals reach Python between
+        them, and a with block around the loop then stops every bus. Raises OfflineError
+        when every bus is gone."""
+        if cycles < 0 or rate_hz < 0 or duration < 0:
+            raise ValueError("cycles, rate_hz and duration must not be negative")
+        r = self._robot()
         period = int(1e6 / rate_hz) if rate_hz > 0 else 0
-        self._check(LIB.j288_robot_run(self._robot(), period, cycles, int(duration * 1e6)))
+        slice_us = period * max(1, _RUN_SLICE_US // period) if period else _RUN_SLICE_US
+        left_us = int(duration * 1e6) if duration > 0 else None
+        left = cycles
+        stats = RobotStats()
+        while left_us is None or left_us > 0:
+            this_us = slice_us if left_us is None else min(slice_us, left_us)
+            self._check(LIB.j288_robot_stats(r, ctypes.byref(stats)))
+            before = stats.cycles
+            start = time.monotonic()
+            self._check(LIB.j288_robot_run(r, period, left, this_us))
+            if left_us is not None:
+                left_us -= max(this_us, int((time.monotonic() - start) * 1e6))
+            if cycles:
+                self._check(LIB.j288_robot_stats(r, ctypes.byref(stats)))
+                left -= min(left, (stats.cycles - before) & 0xFFFFFFFF)
+                if left == 0:
+                    return
 
     def stop(self) -> None:
         """Broadcast lock on every bus; every joint at lock until new targets are set."""

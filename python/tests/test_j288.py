@@ -183,7 +183,15 @@ def test_robot_two_buses(sims, tmp_path: Path) -> None:
         assert e.value.name == "J288_ERR_LIMIT_POS" and "leg1_2" in str(e.value)
         robot.set_target("leg1_3", float(pos[5]), kp=3.0)
         assert robot.cycle().complete
+        before = robot.stats()["cycles"]
         robot.run(cycles=20)
+        assert robot.stats()["cycles"] == before + 20
+        robot.run(cycles=60, rate_hz=400)  # 0.15 s: more than one of run()'s slices
+        assert robot.stats()["cycles"] == before + 80
+        robot.run(duration=0.25, rate_hz=200)  # ends by itself
+        assert robot.stats()["cycles"] > before + 80
+        with pytest.raises(ValueError):
+            robot.run(cycles=-1)
         stats = robot.stats()
         assert stats["cycles"] == stats["complete_cycles"] >= 22
         assert robot.bus_stats("leg1")["sweeps"] == stats["cycles"]
@@ -252,8 +260,12 @@ def test_robot_without_numpy(sims, tmp_path: Path, monkeypatch) -> None:
         assert robot.cycle().complete
 
 
-def test_ctrl_c_stops_every_bus(sims, tmp_path: Path) -> None:
-    """KeyboardInterrupt in a controller's loop: the with block sends the broadcast lock."""
+@pytest.mark.parametrize("loop", ["while True:\n        robot.cycle()",
+                                  "robot.run()", "robot.run(rate_hz=500, duration=3600)"],
+                         ids=["cycle", "run", "run_rate"])
+def test_ctrl_c_stops_every_bus(sims, tmp_path: Path, loop: str) -> None:
+    """KeyboardInterrupt in a controller's loop, or in a run() in C that has no end (near):
+    it reaches Python, and the with block sends the broadcast lock."""
     s0, s1 = sims("1,2,3"), sims("1,2,3")
     cfg = write_config(tmp_path, [s0.pty, s1.pty])
     ready = tmp_path / "ready"
@@ -265,9 +277,8 @@ def test_ctrl_c_stops_every_bus(sims, tmp_path: Path) -> None:
             robot.hold()
             robot.cycle()
             pathlib.Path({str(ready)!r}).write_text("1")
-            while True:
-                robot.cycle()
-        """)
+            LOOP
+        """).replace("LOOP", loop)
     proc = subprocess.Popen([sys.executable, "-c", script],
                             env=dict(os.environ, PYTHONPATH=str(ROOT / "python")),
                             stderr=subprocess.PIPE, text=True)

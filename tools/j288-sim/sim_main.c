@@ -25,6 +25,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "j288/j288.h"
 #include "servo_model.h"
 
 #define QUEUE_LEN  64u
@@ -161,6 +162,7 @@ static void usage(FILE *f)
           "  --log FILE          one line per received command frame ('-' = stderr)\n"
           "  --exit-after S      exit after S seconds (for tests)\n"
           "  --quiet             no messages but errors and the statistics line\n"
+          "  --version           print the version (the library's) and exit\n"
           "fault injection (deterministic for a given --seed and command sequence):\n"
           "  --seed N            random seed (default 1)\n"
           "  --drop P            probability a reply is not sent\n"
@@ -343,6 +345,10 @@ static void parse_args(options_t *o, int argc, char **argv)
         const char *v = (i + 1 < argc) ? argv[i + 1] : NULL;
         if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
             usage(stdout);
+            exit(0);
+        }
+        if (strcmp(a, "--version") == 0) {
+            printf("j288-sim %s\n", J288_VERSION_STRING);
             exit(0);
         }
         if (strcmp(a, "--quiet") == 0) {
