@@ -162,6 +162,7 @@ HAL_StatusTypeDef HAL_HalfDuplex_EnableTransmitter(UART_HandleTypeDef *huart)
     }
     u->te = true;
     u->re = false;
+    huart->gState = HAL_UART_STATE_READY; /* as ST's HAL does, whatever the transmit's state */
     return HAL_OK;
 }
 
@@ -174,6 +175,7 @@ HAL_StatusTypeDef HAL_HalfDuplex_EnableReceiver(UART_HandleTypeDef *huart)
     }
     u->te = false;
     u->re = true;
+    huart->gState = HAL_UART_STATE_READY; /* as ST's HAL does, whatever the transmit's state */
     return HAL_OK;
 }
 
@@ -190,7 +192,8 @@ HAL_StatusTypeDef HAL_UART_Transmit_DMA(UART_HandleTypeDef *huart, const uint8_t
     huart->gState = HAL_UART_STATE_BUSY_TX;
     u->dmat = true; /* set after the stream start, whatever its result */
     if (!dma_start(huart->hdmatx)) {
-        return HAL_OK; /* the F4 HAL's silent failure: nothing goes out, ever */
+        u->tx_busy = false; /* no transfer that will ever complete: a stalled one never does */
+        return HAL_OK;      /* the F4 HAL's silent failure: nothing goes out, ever */
     }
     u->tx_len = (Size <= sizeof u->tx) ? Size : sizeof u->tx;
     memcpy(u->tx, pData, u->tx_len);
