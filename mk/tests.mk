@@ -21,6 +21,21 @@ $(CLI_TEST): $(OBJ)/test/cli/test_cli_helpers.o \
 	@mkdir -p $(@D)
 	$(CC) $(CFLAGS_COMMON) $^ -o $@ $(LDFLAGS_COMMON) -lm
 
+# The tool's robot config and joint selection (cli_joint.c), with the bus plumbing it calls.
+CLI_JOINT_TEST := $(BUILD)/test/test_cli_joint
+$(OBJ)/test/cli/test_cli_joint.o: test/cli/test_cli_joint.c $(J288_HDR) $(TEST_HDR) $(UNITY)/unity.c \
+    port/linux/j288_robot_config.h $(YAML_ENV)
+	@mkdir -p $(@D)
+	$(CC) $(TEST_CPPFLAGS) -Itools/j288 $(TOOL_CPPFLAGS) $(call yaml_var,YAML_CFLAGS) $(CFLAGS_COMMON) -c $< -o $@
+
+$(CLI_JOINT_TEST): $(OBJ)/test/cli/test_cli_joint.o \
+    $(addprefix $(OBJ)/tools/j288/,cli_joint.o cli_bus.o args.o json.o report.o) $(CONFIG_OBJ) \
+    $(UNITY_OBJ) $(LINUX_A) $(LIB_A)
+	@mkdir -p $(@D)
+	$(CC) $(CFLAGS_COMMON) $^ -o $@ $(LDFLAGS_COMMON) $(call yaml_var,YAML_LIBS) -lm
+HOST_TESTS += $(CLI_JOINT_TEST)
+ALL_TARGETS += $(CLI_JOINT_TEST)
+
 # ---- the codec tests with each CRC backend (J288_CONFIG_CRC_BACKEND) -------------------------
 # slice4, nibble, bitwise, and HW through J288_CONFIG_CRC_HW_FUNCTION (a stand-in in
 # test/support). Each is a sub-build in $(BUILD)/crc-<backend>, one sub-make building all its

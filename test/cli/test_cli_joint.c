@@ -1,0 +1,266 @@
+/* Unit tests of the j288 tool's robot config and joint selection (tools/j288/cli_joint.c):
+ * --id / --joint / --config resolved to a joint configuration and the bus options, with
+ * exactly one error line for every refusal. */
+#define _XOPEN_SOURCE 700 /* mkdtemp under -std=c99 */
+
+#include "unity.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "cli_bus.h"
+
+static FILE *err;
+static cli_robot_t robot;
+static char dir[64];
+static char path[128];
+
+void setUp(void)
+{
+    err = tmpfile();
+    cli_set_error_stream(err);
+    cli_set_command("test");
+    memset(&robot, 0, sizeof robot);
+}
+
+void tearDown(void)
+{
+    cli_set_error_stream(NULL);
+    fclose(err);
+}
+
+/* Lines written to the error stream since setUp; the first in line. */
+static int error_lines(char *line, size_t len)
+{
+    int n = 0, c;
+    size_t i = 0;
+    fflush(err);
+    rewind(err);
+    line[0] = '\0';
+    while ((c = fgetc(err)) != EOF) {
+        if (c == '\n') {
+            n++;
+        } else if (n == 0 && i + 1 < len) {
+            line[i++] = (char)c;
+            line[i] = '\0';
+        }
+    }
+    return n;
+}
+
+static void expect_one_error(const char *part)
+{
+    char line[600];
+    TEST_ASSERT_EQUAL_INT_MESSAGE(1, error_lines(line, sizeof line), line);
+    TEST_ASSERT_NOT_NULL_MESSAGE(strstr(line, part), line);
+}
+
+static void opts(cli_bus_opts_t *o)
+{
+    cli_global_t g = {NULL, 0};
+    cli_bus_opts_init(o, &g);
+}
+
+/* No file: the id's all-zero configuration, the library's defaults. */
+static void test_no_config(void)
+{
+    cli_bus_opts_t o;
+    cli_joint_sel_t sel;
+    char line[200];
+    opts(&o);
+    TEST_ASSERT_EQUAL_INT(0, cli_robot_load(&robot, NULL));
+    TEST_ASSERT_EQUAL_INT(0, cli_joint_select(&robot, NULL, 3, &o, &sel));
+    TEST_ASSERT_EQUAL_UINT8(3, sel.id);
+    TEST_ASSERT_NULL(sel.rj);
+    TEST_ASSERT_EQUAL_STRING("servo 3", sel.name);
+    TEST_ASSERT_EQUAL_UINT8(3, sel.jc.id);
+    TEST_ASSERT_FALSE(sel.jc.has_phase || sel.jc.clamp);
+    TEST_ASSERT_EQUAL_DOUBLE(0.0, (double)sel.jc.pos_min);
+    TEST_ASSERT_EQUAL_DOUBLE(0.0, (double)sel.jc.pos_max);
+    TEST_ASSERT_NULL(o.port);
+    TEST_ASSERT_EQUAL_INT(0, error_lines(line, sizeof line));
+}
+
+static void test_no_config_refusals(void)
+{
+    cli_bus_opts_t o;
+    cli_joint_sel_t sel;
+    opts(&o);
+    TEST_ASSERT_EQUAL_INT(-1, cli_joint_select(&robot, "hip", -1, &o, &sel));
+    expect_one_error("--joint hip needs --config FILE");
+}
+
+static void test_neither_or_both(void)
+{
+    cli_bus_opts_t o;
+    cli_joint_sel_t sel;
+    opts(&o);
+    TEST_ASSERT_EQUAL_INT(-1, cli_joint_select(&robot, NULL, -1, &o, &sel));
+    expect_one_error("--id N or --joint NAME is required");
+}
+
+static void test_both(void)
+{
+    cli_bus_opts_t o;
+    cli_joint_sel_t sel;
+    opts(&o);
+    TEST_ASSERT_EQUAL_INT(-1, cli_joint_select(&robot, "hip", 1, &o, &sel));
+    expect_one_error("exclude each other");
+}
+
+/* The default range [-pi, pi] when both limits are 0; the configured one; clamp allows all. */
+static void test_pos_allowed(void)
+{
+    j288_joint_config_t jc;
+    memset(&jc, 0, sizeof jc);
+    TEST_ASSERT_TRUE(cli_joint_pos_allowed(&jc, 3.14));
+    TEST_ASSERT_TRUE(cli_joint_pos_allowed(&jc, -3.14));
+    TEST_ASSERT_FALSE(cli_joint_pos_allowed(&jc, 3.15));
+    TEST_ASSERT_FALSE(cli_joint_pos_allowed(&jc, -3.15));
+    jc.pos_min = (j288_real_t)5.8;
+    jc.pos_max = (j288_real_t)6.8;
+    TEST_ASSERT_TRUE(cli_joint_pos_allowed(&jc, 6.2));
+    TEST_ASSERT_FALSE(cli_joint_pos_allowed(&jc, 0.0));
+    jc.clamp = true;
+    TEST_ASSERT_TRUE(cli_joint_pos_allowed(&jc, 0.0));
+}
+
+#ifdef J288_HAVE_LIBYAML
+
+static void write_config(const char *text)
+{
+    FILE *f = fopen(path, "w");
+    TEST_ASSERT_NOT_NULL(f);
+    fputs(text, f);
+    fclose(f);
+}
+
+static const char k_two_buses[] = "buses:\n"
+                                  "  - name: left\n"
+                                  "    port: /dev/left\n"
+                                  "    baud: 4000000\n"
+                                  "    margin_us: 3000\n"
+                                  "    echo: true\n"
+                                  "  - {name: right, port: /dev/right}\n"
+                                  "joints:\n"
+                                  "  - name: hip\n"
+                                  "    bus: left\n"
+                                  "    id: 1\n"
+                                  "    direction: -1\n"
+                                  "    limits: [-1, 1]\n"
+                                  "  - {name: hip_r, bus: right, id: 1}\n"
+                                  "  - {name: knee, bus: left, id: 2, zero: 100}\n";
+
+/* By name: the file's joint, and its bus's options where the command line left them open. */
+static void test_by_name_fills_bus(void)
+{
+    cli_bus_opts_t o;
+    cli_joint_sel_t sel;
+    write_config(k_two_buses);
+    opts(&o);
+    TEST_ASSERT_EQUAL_INT(0, cli_robot_load(&robot, path));
+    TEST_ASSERT_EQUAL_INT(0, cli_joint_select(&robot, "hip", -1, &o, &sel));
+    TEST_ASSERT_NOT_NULL(sel.rj);
+    TEST_ASSERT_EQUAL_STRING("joint hip", sel.name);
+    TEST_ASSERT_EQUAL_UINT8(1, sel.id);
+    TEST_ASSERT_EQUAL_INT8(-1, sel.jc.direction);
+    TEST_ASSERT_EQUAL_DOUBLE(-1.0, (double)sel.jc.pos_min);
+    TEST_ASSERT_EQUAL_STRING("/dev/left", o.port);
+    TEST_ASSERT_EQUAL_UINT32(4000000u, o.baud);
+    TEST_ASSERT_EQUAL_UINT32(3000u, o.margin_us);
+    TEST_ASSERT_TRUE(o.echo);
+    /* The command line wins. */
+    opts(&o);
+    o.port = "/dev/given";
+    o.baud = 1000000u;
+    o.margin_us = 7u;
+    TEST_ASSERT_EQUAL_INT(0, cli_joint_select(&robot, "hip_r", -1, &o, &sel));
+    TEST_ASSERT_EQUAL_STRING("/dev/given", o.port);
+    TEST_ASSERT_EQUAL_UINT32(1000000u, o.baud);
+    TEST_ASSERT_EQUAL_UINT32(7u, o.margin_us);
+}
+
+/* By id: ambiguous across buses until --port names one; an id not in the file is the
+ * library's default joint. */
+static void test_by_id(void)
+{
+    cli_bus_opts_t o;
+    cli_joint_sel_t sel;
+    write_config(k_two_buses);
+    TEST_ASSERT_EQUAL_INT(0, cli_robot_load(&robot, path));
+    opts(&o);
+    o.port = "/dev/right";
+    TEST_ASSERT_EQUAL_INT(0, cli_joint_select(&robot, NULL, 1, &o, &sel));
+    TEST_ASSERT_NOT_NULL(sel.rj);
+    TEST_ASSERT_EQUAL_STRING("hip_r", sel.rj->name);
+    opts(&o);
+    TEST_ASSERT_EQUAL_INT(0, cli_joint_select(&robot, NULL, 5, &o, &sel));
+    TEST_ASSERT_NULL(sel.rj);
+    TEST_ASSERT_EQUAL_STRING("servo 5", sel.name);
+    opts(&o);
+    TEST_ASSERT_EQUAL_INT(-1, cli_joint_select(&robot, NULL, 1, &o, &sel));
+    expect_one_error("id 1 is used on 2 buses");
+}
+
+static void test_unknown_name(void)
+{
+    cli_bus_opts_t o;
+    cli_joint_sel_t sel;
+    write_config(k_two_buses);
+    TEST_ASSERT_EQUAL_INT(0, cli_robot_load(&robot, path));
+    opts(&o);
+    TEST_ASSERT_EQUAL_INT(-1, cli_joint_select(&robot, "ankle", -1, &o, &sel));
+    expect_one_error("no joint named 'ankle'");
+}
+
+/* A value the file allows but the library does not (|zero| > 64): "FILE:LINE: joint ...". */
+static void test_library_refusal_names_the_line(void)
+{
+    cli_bus_opts_t o;
+    cli_joint_sel_t sel;
+    char want[200];
+    write_config(k_two_buses);
+    TEST_ASSERT_EQUAL_INT(0, cli_robot_load(&robot, path));
+    opts(&o);
+    TEST_ASSERT_EQUAL_INT(-1, cli_joint_select(&robot, "knee", -1, &o, &sel));
+    snprintf(want, sizeof want, "%s:15: joint knee: ", path);
+    expect_one_error(want);
+}
+
+static void test_load_error(void)
+{
+    char want[200];
+    write_config("joints:\n  - name: a\n    id: 99\n");
+    TEST_ASSERT_EQUAL_INT(-1, cli_robot_load(&robot, path));
+    snprintf(want, sizeof want, "%s:3: ", path);
+    expect_one_error(want);
+}
+
+#endif
+
+int main(void)
+{
+    UNITY_BEGIN();
+    strcpy(dir, "/tmp/j288-cli-joint.XXXXXX");
+    if (mkdtemp(dir) == NULL) {
+        return 1;
+    }
+    snprintf(path, sizeof path, "%s/robot.yaml", dir);
+    RUN_TEST(test_no_config);
+    RUN_TEST(test_no_config_refusals);
+    RUN_TEST(test_neither_or_both);
+    RUN_TEST(test_both);
+    RUN_TEST(test_pos_allowed);
+#ifdef J288_HAVE_LIBYAML
+    RUN_TEST(test_by_name_fills_bus);
+    RUN_TEST(test_by_id);
+    RUN_TEST(test_unknown_name);
+    RUN_TEST(test_library_refusal_names_the_line);
+    RUN_TEST(test_load_error);
+#endif
+    (void)unlink(path);
+    (void)rmdir(dir);
+    return UNITY_END();
+}
