@@ -92,12 +92,12 @@ HB_HAL := $(FW_nucleo_f446re_HAL:%=$(ST_DIR)/stm32f4xx_hal_driver/Src/stm32f4xx_
     $(ST_DIR)/cmsis_device_f4/Source/Templates/system_stm32f4xx.c
 HB_APP := test/stm32/hal_bench.c port/stm32_hal/j288_stm32.c $(LIB_SRC) $(call TC,m4f,STARTUP)
 HB_CC = $(call CPU_CC,m4f) -DSTM32F446xx -DUSE_HAL_DRIVER -Iexamples/stm32_hal/nucleo_f446re \
-    -Iport/stm32_hal $(CPPFLAGS_LIB) -isystem $(ST_DIR)/stm32f4xx_hal_driver/Inc \
+    -Iport/stm32_hal -Itest/support $(CPPFLAGS_LIB) -isystem $(ST_DIR)/stm32f4xx_hal_driver/Inc \
     -isystem $(ST_DIR)/cmsis_device_f4/Include -isystem $(ST_DIR)/cmsis_core/Include \
     -ffunction-sections -fdata-sections -g
 
 define HB_RULES
-$(BUILD)/bench-stm32-hal/$(1)/app/%.o: %.c $(LIB_HDR) $(wildcard port/stm32_hal/*.h)
+$(BUILD)/bench-stm32-hal/$(1)/app/%.o: %.c $(LIB_HDR) $(wildcard port/stm32_hal/*.h test/support/*.h)
 	@mkdir -p $$(@D)
 	$(HB_CC) -$(1) $(CSTD) $(WARN) -c $$< -o $$@
 $(BUILD)/bench-stm32-hal/$(1)/st/%.o: $(ST_DIR)/%.c
