@@ -20,29 +20,11 @@
  */
 #include "board.h"
 
-UART_HandleTypeDef huart1;
-DMA_HandleTypeDef hdma_usart1_tx;
-DMA_HandleTypeDef hdma_usart1_rx;
-TIM_HandleTypeDef htim2;
-CRC_HandleTypeDef hcrc;
-
-#define BUS_BAUD 6000000u
 #define BUS_IRQ_PRIORITY 5u
-#define TICK_HZ 1000000u
 
 #ifndef BOARD_CLOCK_HSI
 #define BOARD_CLOCK_HSI 0
 #endif
-
-volatile board_fault_t board_fault;
-volatile bool board_clock_hse;
-
-void board_fatal(void)
-{
-    __disable_irq();
-    for (;;) {
-    }
-}
 
 /* The PLL from the 24 MHz crystal or from the 16 MHz HSI, to 4 MHz at its input, VCO
  * 336 MHz, 168 MHz out. */
@@ -184,14 +166,7 @@ bool board_estop_pressed(void)
 
 static void uart_init(void)
 {
-    huart1.Instance = USART1;
-    huart1.Init.BaudRate = BUS_BAUD;
-    huart1.Init.WordLength = UART_WORDLENGTH_8B;
-    huart1.Init.StopBits = UART_STOPBITS_1;
-    huart1.Init.Parity = UART_PARITY_NONE;
-    huart1.Init.Mode = UART_MODE_TX_RX;
-    huart1.Init.HwFlowCtl = UART_HWCONTROL_NONE;
-    huart1.Init.OverSampling = UART_OVERSAMPLING_16;
+    board_uart_settings(UART_OVERSAMPLING_16);
     huart1.Init.OneBitSampling = UART_ONE_BIT_SAMPLE_DISABLE;
     huart1.Init.ClockPrescaler = UART_PRESCALER_DIV1;
     huart1.AdvancedInit.AdvFeatureInit = UART_ADVFEATURE_NO_INIT;
@@ -199,22 +174,9 @@ static void uart_init(void)
         board_fatal();
     }
     /* 16x oversampling: baud = fck / BRR. */
-    if ((huart1.Instance->BRR == 0u) || ((HAL_RCC_GetPCLK2Freq() % BUS_BAUD) != 0u) ||
-        ((HAL_RCC_GetPCLK2Freq() / huart1.Instance->BRR) != BUS_BAUD)) {
+    if ((huart1.Instance->BRR == 0u) || ((HAL_RCC_GetPCLK2Freq() % BOARD_BUS_BAUD) != 0u) ||
+        ((HAL_RCC_GetPCLK2Freq() / huart1.Instance->BRR) != BOARD_BUS_BAUD)) {
         board_fatal(); /* the clock tree does not give 6 Mbps exactly */
-    }
-}
-
-static void timer_init(void)
-{
-    htim2.Instance = TIM2;
-    htim2.Init.Prescaler = (HAL_RCC_GetPCLK1Freq() / TICK_HZ) - 1u; /* APB1 undivided */
-    htim2.Init.CounterMode = TIM_COUNTERMODE_UP;
-    htim2.Init.Period = 0xFFFFFFFFu;
-    htim2.Init.ClockDivision = TIM_CLOCKDIVISION_DIV1;
-    htim2.Init.AutoReloadPreload = TIM_AUTORELOAD_PRELOAD_DISABLE;
-    if ((HAL_TIM_Base_Init(&htim2) != HAL_OK) || (HAL_TIM_Base_Start(&htim2) != HAL_OK)) {
-        board_fatal();
     }
 }
 
@@ -241,37 +203,13 @@ void board_init(void)
     clock_init();
     button_init();
     uart_init();
-    timer_init();
+    board_tick_timer_init(HAL_RCC_GetPCLK1Freq()); /* APB1 undivided */
     crc_init();
 }
 
-/* ---- interrupt handlers (the names of ST's startup_stm32g474xx.s vector table) ---------- */
+/* ---- interrupt handlers (the names of ST's startup_stm32g474xx.s vector table; USART1's and
+ * TIM2's are in board_common.c, HardFault's in cortex_m/board_fault.c) ---------------------- */
 
 void SysTick_Handler(void) { HAL_IncTick(); }
-void USART1_IRQHandler(void) { HAL_UART_IRQHandler(&huart1); }
 void DMA1_Channel1_IRQHandler(void) { HAL_DMA_IRQHandler(&hdma_usart1_tx); }
 void DMA1_Channel2_IRQHandler(void) { HAL_DMA_IRQHandler(&hdma_usart1_rx); }
-void TIM2_IRQHandler(void) { HAL_TIM_IRQHandler(&htim2); }
-
-/* Faults: as on the F446RE board. */
-void board_fault_record(const uint32_t *frame);
-void board_fault_record(const uint32_t *frame)
-{
-    board_fault.cfsr = SCB->CFSR;
-    board_fault.hfsr = SCB->HFSR;
-    board_fault.mmfar = SCB->MMFAR;
-    board_fault.bfar = SCB->BFAR;
-    board_fault.pc = frame[6];
-    board_fault.lr = frame[5];
-    board_fault.count++;
-    board_fatal();
-}
-
-__attribute__((naked)) void HardFault_Handler(void)
-{
-    __asm volatile("tst lr, #4\n\t"
-                   "ite eq\n\t"
-                   "mrseq r0, msp\n\t"
-                   "mrsne r0, psp\n\t"
-                   "b board_fault_record\n\t");
-}
