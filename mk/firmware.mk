@@ -47,7 +47,7 @@ $(BUILD)/firmware/$(1)/obj/%.o: %.c $(LIB_HDR) $(wildcard port/stm32_hal/*.h exa
 $(BUILD)/firmware/$(1)/obj/board.o: examples/stm32_hal/$(1)/board.c $(wildcard examples/stm32_hal/*.h examples/stm32_hal/$(1)/*.h)
 	@mkdir -p $$(@D)
 	$$(FW_$(1)_CC) $(CSTD) $(WARN) -c $$< -o $$@
-$(BUILD)/firmware/$(1)/st/%.o: $(ST_DIR)/%.c $(wildcard examples/stm32_hal/$(1)/*.h)
+$(BUILD)/firmware/$(1)/st/%.o: $(ST_DIR)/%.c $(wildcard examples/stm32_hal/$(1)/*.h) examples/stm32_hal/hal_conf_common.h
 	@mkdir -p $$(@D)
 	$$(FW_$(1)_CC) -std=gnu11 -w -c $$< -o $$@
 $(BUILD)/firmware/$(1)/st/startup.o: $$(FW_$(1)_STARTUP)
