@@ -23,7 +23,7 @@ FW_nucleo_g474re_LD := stm32g474re.ld
 FW_nucleo_g474re_HAL := hal hal_cortex hal_rcc hal_rcc_ex hal_gpio hal_dma hal_dma_ex hal_uart \
     hal_uart_ex hal_tim hal_tim_ex hal_crc hal_crc_ex hal_pwr hal_pwr_ex hal_flash hal_flash_ex
 # Our code keeps every warning (ST's headers are system headers); ST's sources get none.
-FW_APP_SRC := examples/stm32_hal/main.c examples/stm32_hal/board_common.c examples/stm32_hal/cortex_m/board_fault.c \
+FW_APP_SRC := examples/stm32_hal/main.c examples/stm32_hal/board_common.c examples/stm32_hal/nucleo_common/board_nucleo.c \
     port/stm32_hal/j288_stm32.c $(LIB_SRC)
 FW_ELFS := $(foreach b,$(FW_BOARDS),$(BUILD)/firmware/$(b)/j288_$(b).elf)
 

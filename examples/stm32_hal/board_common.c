@@ -3,7 +3,7 @@
  * fault record, board_fatal(), and the two interrupt handlers whose names do not depend on
  * the family. (The bus UART's settings and the tick timer are inline in board.h.)
  */
-#include "board.h"
+#include "board_common.h"
 
 UART_HandleTypeDef huart1;
 DMA_HandleTypeDef hdma_usart1_tx;

@@ -4,11 +4,7 @@
  * clock tree or MSP (the stub has no RCC). The firmware to flash is nucleo_f446re/ (`make
  * firmware`); in a CubeMX project the generated code replaces both.
  */
-#include "board.h"
-
-/* UART, both DMA streams and the timer share one priority, so that none of the port's
- * callbacks preempts another (required with advance_in_isr). */
-#define BUS_IRQ_PRIORITY 5u
+#include "board_common.h"
 
 static void uart_init(void)
 {
@@ -34,14 +30,8 @@ void board_init(void)
     if (HAL_CRC_Init(&hcrc) != HAL_OK) {
         board_fatal();
     }
-    HAL_NVIC_SetPriority(USART1_IRQn, BUS_IRQ_PRIORITY, 0u);
-    HAL_NVIC_SetPriority(DMA2_Stream7_IRQn, BUS_IRQ_PRIORITY, 0u);
-    HAL_NVIC_SetPriority(DMA2_Stream2_IRQn, BUS_IRQ_PRIORITY, 0u);
-    HAL_NVIC_SetPriority(TIM2_IRQn, BUS_IRQ_PRIORITY, 0u);
-    HAL_NVIC_EnableIRQ(USART1_IRQn);
-    HAL_NVIC_EnableIRQ(DMA2_Stream7_IRQn);
-    HAL_NVIC_EnableIRQ(DMA2_Stream2_IRQn);
-    HAL_NVIC_EnableIRQ(TIM2_IRQn);
+    board_bus_irqs_enable(DMA2_Stream7_IRQn, DMA2_Stream2_IRQn);
+    board_timer_irq_enable();
 }
 
 bool board_estop_pressed(void)

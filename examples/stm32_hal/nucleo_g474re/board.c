@@ -18,9 +18,7 @@
  * checks it).
  * The blue user button B1 (PC13, high when pressed on this board) is the emergency stop.
  */
-#include "board.h"
-
-#define BUS_IRQ_PRIORITY 5u
+#include "board_common.h"
 
 #ifndef BOARD_CLOCK_HSI
 #define BOARD_CLOCK_HSI 0
@@ -124,27 +122,7 @@ void HAL_UART_MspInit(UART_HandleTypeDef *huart)
                      DMA_CIRCULAR);
     __HAL_LINKDMA(huart, hdmarx, hdma_usart1_rx);
 
-    HAL_NVIC_SetPriority(USART1_IRQn, BUS_IRQ_PRIORITY, 0u);
-    HAL_NVIC_SetPriority(DMA1_Channel1_IRQn, BUS_IRQ_PRIORITY, 0u);
-    HAL_NVIC_SetPriority(DMA1_Channel2_IRQn, BUS_IRQ_PRIORITY, 0u);
-    HAL_NVIC_EnableIRQ(USART1_IRQn);
-    HAL_NVIC_EnableIRQ(DMA1_Channel1_IRQn);
-    HAL_NVIC_EnableIRQ(DMA1_Channel2_IRQn);
-}
-
-void HAL_TIM_Base_MspInit(TIM_HandleTypeDef *htim)
-{
-    if (htim->Instance == TIM2) {
-        __HAL_RCC_TIM2_CLK_ENABLE();
-        HAL_NVIC_SetPriority(TIM2_IRQn, BUS_IRQ_PRIORITY, 0u);
-        HAL_NVIC_EnableIRQ(TIM2_IRQn);
-    }
-}
-
-void HAL_CRC_MspInit(CRC_HandleTypeDef *h)
-{
-    (void)h;
-    __HAL_RCC_CRC_CLK_ENABLE();
+    board_bus_irqs_enable(DMA1_Channel1_IRQn, DMA1_Channel2_IRQn);
 }
 
 /* ---- peripherals ------------------------------------------------------------------------ */
@@ -208,8 +186,7 @@ void board_init(void)
 }
 
 /* ---- interrupt handlers (the names of ST's startup_stm32g474xx.s vector table; USART1's and
- * TIM2's are in board_common.c, HardFault's in cortex_m/board_fault.c) ---------------------- */
+ * TIM2's are in board_common.c, SysTick's and HardFault's in nucleo_common/board_nucleo.c) - */
 
-void SysTick_Handler(void) { HAL_IncTick(); }
 void DMA1_Channel1_IRQHandler(void) { HAL_DMA_IRQHandler(&hdma_usart1_tx); }
 void DMA1_Channel2_IRQHandler(void) { HAL_DMA_IRQHandler(&hdma_usart1_rx); }
