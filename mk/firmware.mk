@@ -41,10 +41,10 @@ FW_$(1)_CC := $(call TC,m4f,CC) $(CPU_m4f_FLAGS) $(CPU_m4f_DEFS) -D$(FW_$(1)_DEV
 FW_$(1)_OBJ := $(FW_APP_SRC:%.c=$(BUILD)/firmware/$(1)/obj/%.o) $(BUILD)/firmware/$(1)/obj/board.o \
     $$(patsubst $(ST_DIR)/%.c,$(BUILD)/firmware/$(1)/st/%.o,$$(FW_$(1)_ST_SRC)) $(BUILD)/firmware/$(1)/st/startup.o
 
-$(BUILD)/firmware/$(1)/obj/%.o: %.c $(LIB_HDR) $(wildcard port/stm32_hal/*.h examples/stm32_hal/*.h examples/stm32_hal/$(1)/*.h)
+$(BUILD)/firmware/$(1)/obj/%.o: %.c $(LIB_HDR) $(wildcard port/stm32_hal/*.h examples/stm32_hal/*.h examples/stm32_hal/nucleo_common/*.h examples/stm32_hal/$(1)/*.h)
 	@mkdir -p $$(@D)
 	$$(FW_$(1)_CC) $(CSTD) $(WARN) -c $$< -o $$@
-$(BUILD)/firmware/$(1)/obj/board.o: examples/stm32_hal/$(1)/board.c $(wildcard examples/stm32_hal/*.h examples/stm32_hal/$(1)/*.h)
+$(BUILD)/firmware/$(1)/obj/board.o: examples/stm32_hal/$(1)/board.c $(wildcard examples/stm32_hal/*.h examples/stm32_hal/nucleo_common/*.h examples/stm32_hal/$(1)/*.h)
 	@mkdir -p $$(@D)
 	$$(FW_$(1)_CC) $(CSTD) $(WARN) -c $$< -o $$@
 $(BUILD)/firmware/$(1)/st/%.o: $(ST_DIR)/%.c $(wildcard examples/stm32_hal/$(1)/*.h) examples/stm32_hal/hal_conf_common.h

@@ -18,11 +18,7 @@
  * timeout. USART1, both streams and TIM2 share NVIC priority 5 (SysTick 15). The blue user
  * button B1 (PC13, low when pressed) is the emergency stop.
  */
-#include "board_common.h"
-
-#ifndef BOARD_CLOCK_HSI
-#define BOARD_CLOCK_HSI 0
-#endif
+#include "nucleo_common/board_nucleo.h"
 
 /* The PLL from the ST-LINK's 8 MHz (HSE bypass) or from the 16 MHz HSI, to 2 MHz at its
  * input, VCO 360 MHz, 180 MHz out. */
@@ -45,27 +41,13 @@ static HAL_StatusTypeDef pll_start(bool hse)
 
 static void clock_init(void)
 {
-    RCC_ClkInitTypeDef clk = {0};
-
     __HAL_RCC_PWR_CLK_ENABLE();
     __HAL_PWR_VOLTAGESCALING_CONFIG(PWR_REGULATOR_VOLTAGE_SCALE1);
-    /* A board whose ST-LINK does not feed OSC_IN still boots, on the HSI (about 1 %
-     * accurate: enough for the bench, see docs/stm32.md); board_clock_hse says which. */
-    board_clock_hse = !BOARD_CLOCK_HSI && (pll_start(true) == HAL_OK);
-    if (!board_clock_hse && (pll_start(false) != HAL_OK)) {
-        board_fatal();
-    }
+    board_pll_hse_else_hsi(pll_start); /* without the ST-LINK's MCO: the HSI */
     if (HAL_PWREx_EnableOverDrive() != HAL_OK) {
         board_fatal();
     }
-    clk.ClockType = RCC_CLOCKTYPE_HCLK | RCC_CLOCKTYPE_SYSCLK | RCC_CLOCKTYPE_PCLK1 | RCC_CLOCKTYPE_PCLK2;
-    clk.SYSCLKSource = RCC_SYSCLKSOURCE_PLLCLK;
-    clk.AHBCLKDivider = RCC_SYSCLK_DIV1;
-    clk.APB1CLKDivider = RCC_HCLK_DIV4;
-    clk.APB2CLKDivider = RCC_HCLK_DIV2;
-    if (HAL_RCC_ClockConfig(&clk, FLASH_LATENCY_5) != HAL_OK) {
-        board_fatal();
-    }
+    board_sysclk_from_pll(RCC_HCLK_DIV4, RCC_HCLK_DIV2, FLASH_LATENCY_5);
 }
 
 /* ---- MSP: what the HAL's *_Init functions call back for the pins, clocks and streams --- */
@@ -80,35 +62,18 @@ static void dma_stream_init(DMA_HandleTypeDef *h, DMA_Stream_TypeDef *stream, ui
 {
     h->Instance = stream;
     h->Init.Channel = DMA_CHANNEL_4;
-    h->Init.Direction = direction;
-    h->Init.PeriphInc = DMA_PINC_DISABLE;
-    h->Init.MemInc = DMA_MINC_ENABLE;
-    h->Init.PeriphDataAlignment = DMA_PDATAALIGN_BYTE;
-    h->Init.MemDataAlignment = DMA_MDATAALIGN_BYTE;
-    h->Init.Mode = mode;
-    h->Init.Priority = DMA_PRIORITY_HIGH;
     h->Init.FIFOMode = DMA_FIFOMODE_DISABLE;
-    if (HAL_DMA_Init(h) != HAL_OK) {
-        board_fatal();
-    }
+    board_dma_init(h, direction, mode);
 }
 
 void HAL_UART_MspInit(UART_HandleTypeDef *huart)
 {
-    GPIO_InitTypeDef pin = {0};
     if (huart->Instance != USART1) {
         return;
     }
     __HAL_RCC_USART1_CLK_ENABLE();
-    __HAL_RCC_GPIOA_CLK_ENABLE();
     __HAL_RCC_DMA2_CLK_ENABLE();
-
-    pin.Pin = GPIO_PIN_9; /* USART1_TX: the single wire */
-    pin.Mode = GPIO_MODE_AF_PP;
-    pin.Pull = GPIO_PULLUP; /* idle high while nobody drives (add 1-4.7k outside: see docs) */
-    pin.Speed = GPIO_SPEED_FREQ_VERY_HIGH;
-    pin.Alternate = GPIO_AF7_USART1;
-    HAL_GPIO_Init(GPIOA, &pin);
+    board_bus_pin_init();
 
     dma_stream_init(&hdma_usart1_tx, DMA2_Stream7, DMA_MEMORY_TO_PERIPH, DMA_NORMAL);
     __HAL_LINKDMA(huart, hdmatx, hdma_usart1_tx);
@@ -119,16 +84,6 @@ void HAL_UART_MspInit(UART_HandleTypeDef *huart)
 }
 
 /* ---- peripherals ------------------------------------------------------------------------ */
-
-static void button_init(void)
-{
-    GPIO_InitTypeDef pin = {0};
-    __HAL_RCC_GPIOC_CLK_ENABLE();
-    pin.Pin = GPIO_PIN_13;
-    pin.Mode = GPIO_MODE_INPUT;
-    pin.Pull = GPIO_NOPULL; /* B1 has its own pull-up */
-    HAL_GPIO_Init(GPIOC, &pin);
-}
 
 bool board_estop_pressed(void)
 {
@@ -169,7 +124,7 @@ void board_init(void)
         board_fatal();
     }
     clock_init();
-    button_init();
+    board_button_init(GPIO_NOPULL); /* B1 has its own pull-up */
     uart_init();
     /* APB1 runs at HCLK/4, so its timers get twice PCLK1: 90 MHz. */
     board_tick_timer_init(2u * HAL_RCC_GetPCLK1Freq());

@@ -18,11 +18,7 @@
  * checks it).
  * The blue user button B1 (PC13, high when pressed on this board) is the emergency stop.
  */
-#include "board_common.h"
-
-#ifndef BOARD_CLOCK_HSI
-#define BOARD_CLOCK_HSI 0
-#endif
+#include "nucleo_common/board_nucleo.h"
 
 /* The PLL from the 24 MHz crystal or from the 16 MHz HSI, to 4 MHz at its input, VCO
  * 336 MHz, 168 MHz out. */
@@ -45,24 +41,11 @@ static HAL_StatusTypeDef pll_start(bool hse)
 
 static void clock_init(void)
 {
-    RCC_ClkInitTypeDef clk = {0};
-
     if (HAL_PWREx_ControlVoltageScaling(PWR_REGULATOR_VOLTAGE_SCALE1_BOOST) != HAL_OK) {
         board_fatal();
     }
-    /* Without the crystal the board still boots, on the HSI (board_clock_hse says which). */
-    board_clock_hse = !BOARD_CLOCK_HSI && (pll_start(true) == HAL_OK);
-    if (!board_clock_hse && (pll_start(false) != HAL_OK)) {
-        board_fatal();
-    }
-    clk.ClockType = RCC_CLOCKTYPE_HCLK | RCC_CLOCKTYPE_SYSCLK | RCC_CLOCKTYPE_PCLK1 | RCC_CLOCKTYPE_PCLK2;
-    clk.SYSCLKSource = RCC_SYSCLKSOURCE_PLLCLK;
-    clk.AHBCLKDivider = RCC_SYSCLK_DIV1;
-    clk.APB1CLKDivider = RCC_HCLK_DIV1;
-    clk.APB2CLKDivider = RCC_HCLK_DIV1;
-    if (HAL_RCC_ClockConfig(&clk, FLASH_LATENCY_4) != HAL_OK) {
-        board_fatal();
-    }
+    board_pll_hse_else_hsi(pll_start); /* without the crystal: the HSI */
+    board_sysclk_from_pll(RCC_HCLK_DIV1, RCC_HCLK_DIV1, FLASH_LATENCY_4);
 }
 
 /* ---- MSP: what the HAL's *_Init functions call back for the pins, clocks and channels --- */
@@ -79,21 +62,11 @@ static void dma_channel_init(DMA_HandleTypeDef *h, DMA_Channel_TypeDef *channel,
 {
     h->Instance = channel;
     h->Init.Request = request;
-    h->Init.Direction = direction;
-    h->Init.PeriphInc = DMA_PINC_DISABLE;
-    h->Init.MemInc = DMA_MINC_ENABLE;
-    h->Init.PeriphDataAlignment = DMA_PDATAALIGN_BYTE;
-    h->Init.MemDataAlignment = DMA_MDATAALIGN_BYTE;
-    h->Init.Mode = mode;
-    h->Init.Priority = DMA_PRIORITY_HIGH;
-    if (HAL_DMA_Init(h) != HAL_OK) {
-        board_fatal();
-    }
+    board_dma_init(h, direction, mode);
 }
 
 void HAL_UART_MspInit(UART_HandleTypeDef *huart)
 {
-    GPIO_InitTypeDef pin = {0};
     RCC_PeriphCLKInitTypeDef pclk = {0};
     if (huart->Instance != USART1) {
         return;
@@ -104,16 +77,9 @@ void HAL_UART_MspInit(UART_HandleTypeDef *huart)
         board_fatal();
     }
     __HAL_RCC_USART1_CLK_ENABLE();
-    __HAL_RCC_GPIOA_CLK_ENABLE();
     __HAL_RCC_DMAMUX1_CLK_ENABLE();
     __HAL_RCC_DMA1_CLK_ENABLE();
-
-    pin.Pin = GPIO_PIN_9; /* USART1_TX: the single wire */
-    pin.Mode = GPIO_MODE_AF_PP;
-    pin.Pull = GPIO_PULLUP; /* idle high while nobody drives (add 1-4.7k outside: see docs) */
-    pin.Speed = GPIO_SPEED_FREQ_VERY_HIGH;
-    pin.Alternate = GPIO_AF7_USART1;
-    HAL_GPIO_Init(GPIOA, &pin);
+    board_bus_pin_init();
 
     dma_channel_init(&hdma_usart1_tx, DMA1_Channel1, DMA_REQUEST_USART1_TX, DMA_MEMORY_TO_PERIPH,
                      DMA_NORMAL);
@@ -126,16 +92,6 @@ void HAL_UART_MspInit(UART_HandleTypeDef *huart)
 }
 
 /* ---- peripherals ------------------------------------------------------------------------ */
-
-static void button_init(void)
-{
-    GPIO_InitTypeDef pin = {0};
-    __HAL_RCC_GPIOC_CLK_ENABLE();
-    pin.Pin = GPIO_PIN_13;
-    pin.Mode = GPIO_MODE_INPUT;
-    pin.Pull = GPIO_PULLDOWN; /* B1 pulls PC13 high when pressed; never let the pin float */
-    HAL_GPIO_Init(GPIOC, &pin);
-}
 
 bool board_estop_pressed(void)
 {
@@ -179,7 +135,7 @@ void board_init(void)
         board_fatal();
     }
     clock_init();
-    button_init();
+    board_button_init(GPIO_PULLDOWN); /* B1 pulls PC13 high when pressed: never let it float */
     uart_init();
     board_tick_timer_init(HAL_RCC_GetPCLK1Freq()); /* APB1 undivided */
     crc_init();
