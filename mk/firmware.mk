@@ -23,7 +23,8 @@ FW_nucleo_g474re_LD := stm32g474re.ld
 FW_nucleo_g474re_HAL := hal hal_cortex hal_rcc hal_rcc_ex hal_gpio hal_dma hal_dma_ex hal_uart \
     hal_uart_ex hal_tim hal_tim_ex hal_crc hal_crc_ex hal_pwr hal_pwr_ex hal_flash hal_flash_ex
 # Our code keeps every warning (ST's headers are system headers); ST's sources get none.
-FW_APP_SRC := examples/stm32_hal/main.c port/stm32_hal/j288_stm32.c $(LIB_SRC)
+FW_APP_SRC := examples/stm32_hal/main.c examples/stm32_hal/board_common.c examples/stm32_hal/nucleo_common/board_nucleo.c \
+    port/stm32_hal/j288_stm32.c $(LIB_SRC)
 FW_ELFS := $(foreach b,$(FW_BOARDS),$(BUILD)/firmware/$(b)/j288_$(b).elf)
 
 # $(call FW_RULES,board)
@@ -40,13 +41,13 @@ FW_$(1)_CC := $(call TC,m4f,CC) $(CPU_m4f_FLAGS) $(CPU_m4f_DEFS) -D$(FW_$(1)_DEV
 FW_$(1)_OBJ := $(FW_APP_SRC:%.c=$(BUILD)/firmware/$(1)/obj/%.o) $(BUILD)/firmware/$(1)/obj/board.o \
     $$(patsubst $(ST_DIR)/%.c,$(BUILD)/firmware/$(1)/st/%.o,$$(FW_$(1)_ST_SRC)) $(BUILD)/firmware/$(1)/st/startup.o
 
-$(BUILD)/firmware/$(1)/obj/%.o: %.c $(LIB_HDR) $(wildcard port/stm32_hal/*.h examples/stm32_hal/*.h examples/stm32_hal/$(1)/*.h)
+$(BUILD)/firmware/$(1)/obj/%.o: %.c $(LIB_HDR) $(wildcard port/stm32_hal/*.h examples/stm32_hal/*.h examples/stm32_hal/nucleo_common/*.h examples/stm32_hal/$(1)/*.h)
 	@mkdir -p $$(@D)
 	$$(FW_$(1)_CC) $(CSTD) $(WARN) -c $$< -o $$@
-$(BUILD)/firmware/$(1)/obj/board.o: examples/stm32_hal/$(1)/board.c $(wildcard examples/stm32_hal/*.h examples/stm32_hal/$(1)/*.h)
+$(BUILD)/firmware/$(1)/obj/board.o: examples/stm32_hal/$(1)/board.c $(wildcard examples/stm32_hal/*.h examples/stm32_hal/nucleo_common/*.h examples/stm32_hal/$(1)/*.h)
 	@mkdir -p $$(@D)
 	$$(FW_$(1)_CC) $(CSTD) $(WARN) -c $$< -o $$@
-$(BUILD)/firmware/$(1)/st/%.o: $(ST_DIR)/%.c $(wildcard examples/stm32_hal/$(1)/*.h)
+$(BUILD)/firmware/$(1)/st/%.o: $(ST_DIR)/%.c $(wildcard examples/stm32_hal/$(1)/*.h) examples/stm32_hal/hal_conf_common.h
 	@mkdir -p $$(@D)
 	$$(FW_$(1)_CC) -std=gnu11 -w -c $$< -o $$@
 $(BUILD)/firmware/$(1)/st/startup.o: $$(FW_$(1)_STARTUP)
@@ -92,12 +93,12 @@ HB_HAL := $(FW_nucleo_f446re_HAL:%=$(ST_DIR)/stm32f4xx_hal_driver/Src/stm32f4xx_
     $(ST_DIR)/cmsis_device_f4/Source/Templates/system_stm32f4xx.c
 HB_APP := test/stm32/hal_bench.c port/stm32_hal/j288_stm32.c $(LIB_SRC) $(call TC,m4f,STARTUP)
 HB_CC = $(call CPU_CC,m4f) -DSTM32F446xx -DUSE_HAL_DRIVER -Iexamples/stm32_hal/nucleo_f446re \
-    -Iport/stm32_hal $(CPPFLAGS_LIB) -isystem $(ST_DIR)/stm32f4xx_hal_driver/Inc \
+    -Iport/stm32_hal -Itest/support $(CPPFLAGS_LIB) -isystem $(ST_DIR)/stm32f4xx_hal_driver/Inc \
     -isystem $(ST_DIR)/cmsis_device_f4/Include -isystem $(ST_DIR)/cmsis_core/Include \
     -ffunction-sections -fdata-sections -g
 
 define HB_RULES
-$(BUILD)/bench-stm32-hal/$(1)/app/%.o: %.c $(LIB_HDR) $(wildcard port/stm32_hal/*.h)
+$(BUILD)/bench-stm32-hal/$(1)/app/%.o: %.c $(LIB_HDR) $(wildcard port/stm32_hal/*.h test/support/*.h)
 	@mkdir -p $$(@D)
 	$(HB_CC) -$(1) $(CSTD) $(WARN) -c $$< -o $$@
 $(BUILD)/bench-stm32-hal/$(1)/st/%.o: $(ST_DIR)/%.c

@@ -1,7 +1,8 @@
 /* board.h - what the example's main.c needs from a board: the HAL handles of the bus, the
  * emergency-stop button, board_init() and board_fatal(). Boards: nucleo_f446re/board.c and
- * nucleo_g474re/board.c (firmware against ST's HAL, `make firmware`), board_stub.c (the link
- * check against the HAL stub, `make arm`). In a CubeMX project the generated code provides
+ * nucleo_g474re/board.c (firmware against ST's HAL, `make firmware`, with
+ * nucleo_common/board_nucleo.c), board_stub.c (the link check against the HAL stub, `make
+ * arm`); all with board_common.c and board_common.h. In a CubeMX project the generated code provides
  * the same handles. */
 #ifndef J288_EXAMPLE_BOARD_H
 #define J288_EXAMPLE_BOARD_H
@@ -31,7 +32,11 @@ extern volatile bool board_clock_hse;
 void board_init(void);
 /* The emergency-stop button (the NUCLEO's blue button B1 on PC13) is pressed. */
 bool board_estop_pressed(void);
-/* Interrupts off, stop here (the servos lock themselves after their 1 s watchdog). */
+/* Interrupts off, stop here (the servos lock themselves after their 1 s watchdog). Declared
+ * noreturn so that the callers in other files need no code after the call. */
+#if defined(__GNUC__)
+__attribute__((noreturn))
+#endif
 void board_fatal(void);
 
 #endif /* J288_EXAMPLE_BOARD_H */

@@ -70,9 +70,11 @@ static void record(fake_hal_fn_t fn, const void *handle, uint32_t arg)
     }
 }
 
-static bool take_failure(fake_hal_fn_t fn)
+/* A call of fn: logged; true when the test scripted it to fail (once, by fake_hal_fail_next). */
+static bool call_fails(fake_hal_fn_t fn, const void *handle, uint32_t arg)
 {
     bool f = fail_next[fn];
+    record(fn, handle, arg);
     fail_next[fn] = false;
     return f;
 }
@@ -153,37 +155,32 @@ HAL_StatusTypeDef HAL_HalfDuplex_Init(UART_HandleTypeDef *huart)
     return HAL_OK;
 }
 
-HAL_StatusTypeDef HAL_HalfDuplex_EnableTransmitter(UART_HandleTypeDef *huart)
+static HAL_StatusTypeDef half_duplex_enable(UART_HandleTypeDef *huart, bool transmitter)
 {
     fake_uart_t *u = uart_of(huart);
-    record(FAKE_HALFDUPLEX_TX, huart, 0u);
-    if (take_failure(FAKE_HALFDUPLEX_TX)) {
+    if (call_fails(transmitter ? FAKE_HALFDUPLEX_TX : FAKE_HALFDUPLEX_RX, huart, 0u)) {
         return HAL_ERROR;
     }
-    u->te = true;
-    u->re = false;
+    u->te = transmitter;
+    u->re = !transmitter;
     huart->gState = HAL_UART_STATE_READY; /* as ST's HAL does, whatever the transmit's state */
     return HAL_OK;
 }
 
+HAL_StatusTypeDef HAL_HalfDuplex_EnableTransmitter(UART_HandleTypeDef *huart)
+{
+    return half_duplex_enable(huart, true);
+}
+
 HAL_StatusTypeDef HAL_HalfDuplex_EnableReceiver(UART_HandleTypeDef *huart)
 {
-    fake_uart_t *u = uart_of(huart);
-    record(FAKE_HALFDUPLEX_RX, huart, 0u);
-    if (take_failure(FAKE_HALFDUPLEX_RX)) {
-        return HAL_ERROR;
-    }
-    u->te = false;
-    u->re = true;
-    huart->gState = HAL_UART_STATE_READY; /* as ST's HAL does, whatever the transmit's state */
-    return HAL_OK;
+    return half_duplex_enable(huart, false);
 }
 
 HAL_StatusTypeDef HAL_UART_Transmit_DMA(UART_HandleTypeDef *huart, const uint8_t *pData, uint16_t Size)
 {
     fake_uart_t *u = uart_of(huart);
-    record(FAKE_TRANSMIT_DMA, huart, Size);
-    if (take_failure(FAKE_TRANSMIT_DMA) || (pData == NULL) || (Size == 0u) ||
+    if (call_fails(FAKE_TRANSMIT_DMA, huart, Size) || (pData == NULL) || (Size == 0u) ||
         (huart->gState != HAL_UART_STATE_READY)) {
         return (huart->gState != HAL_UART_STATE_READY) ? HAL_BUSY : HAL_ERROR;
     }
@@ -204,8 +201,7 @@ HAL_StatusTypeDef HAL_UART_Transmit_DMA(UART_HandleTypeDef *huart, const uint8_t
 HAL_StatusTypeDef HAL_UARTEx_ReceiveToIdle_DMA(UART_HandleTypeDef *huart, uint8_t *pData, uint16_t Size)
 {
     fake_uart_t *u = uart_of(huart);
-    record(FAKE_RECEIVE_TO_IDLE_DMA, huart, Size);
-    if (take_failure(FAKE_RECEIVE_TO_IDLE_DMA) || (pData == NULL) || (Size == 0u)) {
+    if (call_fails(FAKE_RECEIVE_TO_IDLE_DMA, huart, Size) || (pData == NULL) || (Size == 0u)) {
         return HAL_ERROR;
     }
     if (huart->RxState != HAL_UART_STATE_READY) {
@@ -229,8 +225,7 @@ HAL_StatusTypeDef HAL_UARTEx_ReceiveToIdle_DMA(UART_HandleTypeDef *huart, uint8_
 HAL_StatusTypeDef HAL_UART_AbortReceive(UART_HandleTypeDef *huart)
 {
     fake_uart_t *u = uart_of(huart);
-    record(FAKE_ABORT_RECEIVE, huart, 0u);
-    if (take_failure(FAKE_ABORT_RECEIVE)) {
+    if (call_fails(FAKE_ABORT_RECEIVE, huart, 0u)) {
         return HAL_ERROR;
     }
     u->rx_buf = NULL;
@@ -245,8 +240,7 @@ HAL_StatusTypeDef HAL_UART_AbortReceive(UART_HandleTypeDef *huart)
 HAL_StatusTypeDef HAL_UART_AbortTransmit(UART_HandleTypeDef *huart)
 {
     fake_uart_t *u = uart_of(huart);
-    record(FAKE_ABORT_TRANSMIT, huart, 0u);
-    if (take_failure(FAKE_ABORT_TRANSMIT)) {
+    if (call_fails(FAKE_ABORT_TRANSMIT, huart, 0u)) {
         return HAL_ERROR;
     }
     u->tx_busy = false;

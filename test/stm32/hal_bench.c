@@ -21,6 +21,7 @@
 
 #include "j288/j288.h"
 #include "j288_stm32.h"
+#include "worked_cmd.h"
 
 #define SYST_CSR (*(volatile uint32_t *)0xE000E010u)
 #define SYST_RVR (*(volatile uint32_t *)0xE000E014u)
@@ -79,19 +80,6 @@ static void on_done(void *user, const j288_txn_t *txn)
     done_ok += (txn->result == J288_OK) ? 1u : 0u;
 }
 
-static j288_cmd_raw_t foc3_cmd(void)
-{
-    j288_cmd_raw_t c;
-    memset(&c, 0, sizeof c);
-    c.id = 3u;
-    c.status = J288_MODE_FOC;
-    c.watchdog = true;
-    c.pos = 5215;
-    c.kp = 1280;
-    c.kd = 12800;
-    return c;
-}
-
 /* ---- lib/ alone: a port whose operations do nothing ------------------------------------- */
 
 static j288_bus_t plain_bus;
@@ -132,7 +120,7 @@ static const j288_port_t nop_port = {
 
 static void plain_transaction(void)
 {
-    j288_cmd_raw_t cmd = foc3_cmd();
+    j288_cmd_raw_t cmd = worked_cmd();
     phase_begin();
     (void)j288_bus_submit(&plain_bus, &cmd, clock_us, on_done, NULL);
     j288_bus_poll(&plain_bus, clock_us);
@@ -249,7 +237,7 @@ static void hw_reply_then_idle(void)
 
 static void port_transaction(void)
 {
-    j288_cmd_raw_t cmd = foc3_cmd();
+    j288_cmd_raw_t cmd = worked_cmd();
     j288_bus_t *bus = j288_stm32_bus(&port);
     phase_begin();
     (void)j288_bus_submit(bus, &cmd, clock_us, on_done, NULL);

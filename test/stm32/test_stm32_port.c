@@ -14,6 +14,7 @@
 #include "fake_hal.h"
 #include "j288/j288.h"
 #include "j288_stm32.h"
+#include "worked_cmd.h"
 
 /* ---- the application side: HAL callbacks forwarded to the port ------------------------- */
 
@@ -60,19 +61,6 @@ static void on_done(void *user, const j288_txn_t *txn)
     (void)user;
     done_count++;
     last_txn = *txn;
-}
-
-static j288_cmd_raw_t foc3_cmd(void)
-{
-    j288_cmd_raw_t c;
-    memset(&c, 0, sizeof c);
-    c.id = 3u;
-    c.status = J288_MODE_FOC;
-    c.watchdog = true;
-    c.pos = 5215;
-    c.kp = 1280;
-    c.kd = 12800;
-    return c;
 }
 
 static j288_stm32_config_t base_config(UART_HandleTypeDef *h, j288_stm32_dma_t *dma)
@@ -137,7 +125,7 @@ static void init_port1(const j288_bus_config_t *bus_cfg, bool timer, bool de)
 /* Submit foc3 on port1 and complete its transmit. */
 static void send_foc3(void)
 {
-    j288_cmd_raw_t cmd = foc3_cmd();
+    j288_cmd_raw_t cmd = worked_cmd();
     TEST_ASSERT_EQUAL_INT(J288_OK, j288_bus_submit(j288_stm32_bus(&port1), &cmd, fake_now, on_done, NULL));
     j288_bus_poll(j288_stm32_bus(&port1), fake_now);
     TEST_ASSERT_TRUE(fake_hal_tx_busy(&huart1));
@@ -218,7 +206,7 @@ static void test_full_transaction_call_order_and_bytes(void)
     init_port1(NULL, false, true);
     fake_hal_log_clear();
 
-    j288_cmd_raw_t cmd = foc3_cmd();
+    j288_cmd_raw_t cmd = worked_cmd();
     TEST_ASSERT_EQUAL_INT(J288_OK, j288_bus_submit(j288_stm32_bus(&port1), &cmd, fake_now, on_done, NULL));
     poll1();
 
@@ -419,7 +407,7 @@ static void test_advance_in_isr_timeout_ends_in_timer_interrupt(void)
 
 static void test_transmit_dma_failure_is_a_port_error(void)
 {
-    j288_cmd_raw_t cmd = foc3_cmd();
+    j288_cmd_raw_t cmd = worked_cmd();
     init_port1(NULL, false, false);
     fake_hal_fail_next(FAKE_TRANSMIT_DMA);
     (void)j288_bus_submit(j288_stm32_bus(&port1), &cmd, fake_now, on_done, NULL);
@@ -446,7 +434,7 @@ static void test_receive_arm_failure_is_reported(void)
 
 static void test_bytes_during_transmit_are_not_heard(void)
 {
-    j288_cmd_raw_t cmd = foc3_cmd();
+    j288_cmd_raw_t cmd = worked_cmd();
     init_port1(NULL, false, false);
     TEST_ASSERT_EQUAL_INT(J288_OK, j288_bus_submit(j288_stm32_bus(&port1), &cmd, fake_now, on_done, NULL));
     poll1();
@@ -456,7 +444,7 @@ static void test_bytes_during_transmit_are_not_heard(void)
 
 static void test_two_buses_route_by_handle(void)
 {
-    j288_cmd_raw_t cmd = foc3_cmd();
+    j288_cmd_raw_t cmd = worked_cmd();
     j288_stm32_config_t c2 = base_config(&huart2, &dma2);
     init_port1(NULL, false, false);
     TEST_ASSERT_EQUAL_INT(J288_OK, j288_stm32_init(&port2, &c2, NULL));
@@ -512,7 +500,7 @@ static void test_estop_broadcasts_lock_without_waiting(void)
 static void test_scheduler_sweep_over_port(void)
 {
     static j288_sched_t sched;
-    j288_cmd_raw_t cmd = foc3_cmd();
+    j288_cmd_raw_t cmd = worked_cmd();
     init_port1(NULL, false, false);
     TEST_ASSERT_EQUAL_INT(J288_OK, j288_sched_init(&sched, j288_stm32_bus(&port1), NULL));
     TEST_ASSERT_EQUAL_INT(J288_OK, j288_sched_enable(&sched, 3u, true));
@@ -724,7 +712,7 @@ static void wait_out_failure(void)
  * must not find the UART still busy transmitting. */
 static void test_stalled_transmit_is_aborted_and_the_next_transaction_works(void)
 {
-    j288_cmd_raw_t cmd = foc3_cmd();
+    j288_cmd_raw_t cmd = worked_cmd();
     init_port1(NULL, false, false);
     TEST_ASSERT_EQUAL_INT(J288_OK, j288_bus_submit(j288_stm32_bus(&port1), &cmd, fake_now, on_done, NULL));
     poll1();
@@ -753,7 +741,7 @@ static void test_transmit_stream_left_busy_is_recovered(void)
 
 static void test_receive_stream_left_busy_is_recovered(void)
 {
-    j288_cmd_raw_t cmd = foc3_cmd();
+    j288_cmd_raw_t cmd = worked_cmd();
     init_port1(NULL, false, false);
     TEST_ASSERT_EQUAL_INT(J288_OK, j288_bus_submit(j288_stm32_bus(&port1), &cmd, fake_now, on_done, NULL));
     poll1();
@@ -775,7 +763,7 @@ static void test_turnaround_to_transmit_failure_is_a_port_error(void)
     memset(&bc, 0, sizeof bc);
     init_port1(&bc, false, false);
     for (size_t i = 0; i < sizeof fails / sizeof fails[0]; i++) {
-        j288_cmd_raw_t cmd = foc3_cmd();
+        j288_cmd_raw_t cmd = worked_cmd();
         unsigned sent = fake_hal_count(FAKE_TRANSMIT_DMA);
         int before = done_count;
         fake_hal_fail_next(fails[i]);
@@ -819,7 +807,7 @@ static void test_turnaround_to_receive_failure_is_a_line_error(void)
  * transceiver is released, and its completion no longer reaches the bus. */
 static void test_deinit_during_a_transmit_stops_it_and_releases_the_line(void)
 {
-    j288_cmd_raw_t cmd = foc3_cmd();
+    j288_cmd_raw_t cmd = worked_cmd();
     init_port1(NULL, false, true);
     TEST_ASSERT_EQUAL_INT(J288_OK, j288_bus_submit(j288_stm32_bus(&port1), &cmd, fake_now, on_done, NULL));
     TEST_ASSERT_TRUE(fake_hal_tx_busy(&huart1));

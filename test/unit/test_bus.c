@@ -3,6 +3,7 @@
 
 #include "fake_port.h"
 #include "j288/j288.h"
+#include "worked_cmd.h"
 
 #include <string.h>
 
@@ -42,19 +43,6 @@ static void on_done(void *user, const j288_txn_t *txn)
     cb.txn = *txn;
     cb.user = user;
     cb.state_in_cb = j288_bus_state(&bus);
-}
-
-static j288_cmd_raw_t worked_cmd(void)
-{
-    j288_cmd_raw_t c;
-    memset(&c, 0, sizeof c);
-    c.id = 3u;
-    c.status = J288_MODE_FOC;
-    c.watchdog = true;
-    c.pos = 5215;
-    c.kp = 1280;
-    c.kd = 12800;
-    return c;
 }
 
 static j288_cmd_raw_t lock_cmd(uint8_t id)

@@ -18,32 +18,7 @@
  * timeout. USART1, both streams and TIM2 share NVIC priority 5 (SysTick 15). The blue user
  * button B1 (PC13, low when pressed) is the emergency stop.
  */
-#include "board.h"
-
-UART_HandleTypeDef huart1;
-DMA_HandleTypeDef hdma_usart1_tx;
-DMA_HandleTypeDef hdma_usart1_rx;
-TIM_HandleTypeDef htim2;
-CRC_HandleTypeDef hcrc;
-
-#define BUS_BAUD 6000000u
-#define BUS_IRQ_PRIORITY 5u
-#define TICK_HZ 1000000u
-
-#ifndef BOARD_CLOCK_HSI
-#define BOARD_CLOCK_HSI 0
-#endif
-
-/* What the fault handler saw, for a debugger (volatile: kept however the code optimises). */
-volatile board_fault_t board_fault;
-volatile bool board_clock_hse;
-
-void board_fatal(void)
-{
-    __disable_irq();
-    for (;;) {
-    }
-}
+#include "nucleo_common/board_nucleo.h"
 
 /* The PLL from the ST-LINK's 8 MHz (HSE bypass) or from the 16 MHz HSI, to 2 MHz at its
  * input, VCO 360 MHz, 180 MHz out. */
@@ -66,27 +41,13 @@ static HAL_StatusTypeDef pll_start(bool hse)
 
 static void clock_init(void)
 {
-    RCC_ClkInitTypeDef clk = {0};
-
     __HAL_RCC_PWR_CLK_ENABLE();
     __HAL_PWR_VOLTAGESCALING_CONFIG(PWR_REGULATOR_VOLTAGE_SCALE1);
-    /* A board whose ST-LINK does not feed OSC_IN still boots, on the HSI (about 1 %
-     * accurate: enough for the bench, see docs/stm32.md); board_clock_hse says which. */
-    board_clock_hse = !BOARD_CLOCK_HSI && (pll_start(true) == HAL_OK);
-    if (!board_clock_hse && (pll_start(false) != HAL_OK)) {
-        board_fatal();
-    }
+    board_pll_hse_else_hsi(pll_start); /* without the ST-LINK's MCO: the HSI */
     if (HAL_PWREx_EnableOverDrive() != HAL_OK) {
         board_fatal();
     }
-    clk.ClockType = RCC_CLOCKTYPE_HCLK | RCC_CLOCKTYPE_SYSCLK | RCC_CLOCKTYPE_PCLK1 | RCC_CLOCKTYPE_PCLK2;
-    clk.SYSCLKSource = RCC_SYSCLKSOURCE_PLLCLK;
-    clk.AHBCLKDivider = RCC_SYSCLK_DIV1;
-    clk.APB1CLKDivider = RCC_HCLK_DIV4;
-    clk.APB2CLKDivider = RCC_HCLK_DIV2;
-    if (HAL_RCC_ClockConfig(&clk, FLASH_LATENCY_5) != HAL_OK) {
-        board_fatal();
-    }
+    board_sysclk_from_pll(RCC_HCLK_DIV4, RCC_HCLK_DIV2, FLASH_LATENCY_5);
 }
 
 /* ---- MSP: what the HAL's *_Init functions call back for the pins, clocks and streams --- */
@@ -101,75 +62,28 @@ static void dma_stream_init(DMA_HandleTypeDef *h, DMA_Stream_TypeDef *stream, ui
 {
     h->Instance = stream;
     h->Init.Channel = DMA_CHANNEL_4;
-    h->Init.Direction = direction;
-    h->Init.PeriphInc = DMA_PINC_DISABLE;
-    h->Init.MemInc = DMA_MINC_ENABLE;
-    h->Init.PeriphDataAlignment = DMA_PDATAALIGN_BYTE;
-    h->Init.MemDataAlignment = DMA_MDATAALIGN_BYTE;
-    h->Init.Mode = mode;
-    h->Init.Priority = DMA_PRIORITY_HIGH;
     h->Init.FIFOMode = DMA_FIFOMODE_DISABLE;
-    if (HAL_DMA_Init(h) != HAL_OK) {
-        board_fatal();
-    }
+    board_dma_init(h, direction, mode);
 }
 
 void HAL_UART_MspInit(UART_HandleTypeDef *huart)
 {
-    GPIO_InitTypeDef pin = {0};
     if (huart->Instance != USART1) {
         return;
     }
     __HAL_RCC_USART1_CLK_ENABLE();
-    __HAL_RCC_GPIOA_CLK_ENABLE();
     __HAL_RCC_DMA2_CLK_ENABLE();
-
-    pin.Pin = GPIO_PIN_9; /* USART1_TX: the single wire */
-    pin.Mode = GPIO_MODE_AF_PP;
-    pin.Pull = GPIO_PULLUP; /* idle high while nobody drives (add 1-4.7k outside: see docs) */
-    pin.Speed = GPIO_SPEED_FREQ_VERY_HIGH;
-    pin.Alternate = GPIO_AF7_USART1;
-    HAL_GPIO_Init(GPIOA, &pin);
+    board_bus_pin_init();
 
     dma_stream_init(&hdma_usart1_tx, DMA2_Stream7, DMA_MEMORY_TO_PERIPH, DMA_NORMAL);
     __HAL_LINKDMA(huart, hdmatx, hdma_usart1_tx);
     dma_stream_init(&hdma_usart1_rx, DMA2_Stream2, DMA_PERIPH_TO_MEMORY, DMA_CIRCULAR);
     __HAL_LINKDMA(huart, hdmarx, hdma_usart1_rx);
 
-    HAL_NVIC_SetPriority(USART1_IRQn, BUS_IRQ_PRIORITY, 0u);
-    HAL_NVIC_SetPriority(DMA2_Stream7_IRQn, BUS_IRQ_PRIORITY, 0u);
-    HAL_NVIC_SetPriority(DMA2_Stream2_IRQn, BUS_IRQ_PRIORITY, 0u);
-    HAL_NVIC_EnableIRQ(USART1_IRQn);
-    HAL_NVIC_EnableIRQ(DMA2_Stream7_IRQn);
-    HAL_NVIC_EnableIRQ(DMA2_Stream2_IRQn);
-}
-
-void HAL_TIM_Base_MspInit(TIM_HandleTypeDef *htim)
-{
-    if (htim->Instance == TIM2) {
-        __HAL_RCC_TIM2_CLK_ENABLE();
-        HAL_NVIC_SetPriority(TIM2_IRQn, BUS_IRQ_PRIORITY, 0u);
-        HAL_NVIC_EnableIRQ(TIM2_IRQn);
-    }
-}
-
-void HAL_CRC_MspInit(CRC_HandleTypeDef *h)
-{
-    (void)h;
-    __HAL_RCC_CRC_CLK_ENABLE();
+    board_bus_irqs_enable(DMA2_Stream7_IRQn, DMA2_Stream2_IRQn);
 }
 
 /* ---- peripherals ------------------------------------------------------------------------ */
-
-static void button_init(void)
-{
-    GPIO_InitTypeDef pin = {0};
-    __HAL_RCC_GPIOC_CLK_ENABLE();
-    pin.Pin = GPIO_PIN_13;
-    pin.Mode = GPIO_MODE_INPUT;
-    pin.Pull = GPIO_NOPULL; /* B1 has its own pull-up */
-    HAL_GPIO_Init(GPIOC, &pin);
-}
 
 bool board_estop_pressed(void)
 {
@@ -187,33 +101,12 @@ static uint32_t uart_actual_baud(void)
 
 static void uart_init(void)
 {
-    huart1.Instance = USART1;
-    huart1.Init.BaudRate = BUS_BAUD;
-    huart1.Init.WordLength = UART_WORDLENGTH_8B;
-    huart1.Init.StopBits = UART_STOPBITS_1;
-    huart1.Init.Parity = UART_PARITY_NONE;
-    huart1.Init.Mode = UART_MODE_TX_RX;
-    huart1.Init.HwFlowCtl = UART_HWCONTROL_NONE;
-    huart1.Init.OverSampling = UART_OVERSAMPLING_8;
+    board_uart_settings(UART_OVERSAMPLING_8);
     if (HAL_HalfDuplex_Init(&huart1) != HAL_OK) {
         board_fatal();
     }
-    if ((uart_actual_baud() != BUS_BAUD) || ((HAL_RCC_GetPCLK2Freq() % BUS_BAUD) != 0u)) {
+    if ((uart_actual_baud() != BOARD_BUS_BAUD) || ((HAL_RCC_GetPCLK2Freq() % BOARD_BUS_BAUD) != 0u)) {
         board_fatal(); /* the clock tree does not give 6 Mbps exactly */
-    }
-}
-
-static void timer_init(void)
-{
-    /* APB1 runs at HCLK/4, so its timers get twice PCLK1: 90 MHz. */
-    htim2.Instance = TIM2;
-    htim2.Init.Prescaler = ((2u * HAL_RCC_GetPCLK1Freq()) / TICK_HZ) - 1u;
-    htim2.Init.CounterMode = TIM_COUNTERMODE_UP;
-    htim2.Init.Period = 0xFFFFFFFFu;
-    htim2.Init.ClockDivision = TIM_CLOCKDIVISION_DIV1;
-    htim2.Init.AutoReloadPreload = TIM_AUTORELOAD_PRELOAD_DISABLE;
-    if ((HAL_TIM_Base_Init(&htim2) != HAL_OK) || (HAL_TIM_Base_Start(&htim2) != HAL_OK)) {
-        board_fatal();
     }
 }
 
@@ -231,43 +124,15 @@ void board_init(void)
         board_fatal();
     }
     clock_init();
-    button_init();
+    board_button_init(GPIO_NOPULL); /* B1 has its own pull-up */
     uart_init();
-    timer_init();
+    /* APB1 runs at HCLK/4, so its timers get twice PCLK1: 90 MHz. */
+    board_tick_timer_init(2u * HAL_RCC_GetPCLK1Freq());
     crc_init();
 }
 
-/* ---- interrupt handlers (the names of ST's startup_stm32f446xx.s vector table) ---------- */
+/* ---- interrupt handlers (the names of ST's startup_stm32f446xx.s vector table; USART1's and
+ * TIM2's are in board_common.c, SysTick's and HardFault's in nucleo_common/board_nucleo.c) - */
 
-void SysTick_Handler(void) { HAL_IncTick(); }
-void USART1_IRQHandler(void) { HAL_UART_IRQHandler(&huart1); }
 void DMA2_Stream7_IRQHandler(void) { HAL_DMA_IRQHandler(&hdma_usart1_tx); }
 void DMA2_Stream2_IRQHandler(void) { HAL_DMA_IRQHandler(&hdma_usart1_rx); }
-void TIM2_IRQHandler(void) { HAL_TIM_IRQHandler(&htim2); }
-
-/* Faults: record the fault status registers and the stacked PC, then stop. The firmware
- * falls silent, and every servo locks itself when its watchdog (enabled in every command)
- * sees no frame for a second. */
-void board_fault_record(const uint32_t *frame);
-void board_fault_record(const uint32_t *frame)
-{
-    board_fault.cfsr = SCB->CFSR;
-    board_fault.hfsr = SCB->HFSR;
-    board_fault.mmfar = SCB->MMFAR;
-    board_fault.bfar = SCB->BFAR;
-    board_fault.pc = frame[6];
-    board_fault.lr = frame[5];
-    board_fault.count++;
-    board_fatal();
-}
-
-/* Naked: pick the stack the fault frame was pushed on (MSP or PSP, bit 2 of EXC_RETURN). */
-__attribute__((naked)) void HardFault_Handler(void)
-{
-    __asm volatile("tst lr, #4\n\t"
-                   "ite eq\n\t"
-                   "mrseq r0, msp\n\t"
-                   "mrsne r0, psp\n\t"
-                   "b board_fault_record\n\t");
-}
-/* MemManage, BusFault and UsageFault are not enabled (SHCSR), so they escalate to HardFault. */

@@ -286,6 +286,8 @@ typedef enum {
 #define UART_HWCONTROL_NONE 0x00000000u
 #define UART_OVERSAMPLING_8 0x00008000u
 #define TIM_COUNTERMODE_UP 0x00000000u
+#define TIM_CLOCKDIVISION_DIV1 0x00000000u
+#define TIM_AUTORELOAD_PRELOAD_DISABLE 0x00000000u
 
 void HAL_NVIC_SetPriority(IRQn_Type IRQn, uint32_t PreemptPriority, uint32_t SubPriority);
 void HAL_NVIC_EnableIRQ(IRQn_Type IRQn);
