@@ -705,29 +705,19 @@ J288_NOINLINE static bool reply_fast(j288_bus_t *bus, const uint8_t *data, size_
 
 /* ---- public entry points */
 
-int j288_bus_submit(j288_bus_t *bus, const j288_cmd_raw_t *cmd, uint32_t now_us,
-                    j288_bus_done_fn done, void *user)
+/* Whether a new transaction may be accepted now (the lock held where it is needed). */
+static bool can_accept(const j288_bus_t *bus)
 {
-    int err;
-    uint8_t st;
+    uint8_t st = bus->state;
+    return !(bus->estop_pending || bus->estop_active || bus->queued || bus->retry_pending) &&
+           ((st == (uint8_t)J288_BUS_IDLE) || (st == (uint8_t)J288_BUS_GUARD));
+}
 
-    if ((bus == NULL) || (cmd == NULL)) {
-        return J288_ERR_NULL;
-    }
-    j288_bus_lock(bus);
-    st = bus->state;
-    if (bus->estop_pending || bus->estop_active || bus->queued || bus->retry_pending ||
-        ((st != J288_BUS_IDLE) && (st != J288_BUS_GUARD))) {
-        j288_bus_unlock(bus);
-        return J288_ERR_BUSY;
-    }
-    /* The transmit buffer is free: the previous transmit has completed. */
-    err = j288_cmd_encode(cmd, bus->tx_buf, &bus->crc);
-    if (err != J288_OK) {
-        j288_bus_unlock(bus);
-        return err;
-    }
-    begin_txn(bus, cmd->id, done, user);
+/* The frame is in tx_buf: the transaction begins (the lock held where it is needed). */
+static void accept(j288_bus_t *bus, uint8_t id, uint32_t now_us, j288_bus_done_fn done,
+                   void *user)
+{
+    begin_txn(bus, id, done, user);
     bus->stats.transactions++;
     bus->queued = true;
     /* From a completion callback (inside an advance) the bus is in the guard that finish()
@@ -735,6 +725,40 @@ int j288_bus_submit(j288_bus_t *bus, const j288_cmd_raw_t *cmd, uint32_t now_us,
     if (!bus->in_advance) {
         advance(bus, now_us);
     }
+}
+
+int j288_bus_submit(j288_bus_t *bus, const j288_cmd_raw_t *cmd, uint32_t now_us,
+                    j288_bus_done_fn done, void *user)
+{
+    int err;
+
+    if ((bus == NULL) || (cmd == NULL)) {
+        return J288_ERR_NULL;
+    }
+    j288_bus_lock(bus);
+    if (!can_accept(bus)) {
+        j288_bus_unlock(bus);
+        return J288_ERR_BUSY;
+    }
+    /* The transmit buffer is free: the previous transmit has completed. */
+    err = j288_cmd_encode(cmd, bus->tx_buf, &bus->crc);
+    if (err == J288_OK) {
+        accept(bus, cmd->id, now_us, done, user);
+    }
+    j288_bus_unlock(bus);
+    return err;
+}
+
+int j288_bus_submit_frame(j288_bus_t *bus, const uint8_t frame[J288_CMD_LEN], uint8_t id,
+                          uint32_t now_us, j288_bus_done_fn done, void *user)
+{
+    j288_bus_lock(bus);
+    if (!can_accept(bus)) {
+        j288_bus_unlock(bus);
+        return J288_ERR_BUSY;
+    }
+    (void)memcpy(bus->tx_buf, frame, J288_CMD_LEN);
+    accept(bus, id, now_us, done, user);
     j288_bus_unlock(bus);
     return J288_OK;
 }

@@ -232,6 +232,13 @@ static inline void j288_bus_unlock(const j288_bus_t *bus)
     }
 }
 
+/* j288_bus_submit() for a command already encoded and checked (the scheduler keeps each
+ * slot's frame): frame (J288_CMD_LEN bytes, addressed to id, CRC in place) is copied into the
+ * bus. Same results and effects as j288_bus_submit() with that command; bus and frame must
+ * not be NULL. */
+int j288_bus_submit_frame(j288_bus_t *bus, const uint8_t frame[J288_CMD_LEN], uint8_t id,
+                          uint32_t now_us, j288_bus_done_fn done, void *user);
+
 /* ---- parser */
 
 /* j288_parser_reset() for the bus, which owns its parser: drop a partial frame. */
