@@ -233,9 +233,10 @@ static inline void j288_bus_unlock(const j288_bus_t *bus)
 }
 
 /* j288_bus_submit() for a command already encoded and checked (the scheduler keeps each
- * slot's frame): frame (J288_CMD_LEN bytes, addressed to id, CRC in place) is copied into the
- * bus. Same results and effects as j288_bus_submit() with that command; bus and frame must
- * not be NULL. */
+ * slot's frame): frame (J288_CMD_LEN bytes, addressed to id, CRC in place) is sent from where
+ * it is, for every attempt and the echo check, so it must stay untouched until the
+ * transaction's completion call. Same results and effects as j288_bus_submit() with that
+ * command; bus and frame must not be NULL. */
 int j288_bus_submit_frame(j288_bus_t *bus, const uint8_t frame[J288_CMD_LEN], uint8_t id,
                           uint32_t now_us, j288_bus_done_fn done, void *user);
 

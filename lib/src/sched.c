@@ -181,7 +181,8 @@ static void end_sweep(j288_sched_t *s, uint32_t now)
 
 /* Submit slot id's command. The frame encoded for it is reused while the command stays the
  * same (its checks were made by set_cmd, its CRC once); a watchdog clear goes out as a
- * one-off frame. */
+ * one-off frame. frame[id] is the bus's frame until the completion: only this function
+ * writes it, and only when slot id is submitted again. */
 static int submit_slot(j288_sched_t *s, uint8_t id, uint32_t now)
 {
     const j288_slot_t *slot = &s->slot[id];

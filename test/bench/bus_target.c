@@ -8,7 +8,8 @@
  * Library rows: the codec alone (encode, parse, unpack: what any engine pays), the same with
  * a CRC unit behind a port's crc32 op, the bus in poll mode (submit, tx done, 26 bytes, idle,
  * poll, guard), and continuous scheduler sweeps over 15 servos with the bus advanced in the
- * event calls (tx done, 26 bytes, idle, timer), the way an MCU runs at the wire's limit. The
+ * event calls (tx done, 26 bytes, idle, timer), the way an MCU runs at the wire's limit, with
+ * the slots' commands unchanged and with a new command for each transaction. The
  * library's CRC is the compile-time default backend of this image (J288_CONFIG_CRC_BACKEND).
  *
  * Floor rows: the same work written by hand for this one job, with every shortcut a
@@ -25,10 +26,11 @@
 #ifndef ITERATIONS
 #define ITERATIONS 300u
 #endif
-/* Rows to run (bits: 1 floors, 2 codec, 4 codec with the CRC unit, 8 poll, 16 sweeps, 32 joint):
- * a profile of one row under QEMU builds the image with -DBUS_TARGET_ROWS=<bits>. */
+/* Rows to run (bits: 1 floors, 2 codec, 4 codec with the CRC unit, 8 poll, 16 sweeps, 32 joint,
+ * 64 sweeps with a new command each transaction): a profile of one row under QEMU builds the
+ * image with -DBUS_TARGET_ROWS=<bits>. */
 #ifndef BUS_TARGET_ROWS
-#define BUS_TARGET_ROWS 0x3Fu
+#define BUS_TARGET_ROWS 0x7Fu
 #endif
 #define RUN_ROW(bit, call) (((BUS_TARGET_ROWS) & (bit)) != 0u ? (call) : 0u)
 #define CAL_LOOPS  100000u
@@ -439,7 +441,10 @@ static uint32_t run_bus_poll(void)
     return icount_between(t0, t1);
 }
 
-static uint32_t run_sched_isr(void)
+/* Continuous sweeps; with new_cmds, the control loop's case: every transaction's slot gets a
+ * new command (j288_sched_set_cmd, a position that changes) before it is sent, so that each
+ * command is encoded afresh, as the floor encodes every one. */
+static uint32_t run_sched_isr(bool new_cmds)
 {
     j288_bus_config_t bc;
     j288_sched_config_t sc;
@@ -461,6 +466,12 @@ static uint32_t run_sched_isr(void)
     before = sch.slot[14].stats.successes;
     t0 = icount_now();
     for (i = 0u; i < ITERATIONS; i++) {
+        if (new_cmds) {
+            j288_cmd_raw_t cmd = bench_cmd();
+            cmd.id = (uint8_t)((last_id == J288_MAX_ID) ? 0u : last_id + 1u);
+            cmd.pos = (int32_t)(i & 7u);
+            (void)j288_sched_set_cmd(&sch, &cmd);
+        }
         j288_bus_on_tx_done(&bus);
         j288_bus_on_rx(&bus, replies[last_id], J288_REPLY_LEN);
         clock_us += 88u;
@@ -552,7 +563,7 @@ static void row(const char *name, uint32_t floor, uint32_t lib)
 int main(void)
 {
     const j288_crc_t unit_engine = {unit_crc32, &unit};
-    uint32_t ipt, f_codec, f_unit, f_engine, codec, codec_unit, poll, isr;
+    uint32_t ipt, f_codec, f_unit, f_engine, codec, codec_unit, poll, isr, isr_new;
     uint8_t id;
 
     for (id = 0u; id < J288_MAX_SERVOS; id++) {
@@ -580,12 +591,14 @@ int main(void)
     codec = per_txn(RUN_ROW(2u, run_codec(NULL)), ipt);
     codec_unit = per_txn(RUN_ROW(4u, run_codec(&unit_engine)), ipt);
     poll = per_txn(RUN_ROW(8u, run_bus_poll()), ipt);
-    isr = per_txn(RUN_ROW(16u, run_sched_isr()), ipt);
+    isr = per_txn(RUN_ROW(16u, run_sched_isr(false)), ipt);
+    isr_new = per_txn(RUN_ROW(64u, run_sched_isr(true)), ipt);
     printf("library CRC: %s | floor | j288 | ratio |\n", backend_name());
     row("codec only (encode, parse, unpack)", f_codec, codec);
     row("codec, CRC unit (port crc32 op)", f_unit, codec_unit);
     row("bus, poll mode", 0u, poll);
     row("scheduler sweeps, advance_in_isr", f_engine, isr);
+    row("sweeps, a new command each transaction", f_engine, isr_new);
 #if J288_CONFIG_SI
     row("joint: reply -> state", 0u, per_txn(RUN_ROW(32u, run_joint_reply()), ipt));
     row("joint: target -> command", 0u, per_txn(RUN_ROW(32u, run_joint_command()), ipt));
