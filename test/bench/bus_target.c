@@ -22,6 +22,7 @@
 #include <string.h>
 
 #include "../target/icount.h"
+#include "crc_unit_model.h"
 
 #ifndef ITERATIONS
 #define ITERATIONS 300u
@@ -89,54 +90,33 @@ static void on_done(void *user, const j288_txn_t *txn)
     }
 }
 
-/* ---- a CRC unit (the STM32's, in its reset configuration), modelled by its registers: a
- * reset bit in CR, a data register taking one word per write. QEMU's mps2 boards have no
- * such unit, so the answer the silicon would give is read from a two-entry table (command,
- * reply, alternating: the order in which both the library and the floor ask) filled from
- * the software CRC before the run; that read costs about three instructions more than a
- * register load, in the library's row and in the floor's alike. */
+/* ---- the CRC unit (crc_unit_model.h) */
 
-typedef struct {
-    volatile uint32_t DR;
-    volatile uint32_t CR;
-} crc_unit_t;
-
-static crc_unit_t unit;
-static uint32_t unit_answer[2];
-static uint32_t unit_next;
-
-static uint32_t unit_result(void)
-{
-    uint32_t v = unit_answer[unit_next];
-    unit_next ^= 1u;
-    return v;
-}
+bench_crc_unit_t bench_unit;
+uint32_t bench_unit_answer[2];
+uint32_t bench_unit_next;
 
 /* The port's crc32 op as a port for this unit writes it: reset, one write per word. */
 static uint32_t unit_crc32(void *ctx, const uint8_t *data, size_t nwords)
 {
-    crc_unit_t *u = (crc_unit_t *)ctx;
+    bench_crc_unit_t *u = (bench_crc_unit_t *)ctx;
     size_t i;
     u->CR = 1u;
     for (i = 0u; i < nwords; i++) {
         u->DR = j288_get_u32le(&data[4u * i]);
     }
-    return unit_result();
+    return bench_unit_result();
 }
 
-#if J288_CONFIG_CRC_BACKEND == J288_CRC_BACKEND_HW
-/* The same unit as the library's compile-time CRC backend (J288_CRC_BACKEND_HW): a function
- * the library calls directly, no port op in between. Only the codec and poll rows ask it in
- * the order the two-entry model answers (a command, then a reply). */
+#if (J288_CONFIG_CRC_BACKEND == J288_CRC_BACKEND_HW) && !defined(J288_USER_CONFIG)
+/* The same unit as the library's compile-time CRC backend (J288_CRC_BACKEND_HW), a function
+ * the library calls, no port op in between (with J288_USER_CONFIG, hw_inline/: the same
+ * function static inline). Only the codec and poll rows ask it in the order the two-entry
+ * model answers (a command, then a reply). */
 uint32_t bench_crc_unit(const uint8_t *data, size_t nwords);
 uint32_t bench_crc_unit(const uint8_t *data, size_t nwords)
 {
-    size_t i;
-    unit.CR = 1u;
-    for (i = 0u; i < nwords; i++) {
-        unit.DR = j288_get_u32le(&data[4u * i]);
-    }
-    return unit_result();
+    return bench_crc_unit_inline(data, nwords);
 }
 #endif
 
@@ -233,12 +213,12 @@ FLOOR_ENTRY int floor_encode_unit(const j288_cmd_raw_t *c, uint32_t out[5])
     if (floor_encode_words(c, w) != 0) {
         return -1;
     }
-    unit.CR = 1u;
-    unit.DR = out[0] = w[0];
-    unit.DR = out[1] = w[1];
-    unit.DR = out[2] = w[2];
-    unit.DR = out[3] = w[3];
-    out[4] = unit_result();
+    bench_unit.CR = 1u;
+    bench_unit.DR = out[0] = w[0];
+    bench_unit.DR = out[1] = w[1];
+    bench_unit.DR = out[2] = w[2];
+    bench_unit.DR = out[3] = w[3];
+    out[4] = bench_unit_result();
     return 0;
 }
 
@@ -284,13 +264,13 @@ FLOOR_ENTRY int floor_decode_unit(const uint32_t *f, j288_reply_raw_t *r)
     if ((f[0] >> 16) != 0xEEFCu) {
         return -1;
     }
-    unit.CR = 1u;
-    unit.DR = f[1];
-    unit.DR = f[2];
-    unit.DR = f[3];
-    unit.DR = f[4];
-    unit.DR = f[5];
-    if (unit_result() != f[6]) {
+    bench_unit.CR = 1u;
+    bench_unit.DR = f[1];
+    bench_unit.DR = f[2];
+    bench_unit.DR = f[3];
+    bench_unit.DR = f[4];
+    bench_unit.DR = f[5];
+    if (bench_unit_result() != f[6]) {
         return -1;
     }
     floor_unpack(f, r);
@@ -377,7 +357,7 @@ static uint32_t run_floor_codec(bool with_unit)
     j288_reply_raw_t r;
     uint32_t frame[5];
     uint32_t i, t0, t1;
-    unit_next = 0u;
+    bench_unit_next = 0u;
     t0 = icount_now();
     for (i = 0u; i < ITERATIONS; i++) {
         if (with_unit) {
@@ -430,7 +410,7 @@ static uint32_t run_codec(const j288_crc_t *crc)
     uint8_t frame[J288_CMD_LEN];
     uint32_t i, t0, t1;
     (void)j288_parser_init(&parser, J288_PARSE_REPLY, crc);
-    unit_next = 0u;
+    bench_unit_next = 0u;
     t0 = icount_now();
     for (i = 0u; i < ITERATIONS; i++) {
         size_t used;
@@ -569,8 +549,10 @@ static const char *backend_name(void)
     return "nibble";
 #elif J288_CONFIG_CRC_BACKEND == J288_CRC_BACKEND_BITWISE
     return "bitwise";
+#elif (J288_CONFIG_CRC_BACKEND == J288_CRC_BACKEND_HW) && defined(J288_USER_CONFIG)
+    return "the CRC unit (J288_CRC_BACKEND_HW, its function static inline)";
 #elif J288_CONFIG_CRC_BACKEND == J288_CRC_BACKEND_HW
-    return "the CRC unit (J288_CRC_BACKEND_HW)";
+    return "the CRC unit (J288_CRC_BACKEND_HW, its function called)";
 #else
     return "table";
 #endif
@@ -589,7 +571,7 @@ static void row(const char *name, uint32_t floor, uint32_t lib)
 
 int main(void)
 {
-    const j288_crc_t unit_engine = {unit_crc32, &unit};
+    const j288_crc_t unit_engine = {unit_crc32, &bench_unit};
     uint32_t ipt, f_codec, f_unit, f_engine, codec, codec_unit, poll, isr, isr_new;
     uint8_t id;
 
@@ -606,8 +588,8 @@ int main(void)
         j288_cmd_raw_t cmd = bench_cmd();
         uint8_t f[J288_CMD_LEN];
         (void)j288_cmd_encode(&cmd, f, &soft_engine);
-        unit_answer[0] = j288_frame_crc_field(f, J288_CMD_LEN);
-        unit_answer[1] = j288_frame_crc_field(replies[3], J288_REPLY_LEN);
+        bench_unit_answer[0] = j288_frame_crc_field(f, J288_CMD_LEN);
+        bench_unit_answer[1] = j288_frame_crc_field(replies[3], J288_REPLY_LEN);
     }
     floor_tables();
     icount_start();
