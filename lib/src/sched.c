@@ -5,7 +5,7 @@
 
 #include "internal.h"
 
-#define ALL_SLOTS ((uint16_t)((1u << J288_MAX_SERVOS) - 1u))
+#define ALL_SLOTS ((uint16_t)(((uint32_t)1u << J288_MAX_SERVOS) - 1u))
 
 int j288_sched_init(j288_sched_t *s, j288_bus_t *bus, const j288_sched_config_t *cfg)
 {
@@ -60,7 +60,7 @@ int j288_sched_set_cmd(j288_sched_t *s, const j288_cmd_raw_t *cmd)
     }
     j288_bus_lock(s->bus);
     s->slot[cmd->id].cmd = *cmd;
-    s->frame_stale |= (uint16_t)(1u << cmd->id);
+    s->frame_stale |= (uint16_t)((uint32_t)1u << cmd->id);
     j288_bus_unlock(s->bus);
     return J288_OK;
 }
@@ -186,7 +186,7 @@ static void end_sweep(j288_sched_t *s, uint32_t now)
 static int submit_slot(j288_sched_t *s, uint8_t id, uint32_t now)
 {
     const j288_slot_t *slot = &s->slot[id];
-    uint16_t bit = (uint16_t)(1u << id);
+    uint16_t bit = (uint16_t)((uint32_t)1u << id);
 
     if (slot->clear_watchdog) {
         j288_cmd_raw_t cleared = slot->cmd;
