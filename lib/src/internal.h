@@ -200,6 +200,10 @@ static inline int j288_cmd_check(const j288_cmd_raw_t *cmd)
     return J288_OK;
 }
 
+/* j288_cmd_encode() without its checks, for a command that passed them (the scheduler's
+ * slots: j288_sched_set_cmd() checks, init and estop make lock commands). */
+void j288_cmd_pack(const j288_cmd_raw_t *cmd, uint8_t out[J288_CMD_LEN], const j288_crc_t *crc);
+
 /* Lock (no torque), every other field 0: the scheduler's initial and post-estop command, and
  * with id 15 and the watchdog on, the emergency stop frame. */
 static inline void j288_cmd_lock(j288_cmd_raw_t *c, uint8_t id, bool watchdog)

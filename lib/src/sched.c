@@ -194,8 +194,9 @@ static int submit_slot(j288_sched_t *s, uint8_t id, uint32_t now)
         return j288_bus_submit(s->bus, &cleared, now, sched_done, s);
     }
     if ((s->frame_stale & bit) != 0u) {
-        /* Valid fields (set_cmd, init and estop make only such commands), its id the slot's */
-        (void)j288_cmd_encode(&slot->cmd, s->frame[id], &s->bus->crc);
+        /* Checked fields (set_cmd, init and estop make only such commands), its id the
+         * slot's */
+        j288_cmd_pack(&slot->cmd, s->frame[id], &s->bus->crc);
         s->frame_stale &= (uint16_t)~bit;
     }
     return j288_bus_submit_frame(s->bus, s->frame[id], id, now, sched_done, s);

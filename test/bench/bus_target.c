@@ -611,7 +611,7 @@ int main(void)
     }
     row("codec, CRC unit (port crc32 op)", f_unit, codec_unit);
     row("bus, poll mode", 0u, poll);
-    if (isr != 0u) {
+    if (!HW_BACKEND) {
         row("scheduler sweeps, advance_in_isr", f_engine, isr);
         row("sweeps, a new command each transaction", f_engine, isr_new);
     }
