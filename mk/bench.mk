@@ -80,12 +80,17 @@ bench-target:
 	        $(call QEMU_BENCH,$(c),$(BUILD)/bench-target/codec_$(c)_$$o.elf) || exit 1; echo; \
 	    done))
 
-# The bus engine and the scheduler, port operations empty, with the default CRC backend (table)
-# and with slicing-by-4 (s4).
+# The bus engine and the scheduler, port operations empty, with the default CRC backend (table),
+# with slicing-by-4 (s4) and with a CRC unit as the compile-time backend (hw; hwi inlined).
 BENCH_BUS_CPUS := m0 m4f rv32
-BENCH_BUS_CRCS := table s4
+BENCH_BUS_CRCS := table s4 hw hwi
 BENCH_BUS_CRC_table :=
 BENCH_BUS_CRC_s4 := -DJ288_CONFIG_CRC_BACKEND=J288_CRC_BACKEND_SLICE4
+# hw: the CRC unit model of test/bench/bus_target.c as the compile-time backend
+BENCH_BUS_CRC_hw := -DJ288_CONFIG_CRC_BACKEND=J288_CRC_BACKEND_HW \
+    -DJ288_CONFIG_CRC_HW_FUNCTION=bench_crc_unit
+# hwi: the same, its function static inline in a user configuration (test/bench/hw_inline)
+BENCH_BUS_CRC_hwi := -DJ288_USER_CONFIG -Itest/bench/hw_inline
 $(foreach c,$(BENCH_BUS_CPUS),$(foreach v,$(BENCH_BUS_CRCS),$(foreach o,$(BENCH_OPTS),$(eval \
     $(call BENCH_IMAGE,bus_$(c)_$(v),$(c),test/bench/bus_target.c $(call TC,$(c),STARTUP) $(LIB_SRC),\
     $(BENCH_BUS_CRC_$(v)),$(o))))))

@@ -348,7 +348,7 @@ static void start_attempt(j288_bus_t *bus, uint32_t now)
     if (bus->cfg.echo && (bus->port->start_rx != NULL)) {
         bus->port->start_rx(bus->port_ctx); /* the echo must be heard */
     }
-    rc = bus->port->start_tx(bus->port_ctx, bus->tx_buf, J288_CMD_LEN);
+    rc = bus->port->start_tx(bus->port_ctx, bus->tx_frame, J288_CMD_LEN);
     if (rc < 0) {
         bus->stats.port_errors++;
         end_attempt(bus, J288_ERR_PORT, now);
@@ -389,6 +389,7 @@ J288_NOINLINE static void send_estop(j288_bus_t *bus, uint32_t now)
 
     j288_cmd_lock(&stop, J288_BROADCAST_ID, true);
     (void)j288_cmd_encode(&stop, bus->tx_buf, &bus->crc); /* constant, valid fields */
+    bus->tx_frame = bus->tx_buf;
     bus->estop_pending = false;
     bus->estop_active = true;
     begin_txn(bus, J288_BROADCAST_ID, NULL, NULL);
@@ -441,7 +442,7 @@ static uint32_t take_echo_bytes(j288_bus_t *bus, const uint8_t *p, uint32_t n)
 
     while (i < k) {
         i++;
-        if (p[i - 1u] != bus->tx_buf[bus->echo_pos + i - 1u]) {
+        if (p[i - 1u] != bus->tx_frame[bus->echo_pos + i - 1u]) {
             bus->collided = true;
             break;
         }
@@ -705,29 +706,20 @@ J288_NOINLINE static bool reply_fast(j288_bus_t *bus, const uint8_t *data, size_
 
 /* ---- public entry points */
 
-int j288_bus_submit(j288_bus_t *bus, const j288_cmd_raw_t *cmd, uint32_t now_us,
-                    j288_bus_done_fn done, void *user)
+/* Whether a new transaction may be accepted now (the lock held where it is needed). */
+static bool can_accept(const j288_bus_t *bus)
 {
-    int err;
-    uint8_t st;
+    uint8_t st = bus->state;
+    return !(bus->estop_pending || bus->estop_active || bus->queued || bus->retry_pending) &&
+           ((st == (uint8_t)J288_BUS_IDLE) || (st == (uint8_t)J288_BUS_GUARD));
+}
 
-    if ((bus == NULL) || (cmd == NULL)) {
-        return J288_ERR_NULL;
-    }
-    j288_bus_lock(bus);
-    st = bus->state;
-    if (bus->estop_pending || bus->estop_active || bus->queued || bus->retry_pending ||
-        ((st != J288_BUS_IDLE) && (st != J288_BUS_GUARD))) {
-        j288_bus_unlock(bus);
-        return J288_ERR_BUSY;
-    }
-    /* The transmit buffer is free: the previous transmit has completed. */
-    err = j288_cmd_encode(cmd, bus->tx_buf, &bus->crc);
-    if (err != J288_OK) {
-        j288_bus_unlock(bus);
-        return err;
-    }
-    begin_txn(bus, cmd->id, done, user);
+/* The transaction of frame (to id) begins (the lock held where it is needed). */
+static void accept(j288_bus_t *bus, const uint8_t *frame, uint8_t id, uint32_t now_us,
+                   j288_bus_done_fn done, void *user)
+{
+    bus->tx_frame = frame;
+    begin_txn(bus, id, done, user);
     bus->stats.transactions++;
     bus->queued = true;
     /* From a completion callback (inside an advance) the bus is in the guard that finish()
@@ -735,6 +727,39 @@ int j288_bus_submit(j288_bus_t *bus, const j288_cmd_raw_t *cmd, uint32_t now_us,
     if (!bus->in_advance) {
         advance(bus, now_us);
     }
+}
+
+int j288_bus_submit(j288_bus_t *bus, const j288_cmd_raw_t *cmd, uint32_t now_us,
+                    j288_bus_done_fn done, void *user)
+{
+    int err;
+
+    if ((bus == NULL) || (cmd == NULL)) {
+        return J288_ERR_NULL;
+    }
+    j288_bus_lock(bus);
+    if (!can_accept(bus)) {
+        j288_bus_unlock(bus);
+        return J288_ERR_BUSY;
+    }
+    /* The transmit buffer is free: the previous transmit has completed. */
+    err = j288_cmd_encode(cmd, bus->tx_buf, &bus->crc);
+    if (err == J288_OK) {
+        accept(bus, bus->tx_buf, cmd->id, now_us, done, user);
+    }
+    j288_bus_unlock(bus);
+    return err;
+}
+
+int j288_bus_submit_frame(j288_bus_t *bus, const uint8_t frame[J288_CMD_LEN], uint8_t id,
+                          uint32_t now_us, j288_bus_done_fn done, void *user)
+{
+    j288_bus_lock(bus);
+    if (!can_accept(bus)) {
+        j288_bus_unlock(bus);
+        return J288_ERR_BUSY;
+    }
+    accept(bus, frame, id, now_us, done, user); /* sent from where it is */
     j288_bus_unlock(bus);
     return J288_OK;
 }

@@ -59,6 +59,24 @@ static uint32_t pair16(int16_t lo, int16_t hi)
 #define CMD_HEAD16 J288_CMD_HEAD16
 #define RPL_HEAD16 J288_REPLY_HEAD16
 
+/* The frame as the four words it is made of (head, mode and reserved byte; tau and speed;
+ * pos; kp and kd), then its CRC. Inlined in both its callers below. */
+static J288_INLINE_HOT void cmd_pack(const j288_cmd_raw_t *cmd, uint8_t out[J288_CMD_LEN],
+                                     const j288_crc_t *crc)
+{
+    j288_store_le32(&out[0], CMD_HEAD16 |
+                                 ((uint32_t)mode_pack(cmd->id, cmd->status, cmd->watchdog) << 16));
+    j288_store_le32(&out[CMD_TAU], pair16(cmd->tau, cmd->speed));
+    j288_store_le32(&out[CMD_POS], from_i32(cmd->pos));
+    j288_store_le32(&out[CMD_KP], pair16(cmd->kp, cmd->kd));
+    j288_store_le32(&out[CMD_CRC], j288_crc_frame_hot(crc, out, CMD_CRC_WORDS));
+}
+
+void j288_cmd_pack(const j288_cmd_raw_t *cmd, uint8_t out[J288_CMD_LEN], const j288_crc_t *crc)
+{
+    cmd_pack(cmd, out, crc);
+}
+
 int j288_cmd_encode(const j288_cmd_raw_t *cmd, uint8_t out[J288_CMD_LEN], const j288_crc_t *crc)
 {
     int err;
@@ -70,14 +88,7 @@ int j288_cmd_encode(const j288_cmd_raw_t *cmd, uint8_t out[J288_CMD_LEN], const 
     if (err != J288_OK) {
         return err;
     }
-    /* Every check is done: out is written only now, as the four words the frame is made of
-     * (head, mode and reserved byte; tau and speed; pos; kp and kd), then its CRC. */
-    j288_store_le32(&out[0], CMD_HEAD16 |
-                                 ((uint32_t)mode_pack(cmd->id, cmd->status, cmd->watchdog) << 16));
-    j288_store_le32(&out[CMD_TAU], pair16(cmd->tau, cmd->speed));
-    j288_store_le32(&out[CMD_POS], from_i32(cmd->pos));
-    j288_store_le32(&out[CMD_KP], pair16(cmd->kp, cmd->kd));
-    j288_store_le32(&out[CMD_CRC], j288_crc_frame_hot(crc, out, CMD_CRC_WORDS));
+    cmd_pack(cmd, out, crc); /* every check done: out is written only now */
     return J288_OK;
 }
 

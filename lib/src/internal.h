@@ -200,6 +200,10 @@ static inline int j288_cmd_check(const j288_cmd_raw_t *cmd)
     return J288_OK;
 }
 
+/* j288_cmd_encode() without its checks, for a command that passed them (the scheduler's
+ * slots: j288_sched_set_cmd() checks, init and estop make lock commands). */
+void j288_cmd_pack(const j288_cmd_raw_t *cmd, uint8_t out[J288_CMD_LEN], const j288_crc_t *crc);
+
 /* Lock (no torque), every other field 0: the scheduler's initial and post-estop command, and
  * with id 15 and the watchdog on, the emergency stop frame. */
 static inline void j288_cmd_lock(j288_cmd_raw_t *c, uint8_t id, bool watchdog)
@@ -231,6 +235,14 @@ static inline void j288_bus_unlock(const j288_bus_t *bus)
         bus->port->unlock(bus->port_ctx);
     }
 }
+
+/* j288_bus_submit() for a command already encoded and checked (the scheduler keeps each
+ * slot's frame): frame (J288_CMD_LEN bytes, addressed to id, CRC in place) is sent from where
+ * it is, for every attempt and the echo check, so it must stay untouched until the
+ * transaction's completion call. Same results and effects as j288_bus_submit() with that
+ * command; bus and frame must not be NULL. */
+int j288_bus_submit_frame(j288_bus_t *bus, const uint8_t frame[J288_CMD_LEN], uint8_t id,
+                          uint32_t now_us, j288_bus_done_fn done, void *user);
 
 /* ---- parser */
 

@@ -19,13 +19,9 @@ int j288_parser_init(j288_parser_t *p, j288_parse_kind_t kind, const j288_crc_t 
     if (kind == J288_PARSE_REPLY) {
         p->head0 = J288_REPLY_HEAD0;
         p->frame_len = (uint8_t)J288_REPLY_LEN;
-        p->crc_first = 2u; /* bytes 2-21 */
-        p->crc_words = 5u;
     } else {
         p->head0 = J288_CMD_HEAD0;
         p->frame_len = (uint8_t)J288_CMD_LEN;
-        p->crc_first = 0u; /* bytes 0-15 */
-        p->crc_words = 4u;
     }
     return J288_OK;
 }

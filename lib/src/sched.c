@@ -5,6 +5,8 @@
 
 #include "internal.h"
 
+#define ALL_SLOTS ((uint16_t)(((uint32_t)1u << J288_MAX_SERVOS) - 1u))
+
 int j288_sched_init(j288_sched_t *s, j288_bus_t *bus, const j288_sched_config_t *cfg)
 {
     uint8_t i;
@@ -24,6 +26,7 @@ int j288_sched_init(j288_sched_t *s, j288_bus_t *bus, const j288_sched_config_t 
         j288_cmd_lock(&s->slot[i].cmd, i, true);
         s->slot[i].last_result = J288_OK;
     }
+    s->frame_stale = ALL_SLOTS;
     return J288_OK;
 }
 
@@ -57,6 +60,7 @@ int j288_sched_set_cmd(j288_sched_t *s, const j288_cmd_raw_t *cmd)
     }
     j288_bus_lock(s->bus);
     s->slot[cmd->id].cmd = *cmd;
+    s->frame_stale |= (uint16_t)((uint32_t)1u << cmd->id);
     j288_bus_unlock(s->bus);
     return J288_OK;
 }
@@ -175,6 +179,29 @@ static void end_sweep(j288_sched_t *s, uint32_t now)
     }
 }
 
+/* Submit slot id's command. The frame encoded for it is reused while the command stays the
+ * same (its checks were made by set_cmd, its CRC once); a watchdog clear goes out as a
+ * one-off frame. frame[id] is the bus's frame until the completion: only this function
+ * writes it, and only when slot id is submitted again. */
+static int submit_slot(j288_sched_t *s, uint8_t id, uint32_t now)
+{
+    const j288_slot_t *slot = &s->slot[id];
+    uint16_t bit = (uint16_t)((uint32_t)1u << id);
+
+    if (slot->clear_watchdog) {
+        j288_cmd_raw_t cleared = slot->cmd;
+        cleared.watchdog = false;
+        return j288_bus_submit(s->bus, &cleared, now, sched_done, s);
+    }
+    if ((s->frame_stale & bit) != 0u) {
+        /* Checked fields (set_cmd, init and estop make only such commands), its id the
+         * slot's */
+        j288_cmd_pack(&slot->cmd, s->frame[id], &s->bus->crc);
+        s->frame_stale &= (uint16_t)~bit;
+    }
+    return j288_bus_submit_frame(s->bus, s->frame[id], id, now, sched_done, s);
+}
+
 /* Submit the next enabled slot of this sweep; end the sweep (and start the next one when
  * continuous) when none is left. Returns J288_ERR_BUSY if the bus refused the submit. */
 static int next_slot(j288_sched_t *s, uint32_t now)
@@ -183,20 +210,13 @@ static int next_slot(j288_sched_t *s, uint32_t now)
         while (s->cursor < J288_MAX_SERVOS) {
             uint8_t id = s->cursor++;
             j288_slot_t *slot = &s->slot[id];
-            const j288_cmd_raw_t *cmd = &slot->cmd; /* its id is the slot's (set_cmd, init) */
-            j288_cmd_raw_t cleared;
             int rc;
             if (!slot->enabled) {
                 continue;
             }
             s->wd_clear_in_flight = slot->clear_watchdog;
-            if (slot->clear_watchdog) {
-                cleared = *cmd;
-                cleared.watchdog = false;
-                cmd = &cleared;
-            }
             s->sent++;
-            rc = j288_bus_submit(s->bus, cmd, now, sched_done, s);
+            rc = submit_slot(s, id, now);
             if (rc == J288_OK) {
                 return J288_OK; /* sched_done continues the sweep */
             }
@@ -304,6 +324,7 @@ int j288_sched_estop(j288_sched_t *s, uint32_t now_us)
     for (i = 0u; i < J288_MAX_SERVOS; i++) {
         j288_cmd_lock(&s->slot[i].cmd, i, s->slot[i].cmd.watchdog);
     }
+    s->frame_stale = ALL_SLOTS;
     j288_bus_unlock(s->bus);
     return j288_bus_estop(s->bus, now_us);
 }

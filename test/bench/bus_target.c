@@ -8,7 +8,8 @@
  * Library rows: the codec alone (encode, parse, unpack: what any engine pays), the same with
  * a CRC unit behind a port's crc32 op, the bus in poll mode (submit, tx done, 26 bytes, idle,
  * poll, guard), and continuous scheduler sweeps over 15 servos with the bus advanced in the
- * event calls (tx done, 26 bytes, idle, timer), the way an MCU runs at the wire's limit. The
+ * event calls (tx done, 26 bytes, idle, timer), the way an MCU runs at the wire's limit, with
+ * the slots' commands unchanged and with a new command for each transaction. The
  * library's CRC is the compile-time default backend of this image (J288_CONFIG_CRC_BACKEND).
  *
  * Floor rows: the same work written by hand for this one job, with every shortcut a
@@ -21,17 +22,20 @@
 #include <string.h>
 
 #include "../target/icount.h"
+#include "crc_unit_model.h"
 
 #ifndef ITERATIONS
 #define ITERATIONS 300u
 #endif
-/* Rows to run (bits: 1 floors, 2 codec, 4 codec with the CRC unit, 8 poll, 16 sweeps, 32 joint):
- * a profile of one row under QEMU builds the image with -DBUS_TARGET_ROWS=<bits>. */
+/* Rows to run (bits: 1 floors, 2 codec, 4 codec with the CRC unit, 8 poll, 16 sweeps, 32 joint,
+ * 64 sweeps with a new command each transaction): a profile of one row under QEMU builds the
+ * image with -DBUS_TARGET_ROWS=<bits>. */
 #ifndef BUS_TARGET_ROWS
-#define BUS_TARGET_ROWS 0x3Fu
+#define BUS_TARGET_ROWS 0x7Fu
 #endif
 #define RUN_ROW(bit, call) (((BUS_TARGET_ROWS) & (bit)) != 0u ? (call) : 0u)
 #define CAL_LOOPS  100000u
+#define HW_BACKEND (J288_CONFIG_CRC_BACKEND == J288_CRC_BACKEND_HW)
 
 static uint32_t clock_us;
 static uint8_t last_id;
@@ -86,40 +90,43 @@ static void on_done(void *user, const j288_txn_t *txn)
     }
 }
 
-/* ---- a CRC unit (the STM32's, in its reset configuration), modelled by its registers: a
- * reset bit in CR, a data register taking one word per write. QEMU's mps2 boards have no
- * such unit, so the answer the silicon would give is read from a two-entry table (command,
- * reply, alternating: the order in which both the library and the floor ask) filled from
- * the software CRC before the run; that read costs about three instructions more than a
- * register load, in the library's row and in the floor's alike. */
+/* ---- the CRC unit (crc_unit_model.h) */
 
-typedef struct {
-    volatile uint32_t DR;
-    volatile uint32_t CR;
-} crc_unit_t;
-
-static crc_unit_t unit;
-static uint32_t unit_answer[2];
-static uint32_t unit_next;
-
-static uint32_t unit_result(void)
-{
-    uint32_t v = unit_answer[unit_next];
-    unit_next ^= 1u;
-    return v;
-}
+bench_crc_unit_t bench_unit;
+uint32_t bench_unit_answer[2];
+uint32_t bench_unit_next;
 
 /* The port's crc32 op as a port for this unit writes it: reset, one write per word. */
 static uint32_t unit_crc32(void *ctx, const uint8_t *data, size_t nwords)
 {
-    crc_unit_t *u = (crc_unit_t *)ctx;
+    bench_crc_unit_t *u = (bench_crc_unit_t *)ctx;
     size_t i;
     u->CR = 1u;
     for (i = 0u; i < nwords; i++) {
         u->DR = j288_get_u32le(&data[4u * i]);
     }
-    return unit_result();
+    return bench_unit_result();
 }
+
+#if (J288_CONFIG_CRC_BACKEND == J288_CRC_BACKEND_HW) && !defined(J288_USER_CONFIG)
+/* The same unit as the library's compile-time CRC backend (J288_CRC_BACKEND_HW), a function
+ * the library calls, no port op in between (with J288_USER_CONFIG, hw_inline/: the same
+ * function static inline). Only the codec and poll rows ask it in the order the two-entry
+ * model answers (a command, then a reply). */
+uint32_t bench_crc_unit(const uint8_t *data, size_t nwords);
+uint32_t bench_crc_unit(const uint8_t *data, size_t nwords)
+{
+    return bench_crc_unit_inline(data, nwords);
+}
+#endif
+
+/* The frames the rows use are made with the table backend, whatever this image's default. */
+static uint32_t soft_crc(void *ctx, const uint8_t *data, size_t nwords)
+{
+    (void)ctx;
+    return j288_crc32_update_table(J288_CRC32_INIT, data, nwords);
+}
+static const j288_crc_t soft_engine = {soft_crc, NULL};
 
 /* ---- the floor: the same work written by hand for this job only. It knows the frames'
  * layout at compile time, keeps a reply where the DMA put it (2 bytes past a word boundary,
@@ -206,12 +213,12 @@ FLOOR_ENTRY int floor_encode_unit(const j288_cmd_raw_t *c, uint32_t out[5])
     if (floor_encode_words(c, w) != 0) {
         return -1;
     }
-    unit.CR = 1u;
-    unit.DR = out[0] = w[0];
-    unit.DR = out[1] = w[1];
-    unit.DR = out[2] = w[2];
-    unit.DR = out[3] = w[3];
-    out[4] = unit_result();
+    bench_unit.CR = 1u;
+    bench_unit.DR = out[0] = w[0];
+    bench_unit.DR = out[1] = w[1];
+    bench_unit.DR = out[2] = w[2];
+    bench_unit.DR = out[3] = w[3];
+    out[4] = bench_unit_result();
     return 0;
 }
 
@@ -257,13 +264,13 @@ FLOOR_ENTRY int floor_decode_unit(const uint32_t *f, j288_reply_raw_t *r)
     if ((f[0] >> 16) != 0xEEFCu) {
         return -1;
     }
-    unit.CR = 1u;
-    unit.DR = f[1];
-    unit.DR = f[2];
-    unit.DR = f[3];
-    unit.DR = f[4];
-    unit.DR = f[5];
-    if (unit_result() != f[6]) {
+    bench_unit.CR = 1u;
+    bench_unit.DR = f[1];
+    bench_unit.DR = f[2];
+    bench_unit.DR = f[3];
+    bench_unit.DR = f[4];
+    bench_unit.DR = f[5];
+    if (bench_unit_result() != f[6]) {
         return -1;
     }
     floor_unpack(f, r);
@@ -350,7 +357,7 @@ static uint32_t run_floor_codec(bool with_unit)
     j288_reply_raw_t r;
     uint32_t frame[5];
     uint32_t i, t0, t1;
-    unit_next = 0u;
+    bench_unit_next = 0u;
     t0 = icount_now();
     for (i = 0u; i < ITERATIONS; i++) {
         if (with_unit) {
@@ -403,7 +410,7 @@ static uint32_t run_codec(const j288_crc_t *crc)
     uint8_t frame[J288_CMD_LEN];
     uint32_t i, t0, t1;
     (void)j288_parser_init(&parser, J288_PARSE_REPLY, crc);
-    unit_next = 0u;
+    bench_unit_next = 0u;
     t0 = icount_now();
     for (i = 0u; i < ITERATIONS; i++) {
         size_t used;
@@ -439,7 +446,10 @@ static uint32_t run_bus_poll(void)
     return icount_between(t0, t1);
 }
 
-static uint32_t run_sched_isr(void)
+/* Continuous sweeps; with new_cmds, the control loop's case: every transaction's slot gets a
+ * new command (j288_sched_set_cmd, a position that changes) before it is sent, so that each
+ * command is encoded afresh, as the floor encodes every one. */
+static uint32_t run_sched_isr(bool new_cmds)
 {
     j288_bus_config_t bc;
     j288_sched_config_t sc;
@@ -461,6 +471,12 @@ static uint32_t run_sched_isr(void)
     before = sch.slot[14].stats.successes;
     t0 = icount_now();
     for (i = 0u; i < ITERATIONS; i++) {
+        if (new_cmds) {
+            j288_cmd_raw_t cmd = bench_cmd();
+            cmd.id = (uint8_t)((last_id == J288_MAX_ID) ? 0u : last_id + 1u);
+            cmd.pos = (int32_t)(i & 7u);
+            (void)j288_sched_set_cmd(&sch, &cmd);
+        }
         j288_bus_on_tx_done(&bus);
         j288_bus_on_rx(&bus, replies[last_id], J288_REPLY_LEN);
         clock_us += 88u;
@@ -533,6 +549,10 @@ static const char *backend_name(void)
     return "nibble";
 #elif J288_CONFIG_CRC_BACKEND == J288_CRC_BACKEND_BITWISE
     return "bitwise";
+#elif (J288_CONFIG_CRC_BACKEND == J288_CRC_BACKEND_HW) && defined(J288_USER_CONFIG)
+    return "the CRC unit (J288_CRC_BACKEND_HW, its function static inline)";
+#elif J288_CONFIG_CRC_BACKEND == J288_CRC_BACKEND_HW
+    return "the CRC unit (J288_CRC_BACKEND_HW, its function called)";
 #else
     return "table";
 #endif
@@ -551,8 +571,8 @@ static void row(const char *name, uint32_t floor, uint32_t lib)
 
 int main(void)
 {
-    const j288_crc_t unit_engine = {unit_crc32, &unit};
-    uint32_t ipt, f_codec, f_unit, f_engine, codec, codec_unit, poll, isr;
+    const j288_crc_t unit_engine = {unit_crc32, &bench_unit};
+    uint32_t ipt, f_codec, f_unit, f_engine, codec, codec_unit, poll, isr, isr_new;
     uint8_t id;
 
     for (id = 0u; id < J288_MAX_SERVOS; id++) {
@@ -561,15 +581,15 @@ int main(void)
         r.id = id;
         r.status = 1u;
         r.pos = 1000 * (int32_t)id;
-        (void)j288_reply_encode(&r, replies[id], NULL);
+        (void)j288_reply_encode(&r, replies[id], &soft_engine);
         memcpy((uint8_t *)floor_replies[id] + 2, replies[id], J288_REPLY_LEN);
     }
     {
         j288_cmd_raw_t cmd = bench_cmd();
         uint8_t f[J288_CMD_LEN];
-        (void)j288_cmd_encode(&cmd, f, NULL);
-        unit_answer[0] = j288_frame_crc_field(f, J288_CMD_LEN);
-        unit_answer[1] = j288_frame_crc_field(replies[3], J288_REPLY_LEN);
+        (void)j288_cmd_encode(&cmd, f, &soft_engine);
+        bench_unit_answer[0] = j288_frame_crc_field(f, J288_CMD_LEN);
+        bench_unit_answer[1] = j288_frame_crc_field(replies[3], J288_REPLY_LEN);
     }
     floor_tables();
     icount_start();
@@ -580,12 +600,21 @@ int main(void)
     codec = per_txn(RUN_ROW(2u, run_codec(NULL)), ipt);
     codec_unit = per_txn(RUN_ROW(4u, run_codec(&unit_engine)), ipt);
     poll = per_txn(RUN_ROW(8u, run_bus_poll()), ipt);
-    isr = per_txn(RUN_ROW(16u, run_sched_isr()), ipt);
+    /* (With the CRC unit as the backend, the model's two answers do not fit 15 servos.) */
+    isr = HW_BACKEND ? 0u : per_txn(RUN_ROW(16u, run_sched_isr(false)), ipt);
+    isr_new = HW_BACKEND ? 0u : per_txn(RUN_ROW(64u, run_sched_isr(true)), ipt);
     printf("library CRC: %s | floor | j288 | ratio |\n", backend_name());
-    row("codec only (encode, parse, unpack)", f_codec, codec);
+    if (HW_BACKEND) {
+        row("codec, CRC unit (compile-time backend)", f_unit, codec);
+    } else {
+        row("codec only (encode, parse, unpack)", f_codec, codec);
+    }
     row("codec, CRC unit (port crc32 op)", f_unit, codec_unit);
     row("bus, poll mode", 0u, poll);
-    row("scheduler sweeps, advance_in_isr", f_engine, isr);
+    if (!HW_BACKEND) {
+        row("scheduler sweeps, advance_in_isr", f_engine, isr);
+        row("sweeps, a new command each transaction", f_engine, isr_new);
+    }
 #if J288_CONFIG_SI
     row("joint: reply -> state", 0u, per_txn(RUN_ROW(32u, run_joint_reply()), ipt));
     row("joint: target -> command", 0u, per_txn(RUN_ROW(32u, run_joint_command()), ipt));

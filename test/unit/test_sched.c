@@ -652,6 +652,42 @@ static void test_reply_hook_sees_every_good_reply_and_may_change_the_next_comman
     assert_frame_cmd(2u, &lock2); /* the hook's command went out next time */
 }
 
+/* A command set while the slot's transaction is under way changes the next transaction, not
+ * the re-send of this one: the frame the bus sends (kept by the scheduler) is not rewritten by
+ * j288_sched_set_cmd(), which may run while that frame is on the wire. */
+static void test_set_cmd_during_a_retry_changes_the_next_sweep_only(void)
+{
+    static const uint8_t ids[1] = {4u};
+    j288_cmd_raw_t first = foc(4u, 111);
+    j288_cmd_raw_t second = foc(4u, -222);
+    j288_bus_config_t bc;
+    memset(&bc, 0, sizeof bc);
+    bc.retries = 1u;
+    setup_all(false, false, 0u);
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_bus_init(&bus, &fp.ops, &fp, &bc));
+    fake_port_attach(&fp, &bus);
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_sched_init(&sch, &bus, &sch.cfg));
+    add_servos(ids, 1u);
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_sched_set_cmd(&sch, &first));
+    fp.servo[4].present = false; /* the first attempt goes unanswered */
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_sched_start_sweep(&sch, 0u));
+    while ((j288_bus_stats(&bus)->timeouts == 0u) && (fp.now_ns < 5000u * US)) {
+        fake_port_run_until(&fp, fp.now_ns + US); /* until the first attempt times out */
+    }
+    TEST_ASSERT_EQUAL_UINT32(1u, fp.nframes);
+    TEST_ASSERT_EQUAL_UINT32(1u, j288_bus_stats(&bus)->timeouts);
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_sched_set_cmd(&sch, &second));
+    fp.servo[4].present = true;
+    TEST_ASSERT_TRUE(fake_port_run_until_idle(&fp, 20000u * US));
+    TEST_ASSERT_EQUAL_UINT32(2u, fp.nframes);
+    assert_frame_cmd(0u, &first);
+    assert_frame_cmd(1u, &first); /* the re-send */
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_sched_slot(&sch, 4u)->last_result);
+    sweep_once();
+    TEST_ASSERT_EQUAL_UINT32(3u, fp.nframes);
+    assert_frame_cmd(2u, &second);
+}
+
 int main(void)
 {
     UNITY_BEGIN();
@@ -673,5 +709,6 @@ int main(void)
     RUN_TEST(test_default_config_without_handlers);
     RUN_TEST(test_control_loop_ticks_in_poll_mode);
     RUN_TEST(test_reply_hook_sees_every_good_reply_and_may_change_the_next_command);
+    RUN_TEST(test_set_cmd_during_a_retry_changes_the_next_sweep_only);
     return UNITY_END();
 }

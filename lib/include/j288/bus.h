@@ -136,8 +136,10 @@ typedef struct j288_bus {
     j288_bus_config_t cfg;
     uint32_t reply_budget_us;
     uint8_t state;                /* read from other contexts through j288_bus_state() */
-    uint8_t tx_buf[J288_CMD_LEN]; /* owned by the port from start_tx until tx done */
-    uint8_t tx_id;                /* id addressed by tx_buf */
+    uint8_t tx_buf[J288_CMD_LEN]; /* a submitted command, encoded */
+    uint8_t tx_id;                /* id addressed by tx_frame */
+    const uint8_t *tx_frame;      /* the transaction's frame: tx_buf, or the scheduler's own
+                                     (owned by the port from start_tx until tx done) */
     j288_parser_t parser;
     /* receive ring: free-running indexes, masked on use */
     uint8_t ring[J288_CONFIG_RX_RING_SIZE];

@@ -47,8 +47,6 @@ typedef struct {
     uint8_t frame_len;
     uint8_t buf[J288_REPLY_LEN]; /* 2 bytes into the struct: a reply's CRC'd words align */
     uint8_t head0;
-    uint8_t crc_first; /* the CRC covers crc_words words from byte crc_first */
-    uint8_t crc_words;
     j288_parse_kind_t kind;
     const j288_crc_t *crc;
     j288_parser_stats_t stats;

@@ -112,7 +112,9 @@ typedef struct {
     bool sweeping;
     bool stopped;          /* after an estop, until the next start */
     bool wd_clear_in_flight; /* the command in flight has its watchdog bit cleared */
+    uint16_t frame_stale;  /* bit id: frame[id] no longer matches slot[id].cmd */
     uint32_t sweeps;
+    uint8_t frame[J288_MAX_SERVOS][J288_CMD_LEN]; /* each slot's command, encoded when sent */
 } j288_sched_t;
 
 /* Bind a scheduler to a bus (already initialised). cfg may be NULL. Slots start disabled,
