@@ -296,8 +296,9 @@ int j288_joint_take_reply(j288_joint_t *j, const j288_reply_raw_t *reply, unsign
         ev |= J288_JOINT_EV_BIT(fault ? J288_JOINT_EV_ENCODER_FAULT : J288_JOINT_EV_ENCODER_OK);
     }
     j->st.encoder_fault = fault;
-    j->st.speed = j->k_speed * (j288_real_t)reply->speed;
-    j->st.torque = j->k_torque * (j288_real_t)reply->torque;
+    /* + 0: a reversed joint at rest is +0, not -0 (which tools print as "-0"). */
+    j->st.speed = (j->k_speed * (j288_real_t)reply->speed) + ZERO;
+    j->st.torque = (j->k_torque * (j288_real_t)reply->torque) + ZERO;
     j->st.encoder = encoder_angle(reply->out_pos);
     if (!j->seen) {
         j->seen = true;
