@@ -293,6 +293,10 @@ t_beyond_limit() {
     cfg=$(config b "  - name: j" "    id: 1" "    zero: 0.202" "    limits: [0.0, 0.5]")
     status_joint j "$cfg" || return 1
     [ "$(jget "$E2E_TMP/st.json" beyond_limit)" = True ] || { cat "$E2E_TMP/st.json"; return 1; }
+    # calibrate from there: the motion starts at the limit and stays inside.
+    timeout -k 2 60 "$J288" calibrate --joint j --config "$cfg" "${M[@]}" >"$E2E_TMP/cal.out" 2>&1 ||
+        { echo "calibrate at the limit: $(cat "$E2E_TMP/cal.out")"; return 1; }
+    grep -q '^    phase: ' "$cfg" || { echo "no phase written: $(cat "$cfg")"; return 1; }
     move_joint j "$cfg" --pos 0.1 --speed 1 --duration 1 || return 1
     truth_now && near "$(truth_val 1 theta)" 0.302 0.005 || return 1
     cfg=$(config b2 "  - name: j" "    id: 1" "    zero: 0.5" "    limits: [0.0, 0.5]")
