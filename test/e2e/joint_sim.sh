@@ -293,6 +293,8 @@ t_beyond_limit() {
     cfg=$(config b "  - name: j" "    id: 1" "    zero: 0.202" "    limits: [0.0, 0.5]")
     status_joint j "$cfg" || return 1
     [ "$(jget "$E2E_TMP/st.json" beyond_limit)" = True ] || { cat "$E2E_TMP/st.json"; return 1; }
+    timeout -k 2 60 "$J288" log --joint j --config "$cfg" --hold --rate 50 --duration 0.2 "${M[@]}" >"$E2E_TMP/lh.out" 2>&1 ||
+        { echo "log --hold beyond the limit: $(cat "$E2E_TMP/lh.out")"; return 1; }
     # calibrate from there: the motion starts at the limit and stays inside.
     timeout -k 2 60 "$J288" calibrate --joint j --config "$cfg" "${M[@]}" >"$E2E_TMP/cal.out" 2>&1 ||
         { echo "calibrate at the limit: $(cat "$E2E_TMP/cal.out")"; return 1; }
