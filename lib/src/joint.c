@@ -280,6 +280,13 @@ static void check_limits(j288_joint_t *j, unsigned *ev)
     }
 }
 
+/* k * raw, and +0 for raw 0: a reversed joint at rest is not -0 (tools print "-0"). A test
+ * is cheaper than adding 0 in soft float. */
+static j288_real_t scale_raw(j288_real_t k, int16_t raw)
+{
+    return (raw == 0) ? ZERO : (k * (j288_real_t)raw);
+}
+
 int j288_joint_take_reply(j288_joint_t *j, const j288_reply_raw_t *reply, unsigned *events)
 {
     unsigned ev = 0u;
@@ -296,8 +303,8 @@ int j288_joint_take_reply(j288_joint_t *j, const j288_reply_raw_t *reply, unsign
         ev |= J288_JOINT_EV_BIT(fault ? J288_JOINT_EV_ENCODER_FAULT : J288_JOINT_EV_ENCODER_OK);
     }
     j->st.encoder_fault = fault;
-    j->st.speed = j->k_speed * (j288_real_t)reply->speed;
-    j->st.torque = j->k_torque * (j288_real_t)reply->torque;
+    j->st.speed = scale_raw(j->k_speed, reply->speed);
+    j->st.torque = scale_raw(j->k_torque, reply->torque);
     j->st.encoder = encoder_angle(reply->out_pos);
     if (!j->seen) {
         j->seen = true;

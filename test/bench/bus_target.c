@@ -508,6 +508,8 @@ static uint32_t run_joint_reply(void)
     r.id = 3u;
     r.pos = 5000;
     r.out_pos = 100u;
+    r.speed = 100; /* a moving joint: speed and torque are scaled, not skipped as zero */
+    r.torque = 10;
     (void)j288_joint_init(&joint, &jc);
     for (i = 0u; i < J288_JOINT_DEFAULT_INIT_SAMPLES; i++) {
         (void)j288_joint_take_reply(&joint, &r, NULL);

@@ -59,7 +59,7 @@ static void expect_one_error(const char *part)
 
 static void opts(cli_bus_opts_t *o)
 {
-    cli_global_t g = {NULL, 0};
+    cli_global_t g = {NULL, 0, NULL};
     cli_bus_opts_init(o, &g);
 }
 

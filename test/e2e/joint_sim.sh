@@ -7,7 +7,8 @@
 # joint angle X, power cycles (the angle the same before and after, uncalibrated and
 # calibrated), `calibrate` and `zero` written back into the robot config, ranges across the
 # output encoder's wrap in both directions (and direction -1), limits refused with nothing
-# sent, fault bit 12 (output encoder), and a wrong phase reported as a mismatch.
+# sent, a joint just beyond its limits brought back (far beyond: refused), fault bit 12
+# (output encoder), and a wrong phase reported as a mismatch.
 # Run from the repo root with BIN set (make test does). Every process is bounded by timeout
 # and killed by the EXIT trap; waits poll, bounded; no check depends on the machine's speed
 # (a move is given ample time, and the checks are on where it ended).
@@ -283,6 +284,32 @@ t_limits() {
     [ "$(wc -l <"$SLOG")" = "$frames" ] || { echo "frames were sent"; return 1; }
     stop_sim
 }
+# A joint just beyond its limits (a zero taken at a hard stop, a load that pushed it out) can be
+# moved and held back inside: the ramp starts at the nearest limit. Far beyond, move refuses
+# and sends no FOC frame.
+t_beyond_limit() {
+    local cfg
+    start_sim beyond --ids 1 --start-angle 1:0.2 --quiet || return 1
+    cfg=$(config b "  - name: j" "    id: 1" "    zero: 0.202" "    limits: [0.0, 0.5]")
+    status_joint j "$cfg" || return 1
+    [ "$(jget "$E2E_TMP/st.json" beyond_limit)" = True ] || { cat "$E2E_TMP/st.json"; return 1; }
+    timeout -k 2 60 "$J288" log --joint j --config "$cfg" --hold --rate 50 --duration 0.2 "${M[@]}" >"$E2E_TMP/lh.out" 2>&1 ||
+        { echo "log --hold beyond the limit: $(cat "$E2E_TMP/lh.out")"; return 1; }
+    # calibrate from there: the motion starts at the limit and stays inside.
+    timeout -k 2 60 "$J288" calibrate --joint j --config "$cfg" "${M[@]}" >"$E2E_TMP/cal.out" 2>&1 ||
+        { echo "calibrate at the limit: $(cat "$E2E_TMP/cal.out")"; return 1; }
+    grep -q '^    phase: ' "$cfg" || { echo "no phase written: $(cat "$cfg")"; return 1; }
+    move_joint j "$cfg" --pos 0.1 --speed 1 --duration 1 || return 1
+    truth_now && near "$(truth_val 1 theta)" 0.302 0.005 || return 1
+    cfg=$(config b2 "  - name: j" "    id: 1" "    zero: 0.5" "    limits: [0.0, 0.5]")
+    expect_bad beyond_limit_far_refused 2 "^j288 move: joint j: at -0.19[0-9]* rad, 0.19[0-9]* rad outside its limits \\[0, 0.5\\] \\(more than 0.05\\): move it inside by hand or with --side output; servo locked$" \
+        "$J288" move --joint j --config "$cfg" --pos 0.1 "${M[@]}"
+    [ "$(foc_frames 1)" -gt 0 ] || { echo "the first move sent no FOC frame"; return 1; }
+    local before; before=$(foc_frames 1)
+    expect_bad beyond_limit_far_hold_refused 2 "outside its limits" "$J288" hold --joint j --config "$cfg" --duration 0.2 "${M[@]}"
+    [ "$(foc_frames 1)" = "$before" ] || { echo "a FOC frame was sent"; return 1; }
+    stop_sim
+}
 t_encoder_fault() {
     start_sim fault --ids 1 --fault 1:0x1000 --quiet || return 1
     status_json 1 || { cat "$E2E_TMP/st.err"; return 1; }
@@ -362,7 +389,7 @@ run_check() { # NAME FUNCTION ARGS...
 for s in $SEEDS; do
     run_check "seed_$s" t_seed "$s"
 done
-for t in t_wrap_around_zero t_wrap_high_range t_direction t_power_cycle_while_driving t_limits t_encoder_fault t_wrong_phase t_config_errors; do
+for t in t_wrap_around_zero t_wrap_high_range t_direction t_power_cycle_while_driving t_limits t_beyond_limit t_encoder_fault t_wrong_phase t_config_errors; do
     run_check "${t#t_}" "$t"
 done
 e2e_summary

@@ -476,6 +476,24 @@ static void test_state_speed_torque_and_direction(void)
     }
 }
 
+/* A reversed joint at rest reports speed and torque +0, not -0 (printed "-0" by tools). */
+static void test_reversed_joint_at_rest_is_plus_zero(void)
+{
+    j288_joint_config_t c = cfg_for(7u);
+    j288_reply_raw_t r;
+    model_t m = servo_at(0.25, 0.0);
+
+    c.direction = -1;
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_joint_init(&joint, &c));
+    (void)start_joint(&joint, &m);
+    r = reply_of(&m, 7u);
+    r.speed = 0;
+    r.torque = 0;
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_joint_take_reply(&joint, &r, NULL));
+    TEST_ASSERT_FALSE(signbit(j288_joint_state(&joint)->speed));
+    TEST_ASSERT_FALSE(signbit(j288_joint_state(&joint)->torque));
+}
+
 /* A start with the joint moving, and one where a sample disagrees: the start restarts. */
 static void test_start_while_moving_and_outlier(void)
 {
@@ -1556,6 +1574,7 @@ int main(void)
     RUN_TEST(test_uncalibrated_random);
     RUN_TEST(test_calibrated_random);
     RUN_TEST(test_state_speed_torque_and_direction);
+    RUN_TEST(test_reversed_joint_at_rest_is_plus_zero);
     RUN_TEST(test_start_while_moving_and_outlier);
     RUN_TEST(test_start_average_while_moving);
     RUN_TEST(test_turn_choice);

@@ -173,6 +173,15 @@ void cli_robot_fill_bus(const cli_robot_t *r, const j288_robot_config_joint_t *r
  * outside the joint's limits [-1.5, 1.5]". */
 void cli_joint_target_error(const j288_joint_t *j, const char *name, const char *what, int rc);
 
+/* How far beyond its limits a joint may be for hold and move to start: from the nearest
+ * limit, so that the first command pulls it in by at most this (rad). */
+#define CLI_JOINT_START_OUTSIDE_MAX 0.05
+
+/* The joint-frame pose hold and move start from, given the joint's angle q: q inside the
+ * limits (or a clamping joint), else the nearest limit when q is beyond it by at most
+ * CLI_JOINT_START_OUTSIDE_MAX. Farther out: an error line and -1. */
+int cli_joint_start_inside(const j288_joint_t *j, const char *name, double q, double *q_start);
+
 /* Whether a position target lies within the joint configuration's limits ([-pi, pi] when
  * both are 0) or the joint clamps. For checks before the bus is opened. */
 bool cli_joint_pos_allowed(const j288_joint_config_t *jc, double pos);

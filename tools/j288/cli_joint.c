@@ -222,6 +222,25 @@ bool cli_joint_pos_allowed(const j288_joint_config_t *jc, double pos)
     return jc->clamp || (pos >= lo && pos <= hi);
 }
 
+int cli_joint_start_inside(const j288_joint_t *j, const char *name, double q, double *q_start)
+{
+    double lo, hi, out;
+    joint_range(&j->cfg, &lo, &hi);
+    out = q < lo ? lo - q : (q > hi ? q - hi : 0.0);
+    if (j->cfg.clamp || out == 0.0) {
+        *q_start = q;
+        return 0;
+    }
+    if (out > CLI_JOINT_START_OUTSIDE_MAX) {
+        cli_error("%s: at %g rad, %g rad outside its limits [%g, %g] (more than %g): move it "
+                  "inside by hand or with --side output; servo locked",
+                  name, q, out, lo, hi, CLI_JOINT_START_OUTSIDE_MAX);
+        return -1;
+    }
+    *q_start = q < lo ? lo : hi;
+    return 0;
+}
+
 void cli_joint_target_error(const j288_joint_t *j, const char *name, const char *what, int rc)
 {
     double lo, hi;

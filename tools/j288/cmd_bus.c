@@ -689,6 +689,11 @@ static int drive_start(cli_bus_t *b, drive_args_t *d, drive_plan_t *p, drive_res
             return rc;
         }
         p->q0 = (double)j288_joint_state(&d->j)->pos;
+        /* Just beyond a limit (a zero at a hard stop, a load): start from the limit, so the
+         * joint can be brought back; the lib refuses any target outside. */
+        if (d->kind != DRIVE_TORQUE && cli_joint_start_inside(&d->j, d->sel.name, p->q0, &p->q0) != 0) {
+            return CLI_EXIT_USAGE;
+        }
         res->last_target = p->q0;
     } else {
         cli_lock_cmd((uint8_t)d->id, &cmd);
@@ -869,8 +874,10 @@ static int run_drive(drive_args_t *d, cli_bus_opts_t *o)
     "                   counted from wherever the rotor started at power-up (no limits)\n"         \
     "  --id N           the servo; or --joint NAME with --config FILE\n"                           \
     "A target outside the joint's limits is refused before anything is sent (exit 2),\n"          \
-    "unless the joint is configured to clamp. The joint angle is watched: if it is lost\n"         \
-    "(power cycle, slipped gear) the servo is locked and the command fails.\n"                     \
+    "unless the joint is configured to clamp. A joint found up to 0.05 rad beyond its\n"          \
+    "limits starts from the nearest one (it is pulled in); farther out it is refused (exit 2).\n" \
+    "The joint angle is watched: if it is lost (power cycle, slipped gear) the servo is\n"       \
+    "locked and the command fails.\n"                                                             \
     "Ctrl-C or SIGTERM: the servo is sent lock before exiting (exit 130 / 143).\n"                 \
     "Exit status: 0 done; 1 no reply, servo stopped answering, joint angle unknown or lost,\n"     \
     "or device error; 2 bad arguments or a target outside the limits.\n"

@@ -181,8 +181,9 @@ static const char calibrate_help[] =
     "Fit the joint's rotor phase c (r = N theta + c) and write it as the joint's phase: in\n"
     "FILE (comments and every other value kept); without a joint from FILE, print it. The\n"
     "joint moves: from where it is, slowly over --range (default 0.1 rad) up and down and\n"
-    "back, kept inside its limits by 0.01 rad; every reply's (output encoder, rotor) pair\n"
-    "goes into the fit. The joint must be free to move over that range.\n"
+    "back, kept inside its limits by 0.01 rad (a joint starting closer to a limit, or up to\n"
+    "0.05 rad beyond it, starts from there); every reply's (output encoder, rotor) pair goes\n"
+    "into the fit. The joint must be free to move over that range.\n"
     "  --range RAD      width of the motion, 0.02..1 (default 0.1)\n"
     "  --speed RAD_S    speed of the motion, 0.001..1 (default 0.05)\n"
     "  --rate HZ        command refresh rate, 50..5000 (default 200)\n"
@@ -202,17 +203,22 @@ typedef struct {
     double kp, kd, speed;
 } cal_path_t;
 
-/* The window of the motion inside the limits. 0, or -1 after an error line. */
-static int cal_window(const joint_args_t *a, const j288_joint_config_t *jc, double q0,
-                      cal_path_t *p, const char *name)
+/* The window of the motion inside the limits, by CAL_LIMIT_MARGIN or, for a joint starting
+ * closer (at a hard stop, say), from its start pose (the nearest limit when it is just beyond:
+ * cli_joint_start_inside). 0, or -1 after an error line. */
+static int cal_window(const joint_args_t *a, const j288_joint_t *j, double q, cal_path_t *p,
+                      const char *name)
 {
-    double lmin = (double)jc->pos_min, lmax = (double)jc->pos_max;
+    double lmin = (double)j->cfg.pos_min, lmax = (double)j->cfg.pos_max, q0;
     if (lmin == 0.0 && lmax == 0.0) {
         lmin = -J288_PI;
         lmax = J288_PI;
     }
-    lmin += CAL_LIMIT_MARGIN;
-    lmax -= CAL_LIMIT_MARGIN;
+    if (cli_joint_start_inside(j, name, q, &q0) != 0) {
+        return -1;
+    }
+    lmin = fmin(lmin + CAL_LIMIT_MARGIN, q0);
+    lmax = fmax(lmax - CAL_LIMIT_MARGIN, q0);
     p->q0 = q0;
     p->lo = q0 - a->range / 2.0;
     p->hi = q0 + a->range / 2.0;
@@ -224,10 +230,10 @@ static int cal_window(const joint_args_t *a, const j288_joint_config_t *jc, doub
         p->lo -= p->hi - lmax;
         p->hi = lmax;
     }
-    if (p->lo < lmin || q0 < lmin || q0 > lmax) {
-        cli_error("%s: no room for a %g rad motion inside the limits [%g, %g] from %g (give a "
-                  "smaller --range, or move the joint inside its range)",
-                  name, a->range, lmin - CAL_LIMIT_MARGIN, lmax + CAL_LIMIT_MARGIN, q0);
+    if (p->lo < lmin) {
+        cli_error("%s: no room for a %g rad motion inside the limits [%g, %g] (give a smaller "
+                  "--range)",
+                  name, a->range, (double)j->cfg.pos_min, (double)j->cfg.pos_max);
         return -1;
     }
     return 0;
@@ -415,7 +421,7 @@ static int cal_run(cli_bus_t *b, const joint_args_t *a, const cli_joint_sel_t *s
     if ((ec = cli_joint_acquire(b, &joint, sel->name, &txn, &replies, true)) != CLI_EXIT_OK) {
         return ec;
     }
-    if (cal_window(a, jc, (double)j288_joint_state(&joint)->pos, &path, sel->name) != 0) {
+    if (cal_window(a, &joint, (double)j288_joint_state(&joint)->pos, &path, sel->name) != 0) {
         return CLI_EXIT_USAGE;
     }
     path.speed = a->speed;

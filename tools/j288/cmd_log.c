@@ -39,7 +39,8 @@ static const char log_help[] =
     "                 the output encoder's wrapped to [-pi, pi) or the --config joints'),\n"
     "                 rotor (raw), or output (rotor / N from where the rotor started)\n"
     "  --config FILE  the joints of the listed ids: zero, direction, limits (a swing\n"
-    "                 leaving them is refused before it starts), phase\n"
+    "                 leaving them is refused before it starts; a joint up to 0.05 rad\n"
+    "                 beyond them holds or swings from the nearest limit), phase\n"
     "Prints the achieved rate, missed deadlines (sweeps that ended after the next tick was\n"
     "due: that tick starts late; ticks a whole period behind are skipped, never bunched),\n"
     "bus statistics and, when driving, the tracking error. Ctrl-C or SIGTERM: every driven\n"
@@ -643,7 +644,11 @@ static int log_probe(log_run_t *r)
                 cli_error("%s", why);
                 return CLI_EXIT_FAIL;
             }
-            r->q0[id] = (double)st->pos;
+            /* Just beyond a limit: hold or swing from the limit (every target outside is
+             * refused); farther out, refused here. */
+            if (cli_joint_start_inside(&r->joint[id], r->sel[id].name, (double)st->pos, &r->q0[id]) != 0) {
+                return CLI_EXIT_USAGE;
+            }
             if (r->a.motion == MOTION_SWING &&
                 !cli_joint_pos_allowed(&r->sel[id].jc, r->q0[id] + r->a.amp)) {
                 cli_joint_target_error(&r->joint[id], r->sel[id].name, "--swing", J288_ERR_LIMIT_POS);

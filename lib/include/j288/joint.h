@@ -182,7 +182,8 @@ void j288_joint_reset(j288_joint_t *j);
 /* Take one reply of this joint's servo: update the state, run the start, the tracking
  * check and the limit check, and OR the events (J288_JOINT_EV_BIT) into *events (may be
  * NULL; set to 0 first). Errors (joint untouched): J288_ERR_NULL, J288_ERR_WRONG_ID (the
- * reply is from another id). Pure: the reply is only read during the call. */
+ * reply is from another id). The reply is only read during the call (not kept); no field of
+ * it is trusted beyond its type's range (OutPos is taken modulo 8192). */
 int j288_joint_take_reply(j288_joint_t *j, const j288_reply_raw_t *reply, unsigned *events);
 
 /* The state after the latest reply (all zero before one), or NULL for NULL. Valid as long as
@@ -223,7 +224,8 @@ typedef struct {
     j288_real_t value; /* see the kinds */
 } j288_joint_event_t;
 
-/* Called from the context that advances the bus (inside the scheduler's on_reply). */
+/* Called from the context that advances the bus (inside the scheduler's on_reply: in an
+ * interrupt with advance_in_isr, so keep it short). ev is valid during the call only. */
 typedef void (*j288_joint_event_fn)(void *user, const j288_joint_event_t *ev);
 
 typedef struct {
@@ -245,8 +247,9 @@ int j288_joint_bus_init(j288_joint_bus_t *jb, j288_sched_t *sched, j288_joint_ev
                         void *user);
 
 /* Add joint j (initialised) under its id and set its slot's command to lock. Enabling the
- * slot is the application's (j288_sched_enable()). Errors: J288_ERR_NULL,
- * J288_ERR_BAD_CONFIG (another joint has that id here). */
+ * slot is the application's (j288_sched_enable()). The binding keeps the pointer: j must
+ * stay valid and in place as long as the binding is in use (there is no remove). Errors:
+ * J288_ERR_NULL, J288_ERR_BAD_CONFIG (another joint has that id here). */
 int j288_joint_bus_add(j288_joint_bus_t *jb, j288_joint_t *j);
 
 /* The scheduler's reply hook (j288_reply_fn; user: the binding). Feeds the reply to the
