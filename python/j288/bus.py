@@ -44,7 +44,8 @@ class Bus:
 
     Every frame of the protocol commands the servo: scan and status send lock (no torque) to
     each id they probe. Used as a context manager, the bus sends the broadcast lock on exit
-    if a command moved a servo, then closes::
+    (an exception or Ctrl-C included), then closes; close() alone sends it only if a command
+    went out since the last stop::
 
         with j288.Bus("/dev/ttyUSB0", margin_us=3000) as bus:
             print(bus.scan())
@@ -116,7 +117,7 @@ class Bus:
             raise error_for(rc, _native.error_text(self._r), self.port)
 
     def close(self) -> None:
-        """Stop (if a command moved a servo) and close. Safe twice."""
+        """Stop (if a command went out since the last stop) and close. Safe twice."""
         if self._r is not None:
             LIB.j288_robot_close(self._r)
             self._r = None
