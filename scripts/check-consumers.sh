@@ -79,6 +79,12 @@ installed "$root/cmake-prefix"
 quiet make -j"$jobs" BUILD="${BUILD:-build}" PREFIX=/usr DESTDIR="$root/make-destdir" install
 installed "$root/make-destdir/usr"
 installed_python "$root/make-destdir/usr"
+# Both installs hold the same files (`make install` adds the Python package).
+if ! diff <(cd "$root/cmake-prefix" && find . ! -type d | sort) \
+    <(cd "$root/make-destdir/usr" && find . ! -type d ! -path './lib/python3/*' | sort) >&2; then
+    echo "check-consumers: cmake --install and make install differ (<: cmake, >: make)" >&2
+    exit 1
+fi
 consumer add_subdirectory -DJ288_SOURCE_DIR="$PWD"
 
 bash scripts/need.sh arm-none-eabi-gcc gcc-arm-none-eabi || exit $(($? == 1 ? 0 : 1))
