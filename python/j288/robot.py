@@ -20,6 +20,7 @@ except ImportError:  # pragma: no cover - depends on the machine
 Vector = Union[Sequence[float], Any]  # a sequence of floats or a NumPy array
 
 _RUN_SLICE_US = 100000  # run(): Python's signal handlers get their turn this often
+_MAX_SECONDS = 4000     # a cycle's timeout, run()'s period: microseconds in 32 bits
 
 
 @dataclass(frozen=True)
@@ -138,7 +139,10 @@ class Robot:
     # ---- the loop
     def cycle(self, timeout: float = 1.0) -> Cycle:
         """Sweep every bus once. Returns the cycle's outcome, also when some joint got no
-        reply (complete False). Raises OfflineError when every bus is gone."""
+        reply (complete False). timeout: seconds, (0, 4000]. Raises OfflineError when every
+        bus is gone."""
+        if not 0 < timeout <= _MAX_SECONDS:
+            raise ValueError(f"timeout {timeout} s outside (0, {_MAX_SECONDS}]")
         info = CycleInfo()
         rc = LIB.j288_robot_cycle(self._robot(), int(timeout * 1e6), ctypes.byref(info))
         if rc not in (0, -31):
@@ -153,8 +157,10 @@ class Robot:
         goes on evenly): Ctrl-C (KeyboardInterrupt) and other signals reach Python between
         them, and a with block around the loop then stops every bus. Raises OfflineError
         when every bus is gone."""
-        if cycles < 0 or rate_hz < 0 or duration < 0:
-            raise ValueError("cycles, rate_hz and duration must not be negative")
+        if not (0 <= cycles < 2**32 and (rate_hz == 0 or 1 / _MAX_SECONDS <= rate_hz)
+                and duration >= 0):
+            raise ValueError(f"cycles 0 to 2**32 - 1, rate_hz 0 or from {1 / _MAX_SECONDS}, "
+                             "duration >= 0")
         r = self._robot()
         period = int(1e6 / rate_hz) if rate_hz > 0 else 0
         slice_us = period * max(1, _RUN_SLICE_US // period) if period else _RUN_SLICE_US

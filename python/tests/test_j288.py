@@ -190,8 +190,12 @@ def test_robot_two_buses(sims, tmp_path: Path) -> None:
         assert robot.stats()["cycles"] == before + 80
         robot.run(duration=0.25, rate_hz=200)  # ends by itself
         assert robot.stats()["cycles"] > before + 80
-        with pytest.raises(ValueError):
-            robot.run(cycles=-1)
+        for bad in ({"cycles": -1}, {"cycles": 2**32}, {"rate_hz": 1e-6}, {"duration": -1}):
+            with pytest.raises(ValueError):
+                robot.run(**bad)
+        for t in (-1.0, 0.0, 5000.0):
+            with pytest.raises(ValueError):
+                robot.cycle(timeout=t)
         stats = robot.stats()
         assert stats["cycles"] == stats["complete_cycles"] >= 22
         assert robot.bus_stats("leg1")["sweeps"] == stats["cycles"]
