@@ -235,6 +235,40 @@ def test_robot_bad_config(sims, tmp_path: Path) -> None:
     assert e.value.name == "J288_ERR_BAD_CONFIG"
 
 
+def test_robot_bus_stops_answering(sims, tmp_path: Path) -> None:
+    """A bus of four freezes: down after a few cycles, the others fresh in every cycle, and
+    back up once it answers again; the with block still stops every bus."""
+    s = [sims("1,2,3") for _ in range(4)]
+    cfg = write_config(tmp_path, [x.pty for x in s])
+    # the bus that will freeze with a short margin (as a USB adapter's): shorter waits
+    text = cfg.read_text().replace(f"port: {s[2].pty}\n    margin_us: {MARGIN}",
+                                   f"port: {s[2].pty}\n    margin_us: 20000")
+    assert "margin_us: 20000" in text
+    cfg.write_text(text)
+    with j288.Robot(str(cfg)) as robot:
+        assert robot.cycle().complete
+        os.kill(s[2].proc.pid, signal.SIGSTOP)
+        try:
+            for _ in range(10):
+                if not robot.bus_stats("leg2")["up"]:
+                    break
+                robot.cycle()
+            stats = robot.bus_stats("leg2")
+            assert not stats["up"] and stats["down_events"] == 1 and not stats["gone"]
+            for _ in range(3):
+                c = robot.cycle()
+                assert (c.fresh, c.joints, c.complete) == (9, 12, False)
+                assert not robot.state("leg2_1").fresh and robot.state("leg3_1").fresh
+        finally:
+            os.kill(s[2].proc.pid, signal.SIGCONT)
+        for _ in range(200):
+            if robot.cycle().complete:
+                break
+        assert robot.bus_stats("leg2")["up"] and robot.cycle().complete
+    for x in s:
+        assert x.logged(" id=15 status=0 wd=1")
+
+
 def test_robot_bus_gone(sims, tmp_path: Path) -> None:
     s0, s1 = sims("1,2,3"), sims("1,2,3")
     cfg = write_config(tmp_path, [s0.pty, s1.pty])
