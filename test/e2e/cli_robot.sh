@@ -132,7 +132,10 @@ t_one_bus_stops_answering() {
         >"$tmp/out" 2>"$tmp/err" &
     pid=$!
     # (frozen once the run's cycles have begun: the start found every joint's angle)
-    for _ in $(seq 1 400); do [ "$(wc -l <"$tmp/stall.csv" 2>/dev/null)" -gt 30 ] 2>/dev/null && break; sleep 0.05; done
+    for _ in $(seq 1 400); do
+        [ -f "$tmp/stall.csv" ] && [ "$(wc -l <"$tmp/stall.csv")" -gt 30 ] && break
+        sleep 0.05
+    done
     kill -STOP "$SIM_PID_2"
     wait_exit "$pid"; rc=$?
     kill -CONT "$SIM_PID_2"
