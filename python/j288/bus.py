@@ -8,10 +8,15 @@ from typing import List, Optional
 
 from . import _native
 from ._native import LIB, ServoReply, Target
-from .errors import NoReplyError, error_for
+from .errors import J288Error, error_for
 
 MODE_LOCK = 0
 MODE_FOC = 1
+
+# Results that mean "no good reply from that id" (scan goes on to the next).
+_BAD_REPLY = frozenset(("J288_ERR_TIMEOUT", "J288_ERR_CRC", "J288_ERR_TRUNCATED",
+                        "J288_ERR_BAD_HEADER", "J288_ERR_WRONG_ID", "J288_ERR_COLLISION",
+                        "J288_ERR_LINE"))
 
 
 @dataclass(frozen=True)
@@ -85,13 +90,18 @@ class Bus:
         return ServoStatus._from(reply)
 
     def scan(self, ids: Optional[List[int]] = None) -> List[int]:
-        """The ids (0-14, or those of ids) that answer a lock command."""
+        """The ids (0-14, or those of ids) that answer a lock command with a good reply, as
+        `j288 scan` lists them: an id with no reply or a bad one (CRC, truncated, another
+        id's, a collision) is left out. Raises OfflineError when the device is gone,
+        J288Error (J288_ERR_BAD_ID) for an id outside 0-14."""
         found = []
         for i in (range(_native.MAX_SERVOS) if ids is None else ids):
             try:
                 self._exchange(i, None)
-            except NoReplyError:
-                continue
+            except J288Error as e:
+                if e.name in _BAD_REPLY:
+                    continue
+                raise
             found.append(i)
         return found
 

@@ -28,10 +28,10 @@ MARGIN = 250000
 class Sim:
     """One j288-sim on a pseudo-terminal, with its command log."""
 
-    def __init__(self, tmp: Path, ids: str, name: str) -> None:
+    def __init__(self, tmp: Path, ids: str, name: str, *extra: str) -> None:
         self.log = tmp / f"{name}.log"
         self.proc = subprocess.Popen([SIM, "--quiet", "--exit-after", "60", "--ids", ids,
-                                      "--log", str(self.log)],
+                                      "--log", str(self.log), *extra],
                                      stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
         assert self.proc.stdout is not None
         self.pty = self.proc.stdout.readline().strip()
@@ -61,8 +61,8 @@ class Sim:
 def sims(tmp_path: Path) -> Iterator[List[Sim]]:
     started: List[Sim] = []
 
-    def start(ids: str) -> Sim:
-        s = Sim(tmp_path, ids, f"sim{len(started)}")
+    def start(ids: str, *extra: str) -> Sim:
+        s = Sim(tmp_path, ids, f"sim{len(started)}", *extra)
         started.append(s)
         return s
 
@@ -151,6 +151,19 @@ def test_bus_errors(sims) -> None:
     bus.close()
     with pytest.raises(ValueError):
         bus.status(1)
+
+
+def test_bus_scan_skips_bad_replies(sims) -> None:
+    """Every reply corrupted: scan lists no id (as `j288 scan`), it does not raise."""
+    sim = sims("2,7", "--corrupt", "1")
+    with j288.Bus(sim.pty, margin_us=20000) as bus:
+        with pytest.raises(j288.J288Error) as e:
+            bus.status(2)
+        assert e.value.name == "J288_ERR_CRC"
+        assert bus.scan() == []
+        with pytest.raises(j288.J288Error) as e:
+            bus.scan([2, 15])
+        assert e.value.name == "J288_ERR_BAD_ID"
 
 
 # ---- Robot ----------------------------------------------------------------------------------
