@@ -92,14 +92,20 @@ class Robot:
         config: path of the robot config file.
         port: the device when the file names no bus.
         margin_us: reply margin for buses whose entry gives none (default 20 ms).
+        down_after: sweeps without any reply before a bus is down and cycles stop waiting
+            for it (default 3; until then a silent bus slows every cycle).
     Raises:
         J288Error: J288_ERR_BAD_CONFIG (file errors, with "FILE:LINE: ..." in detail), a
             device that cannot be opened (OfflineError), ...
     """
 
-    def __init__(self, config: str, port: Optional[str] = None, margin_us: int = 0) -> None:
+    def __init__(self, config: str, port: Optional[str] = None, margin_us: int = 0,
+                 down_after: int = 0) -> None:
+        if not 0 <= down_after <= 255:
+            raise ValueError(f"down_after {down_after} outside 0-255")
         self._r: Optional[ctypes.Array] = _native.new_robot()
-        opt = _native.Options(port=port.encode() if port else None, margin_us=margin_us)
+        opt = _native.Options(port=port.encode() if port else None, margin_us=margin_us,
+                              down_after=down_after)
         rc = LIB.j288_robot_open_file(self._r, config.encode(), ctypes.byref(opt))
         if rc != 0:
             detail = _native.error_text(self._r)
