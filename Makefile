@@ -126,7 +126,7 @@ J288_VERSION := $(shell sed -n 's/.*J288_VERSION_STRING "\(.*\)"/\1/p' lib/inclu
 install: $(LIB_A) $(J288_BIN) $(SIM_BIN)
 	install -d $(DESTDIR)$(LIBDIR) $(DESTDIR)$(INCLUDEDIR)/j288 $(DESTDIR)$(BINDIR)
 	install -m 644 $(LIB_A) $(DESTDIR)$(LIBDIR)/
-	install -m 644 $(LIB_HDR) $(DESTDIR)$(INCLUDEDIR)/j288/
+	install -m 644 $(wildcard lib/include/j288/*.h) $(DESTDIR)$(INCLUDEDIR)/j288/
 	install -m 755 $(J288_BIN) $(SIM_BIN) $(DESTDIR)$(BINDIR)/
 	bash scripts/cmake-config.sh $(DESTDIR)$(LIBDIR)/cmake/j288 $(J288_VERSION) \
 	    $(patsubst $(PREFIX)/%,%,$(LIBDIR)) $(patsubst $(PREFIX)/%,%,$(INCLUDEDIR))

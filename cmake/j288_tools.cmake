@@ -19,6 +19,8 @@ set(_j288_robot_sources "${PROJECT_SOURCE_DIR}/port/linux/j288_robot.c"
                         "${PROJECT_SOURCE_DIR}/port/linux/j288_robot_config.c")
 add_library(j288_robot STATIC ${_j288_robot_sources})
 target_link_libraries(j288_robot PUBLIC j288_linux)
+# The installed package's j288::robot is libj288.so; in the tree, the static runner.
+add_library(j288::robot ALIAS j288_robot)
 
 file(GLOB _j288_shared_sources CONFIGURE_DEPENDS "${PROJECT_SOURCE_DIR}/lib/src/*.c")
 add_library(j288_shared SHARED ${_j288_shared_sources} "${PROJECT_SOURCE_DIR}/port/linux/j288_linux.c"

@@ -30,6 +30,27 @@ consumer() {
     quiet cmake --build "$root/$name" -j "$jobs"
     echo "$name: $("$root/$name/j288_consumer")"
 }
+# robot_consumer NAME CMAKE_ARGS...: test/e2e/pkgconfig_consumer.c (the library, the Linux port
+# and the runner) built against the target j288::robot, and run.
+robot_consumer() {
+    local name=$1 src=$root/robot-consumer; shift
+    mkdir -p "$src"
+    cat >"$src/CMakeLists.txt" <<EOF
+cmake_minimum_required(VERSION 3.13)
+project(j288_robot_consumer LANGUAGES C)
+if(J288_SOURCE_DIR)
+    set(J288_BUILD_TOOLS ON)
+    add_subdirectory("\${J288_SOURCE_DIR}" j288)
+else()
+    find_package(j288 0.1 REQUIRED)
+endif()
+add_executable(robot_consumer "$PWD/test/e2e/pkgconfig_consumer.c")
+target_link_libraries(robot_consumer PRIVATE j288::robot)
+EOF
+    quiet cmake -S "$src" -B "$root/$name" "$@"
+    quiet cmake --build "$root/$name" -j "$jobs"
+    echo "$name: $(env -u LD_LIBRARY_PATH "$root/$name/robot_consumer")"
+}
 # installed PREFIX: what an install must hold, then a find_package consumer against it.
 installed() {
     local p=$1 f
@@ -40,6 +61,7 @@ installed() {
     same_version "$p/bin/j288 --version" "$("$p/bin/j288" --version 2>&1)"
     same_version "$p/bin/j288-sim --version" "$("$p/bin/j288-sim" --version 2>&1)"
     consumer "find_package-$(basename "$p")" -DCMAKE_PREFIX_PATH="$p"
+    robot_consumer "find_package-robot-$(basename "$p")" -DCMAKE_PREFIX_PATH="$p"
     pkgconfig_consumer "$p"
 }
 # pkgconfig_consumer PREFIX: build test/e2e/pkgconfig_consumer.c with pkg-config's flags for
@@ -79,7 +101,14 @@ installed "$root/cmake-prefix"
 quiet make -j"$jobs" BUILD="${BUILD:-build}" PREFIX=/usr DESTDIR="$root/make-destdir" install
 installed "$root/make-destdir/usr"
 installed_python "$root/make-destdir/usr"
+# Both installs hold the same files (`make install` adds the Python package).
+if ! diff <(cd "$root/cmake-prefix" && find . ! -type d | sort) \
+    <(cd "$root/make-destdir/usr" && find . ! -type d ! -path './lib/python3/*' | sort) >&2; then
+    echo "check-consumers: cmake --install and make install differ (<: cmake, >: make)" >&2
+    exit 1
+fi
 consumer add_subdirectory -DJ288_SOURCE_DIR="$PWD"
+robot_consumer add_subdirectory-robot -DJ288_SOURCE_DIR="$PWD"
 
 bash scripts/need.sh arm-none-eabi-gcc gcc-arm-none-eabi || exit $(($? == 1 ? 0 : 1))
 for cpu in cortex-m4f cortex-m0; do

@@ -959,6 +959,9 @@ int j288_robot_exchange(j288_robot_t *r, unsigned bus, uint8_t id, const j288_ro
         if (rc != J288_OK)
             return rc;
     }
+    /* From here the command may reach the servo even if its reply does not reach us. */
+    if (foc != NULL)
+        r->driven = true;
     rc = j288_bus_transfer_blocking(&b->bus, &cmd, &txn);
     if (j288_linux_offline(&b->lp) && !b->stats.gone) {
         b->stats.gone = true;
@@ -967,12 +970,8 @@ int j288_robot_exchange(j288_robot_t *r, unsigned bus, uint8_t id, const j288_ro
         emit_bus(r, J288_ROBOT_EV_BUS_GONE, bus);
         return J288_ERR_OFFLINE;
     }
-    if (rc == J288_OK) {
-        if (foc != NULL)
-            r->driven = true;
-        if (out != NULL)
-            servo_from_reply(&txn, out);
-    }
+    if (rc == J288_OK && out != NULL)
+        servo_from_reply(&txn, out);
     return rc;
 }
 

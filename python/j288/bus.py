@@ -8,10 +8,15 @@ from typing import List, Optional
 
 from . import _native
 from ._native import LIB, ServoReply, Target
-from .errors import NoReplyError, error_for
+from .errors import J288Error, error_for
 
 MODE_LOCK = 0
 MODE_FOC = 1
+
+# Results that mean "no good reply from that id" (scan goes on to the next).
+_BAD_REPLY = frozenset(("J288_ERR_TIMEOUT", "J288_ERR_CRC", "J288_ERR_TRUNCATED",
+                        "J288_ERR_BAD_HEADER", "J288_ERR_WRONG_ID", "J288_ERR_COLLISION",
+                        "J288_ERR_LINE"))
 
 
 @dataclass(frozen=True)
@@ -44,7 +49,8 @@ class Bus:
 
     Every frame of the protocol commands the servo: scan and status send lock (no torque) to
     each id they probe. Used as a context manager, the bus sends the broadcast lock on exit
-    if a command moved a servo, then closes::
+    (an exception or Ctrl-C included), then closes; close() alone sends it only if a command
+    went out since the last stop::
 
         with j288.Bus("/dev/ttyUSB0", margin_us=3000) as bus:
             print(bus.scan())
@@ -84,13 +90,18 @@ class Bus:
         return ServoStatus._from(reply)
 
     def scan(self, ids: Optional[List[int]] = None) -> List[int]:
-        """The ids (0-14, or those of ids) that answer a lock command."""
+        """The ids (0-14, or those of ids) that answer a lock command with a good reply, as
+        `j288 scan` lists them: an id with no reply or a bad one (CRC, truncated, another
+        id's, a collision) is left out. Raises OfflineError when the device is gone,
+        J288Error (J288_ERR_BAD_ID) for an id outside 0-14."""
         found = []
         for i in (range(_native.MAX_SERVOS) if ids is None else ids):
             try:
                 self._exchange(i, None)
-            except NoReplyError:
-                continue
+            except J288Error as e:
+                if e.name in _BAD_REPLY:
+                    continue
+                raise
             found.append(i)
         return found
 
@@ -116,7 +127,7 @@ class Bus:
             raise error_for(rc, _native.error_text(self._r), self.port)
 
     def close(self) -> None:
-        """Stop (if a command moved a servo) and close. Safe twice."""
+        """Stop (if a command went out since the last stop) and close. Safe twice."""
         if self._r is not None:
             LIB.j288_robot_close(self._r)
             self._r = None

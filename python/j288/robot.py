@@ -20,6 +20,7 @@ except ImportError:  # pragma: no cover - depends on the machine
 Vector = Union[Sequence[float], Any]  # a sequence of floats or a NumPy array
 
 _RUN_SLICE_US = 100000  # run(): Python's signal handlers get their turn this often
+_MAX_SECONDS = 4000     # a cycle's timeout, run()'s period: microseconds in 32 bits
 
 
 @dataclass(frozen=True)
@@ -91,14 +92,20 @@ class Robot:
         config: path of the robot config file.
         port: the device when the file names no bus.
         margin_us: reply margin for buses whose entry gives none (default 20 ms).
+        down_after: sweeps without any reply before a bus is down and cycles stop waiting
+            for it (default 3; until then a silent bus slows every cycle).
     Raises:
         J288Error: J288_ERR_BAD_CONFIG (file errors, with "FILE:LINE: ..." in detail), a
             device that cannot be opened (OfflineError), ...
     """
 
-    def __init__(self, config: str, port: Optional[str] = None, margin_us: int = 0) -> None:
+    def __init__(self, config: str, port: Optional[str] = None, margin_us: int = 0,
+                 down_after: int = 0) -> None:
+        if not 0 <= down_after <= 255:
+            raise ValueError(f"down_after {down_after} outside 0-255")
         self._r: Optional[ctypes.Array] = _native.new_robot()
-        opt = _native.Options(port=port.encode() if port else None, margin_us=margin_us)
+        opt = _native.Options(port=port.encode() if port else None, margin_us=margin_us,
+                              down_after=down_after)
         rc = LIB.j288_robot_open_file(self._r, config.encode(), ctypes.byref(opt))
         if rc != 0:
             detail = _native.error_text(self._r)
@@ -138,7 +145,10 @@ class Robot:
     # ---- the loop
     def cycle(self, timeout: float = 1.0) -> Cycle:
         """Sweep every bus once. Returns the cycle's outcome, also when some joint got no
-        reply (complete False). Raises OfflineError when every bus is gone."""
+        reply (complete False). timeout: seconds, (0, 4000]. Raises OfflineError when every
+        bus is gone."""
+        if not 0 < timeout <= _MAX_SECONDS:
+            raise ValueError(f"timeout {timeout} s outside (0, {_MAX_SECONDS}]")
         info = CycleInfo()
         rc = LIB.j288_robot_cycle(self._robot(), int(timeout * 1e6), ctypes.byref(info))
         if rc not in (0, -31):
@@ -153,8 +163,10 @@ class Robot:
         goes on evenly): Ctrl-C (KeyboardInterrupt) and other signals reach Python between
         them, and a with block around the loop then stops every bus. Raises OfflineError
         when every bus is gone."""
-        if cycles < 0 or rate_hz < 0 or duration < 0:
-            raise ValueError("cycles, rate_hz and duration must not be negative")
+        if not (0 <= cycles < 2**32 and (rate_hz == 0 or 1 / _MAX_SECONDS <= rate_hz)
+                and duration >= 0):
+            raise ValueError(f"cycles 0 to 2**32 - 1, rate_hz 0 or from {1 / _MAX_SECONDS}, "
+                             "duration >= 0")
         r = self._robot()
         period = int(1e6 / rate_hz) if rate_hz > 0 else 0
         slice_us = period * max(1, _RUN_SLICE_US // period) if period else _RUN_SLICE_US

@@ -28,10 +28,10 @@ MARGIN = 250000
 class Sim:
     """One j288-sim on a pseudo-terminal, with its command log."""
 
-    def __init__(self, tmp: Path, ids: str, name: str) -> None:
+    def __init__(self, tmp: Path, ids: str, name: str, *extra: str) -> None:
         self.log = tmp / f"{name}.log"
         self.proc = subprocess.Popen([SIM, "--quiet", "--exit-after", "60", "--ids", ids,
-                                      "--log", str(self.log)],
+                                      "--log", str(self.log), *extra],
                                      stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
         assert self.proc.stdout is not None
         self.pty = self.proc.stdout.readline().strip()
@@ -61,8 +61,8 @@ class Sim:
 def sims(tmp_path: Path) -> Iterator[List[Sim]]:
     started: List[Sim] = []
 
-    def start(ids: str) -> Sim:
-        s = Sim(tmp_path, ids, f"sim{len(started)}")
+    def start(ids: str, *extra: str) -> Sim:
+        s = Sim(tmp_path, ids, f"sim{len(started)}", *extra)
         started.append(s)
         return s
 
@@ -153,6 +153,19 @@ def test_bus_errors(sims) -> None:
         bus.status(1)
 
 
+def test_bus_scan_skips_bad_replies(sims) -> None:
+    """Every reply corrupted: scan lists no id (as `j288 scan`), it does not raise."""
+    sim = sims("2,7", "--corrupt", "1")
+    with j288.Bus(sim.pty, margin_us=20000) as bus:
+        with pytest.raises(j288.J288Error) as e:
+            bus.status(2)
+        assert e.value.name == "J288_ERR_CRC"
+        assert bus.scan() == []
+        with pytest.raises(j288.J288Error) as e:
+            bus.scan([2, 15])
+        assert e.value.name == "J288_ERR_BAD_ID"
+
+
 # ---- Robot ----------------------------------------------------------------------------------
 
 def test_robot_two_buses(sims, tmp_path: Path) -> None:
@@ -190,8 +203,12 @@ def test_robot_two_buses(sims, tmp_path: Path) -> None:
         assert robot.stats()["cycles"] == before + 80
         robot.run(duration=0.25, rate_hz=200)  # ends by itself
         assert robot.stats()["cycles"] > before + 80
-        with pytest.raises(ValueError):
-            robot.run(cycles=-1)
+        for bad in ({"cycles": -1}, {"cycles": 2**32}, {"rate_hz": 1e-6}, {"duration": -1}):
+            with pytest.raises(ValueError):
+                robot.run(**bad)
+        for t in (-1.0, 0.0, 5000.0):
+            with pytest.raises(ValueError):
+                robot.cycle(timeout=t)
         stats = robot.stats()
         assert stats["cycles"] == stats["complete_cycles"] >= 22
         assert robot.bus_stats("leg1")["sweeps"] == stats["cycles"]
@@ -229,6 +246,37 @@ def test_robot_bad_config(sims, tmp_path: Path) -> None:
     with pytest.raises(j288.J288Error) as e:
         j288.Robot(str(tmp_path / "missing.yaml"))
     assert e.value.name == "J288_ERR_BAD_CONFIG"
+
+
+def test_robot_bus_stops_answering(sims, tmp_path: Path) -> None:
+    """A bus of four freezes: down after a few cycles, the others fresh in every cycle, and
+    back up once it answers again; the with block still stops every bus."""
+    s = [sims("1,2,3") for _ in range(4)]
+    cfg = write_config(tmp_path, [x.pty for x in s])
+    # the bus that will freeze with a short margin (as a USB adapter's): shorter waits
+    text = cfg.read_text().replace(f"port: {s[2].pty}\n    margin_us: {MARGIN}",
+                                   f"port: {s[2].pty}\n    margin_us: 20000")
+    assert "margin_us: 20000" in text
+    cfg.write_text(text)
+    with j288.Robot(str(cfg), down_after=1) as robot:
+        assert robot.cycle().complete
+        os.kill(s[2].proc.pid, signal.SIGSTOP)
+        try:
+            robot.cycle()  # one sweep without a reply: down (down_after=1)
+            stats = robot.bus_stats("leg2")
+            assert not stats["up"] and stats["down_events"] == 1 and not stats["gone"]
+            for _ in range(3):
+                c = robot.cycle()
+                assert (c.fresh, c.joints, c.complete) == (9, 12, False)
+                assert not robot.state("leg2_1").fresh and robot.state("leg3_1").fresh
+        finally:
+            os.kill(s[2].proc.pid, signal.SIGCONT)
+        for _ in range(200):
+            if robot.cycle().complete:
+                break
+        assert robot.bus_stats("leg2")["up"] and robot.cycle().complete
+    for x in s:
+        assert x.logged(" id=15 status=0 wd=1")
 
 
 def test_robot_bus_gone(sims, tmp_path: Path) -> None:

@@ -577,6 +577,28 @@ static void test_exchange_on_one_port(void)
     TEST_ASSERT_TRUE(j288_robot_sizeof() == sizeof(j288_robot_t));
 }
 
+/* A command whose reply never comes may still have reached the servo and moved it: close
+ * stops the bus all the same. (The simulator is frozen while the command goes out; resumed,
+ * it reads the command, then the stop.) */
+static void test_close_stops_after_an_unanswered_command(void)
+{
+    j288_robot_servo_t sv;
+    j288_robot_target_t foc = {0.0, 0.0, 0.0, 1.0, 0.0};
+    j288_robot_options_t o;
+    memset(&o, 0, sizeof o);
+    o.margin_us = 20000u;
+    sim_start(0, "2");
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_robot_open_port(&g_robot, g_sim[0].pty, &o));
+    TEST_ASSERT_EQUAL_INT(0, kill(g_sim[0].pid, SIGSTOP));
+    g_sim[0].stopped = true;
+    TEST_ASSERT_EQUAL_INT(J288_ERR_TIMEOUT, j288_robot_exchange(&g_robot, 0, 2, &foc, &sv));
+    TEST_ASSERT_EQUAL_INT(0, kill(g_sim[0].pid, SIGCONT));
+    g_sim[0].stopped = false;
+    TEST_ASSERT_TRUE(log_wait(0, " id=2 status=1 wd=1"));
+    j288_robot_close(&g_robot);
+    TEST_ASSERT_TRUE(log_wait(0, " id=15 status=0 wd=1"));
+}
+
 int main(void)
 {
     UNITY_BEGIN();
@@ -587,5 +609,6 @@ int main(void)
     RUN_TEST(test_stop_flag_stops_every_bus);
     RUN_TEST(test_stop_waits_for_a_long_margin);
     RUN_TEST(test_exchange_on_one_port);
+    RUN_TEST(test_close_stops_after_an_unanswered_command);
     return UNITY_END();
 }

@@ -51,6 +51,7 @@ typedef struct {
 } robot_args_t;
 
 typedef struct {
+    const j288_robot_t *robot;
     FILE *csv;
     uint32_t t0;
     unsigned joint_events, bus_events;
@@ -162,7 +163,8 @@ static void on_event(void *user, const j288_robot_event_t *ev)
         static const char *const what[] = {"", "", "stopped answering", "answers again",
                                            "is gone"};
         run->bus_events++;
-        fprintf(stderr, "j288: bus %u %s\n", ev->bus, what[ev->kind]);
+        fprintf(stderr, "j288: bus '%s' %s\n", j288_robot_bus_name(run->robot, ev->bus),
+                what[ev->kind]);
     } else if (ev->kind == J288_ROBOT_EV_JOINT) {
         run->joint_events++;
     }
@@ -367,6 +369,7 @@ int cli_cmd_robot(int argc, char **argv, const cli_global_t *g)
     if (parse_robot_args(argc, argv, g, &a, &exit_code) != 0)
         return exit_code;
     memset(&run, 0, sizeof run);
+    run.robot = &robot;
     memset(&o, 0, sizeof o);
     o.port = a.port != NULL ? a.port : getenv("J288_PORT");
     o.margin_us = a.margin_us;
