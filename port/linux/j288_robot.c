@@ -833,6 +833,24 @@ int j288_robot_set_targets(j288_robot_t *r, size_t n, const double *pos, const d
     return J288_OK;
 }
 
+/* The pose to hold a joint at pos: pos itself, or the nearest limit when pos is beyond it
+ * by at most J288_ROBOT_HOLD_BEYOND_MAX (farther, pos: the joint layer refuses it). */
+static j288_real_t hold_pose(const j288_joint_config_t *jc, j288_real_t pos)
+{
+    double lo = -J288_PI, hi = J288_PI, q = (double)pos;
+    if (jc->clamp)
+        return pos;
+    if (jc->pos_min != 0 || jc->pos_max != 0) {
+        lo = (double)jc->pos_min;
+        hi = (double)jc->pos_max;
+    }
+    if (q < lo && lo - q <= J288_ROBOT_HOLD_BEYOND_MAX)
+        return (j288_real_t)lo;
+    if (q > hi && q - hi <= J288_ROBOT_HOLD_BEYOND_MAX)
+        return (j288_real_t)hi;
+    return pos;
+}
+
 int j288_robot_hold(j288_robot_t *r, unsigned joint)
 {
     j288_joint_target_t jt;
@@ -845,6 +863,7 @@ int j288_robot_hold(j288_robot_t *r, unsigned joint)
     if (!j288_joint_state(&r->joint[joint])->known)
         return J288_ERR_ANGLE_UNKNOWN;
     j288_joint_target_init(&r->joint[joint], &jt);
+    jt.pos = hold_pose(&r->joint[joint].cfg, jt.pos);
     rc = j288_joint_bus_set_target(&r->bus[r->joint_bus[joint]].jb, &r->joint[joint], &jt, NULL);
     if (rc == J288_OK)
         r->driven = true;

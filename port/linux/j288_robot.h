@@ -290,8 +290,15 @@ int j288_robot_set_targets(j288_robot_t *r, size_t n, const double *pos, const d
                            const double *torque, const double *kp, const double *kd,
                            unsigned *bad);
 
-/* Hold the joint where it is (its configured gains), or put it at lock. Errors:
- * J288_ERR_NULL, J288_ERR_BAD_ARG; hold: J288_ERR_ANGLE_UNKNOWN. */
+/* How far beyond its soft limits a joint may be for j288_robot_hold() to hold it at the
+ * nearest limit (rad, joint frame): a joint zeroed against a hard stop reads a hair outside
+ * its range, and must still be holdable; the first command pulls it in by at most this. */
+#define J288_ROBOT_HOLD_BEYOND_MAX 0.05
+
+/* Hold the joint where it is (its configured gains), or put it at lock. A joint beyond its
+ * limits by at most J288_ROBOT_HOLD_BEYOND_MAX is held at the nearest limit. Errors:
+ * J288_ERR_NULL, J288_ERR_BAD_ARG; hold: J288_ERR_ANGLE_UNKNOWN, J288_ERR_LIMIT_POS (farther
+ * beyond its limits: nothing changes). */
 int j288_robot_hold(j288_robot_t *r, unsigned joint);
 int j288_robot_lock(j288_robot_t *r, unsigned joint);
 

@@ -51,8 +51,9 @@ static const char *sim_path(void)
     return (p != NULL && *p != '\0') ? p : J288_SIM_DEFAULT;
 }
 
-/* Start simulator k with servos ids (e.g. "1,2,3") and read its pty path. */
-static void sim_start(int k, const char *ids)
+/* Start simulator k with servos ids (e.g. "1,2,3") and the options in extra (NULL-terminated,
+ * or NULL), and read its pty path. */
+static void sim_start_with(int k, const char *ids, const char *const *extra)
 {
     sim_t *s = &g_sim[k];
     const char *argv[16];
@@ -68,6 +69,8 @@ static void sim_start(int k, const char *ids)
     argv[n++] = ids;
     argv[n++] = "--log";
     argv[n++] = s->log;
+    while (extra != NULL && *extra != NULL && n < 15)
+        argv[n++] = *extra++;
     argv[n] = NULL;
     TEST_ASSERT_EQUAL_INT(0, pipe(fds));
     s->pid = fork();
@@ -96,6 +99,11 @@ static void sim_start(int k, const char *ids)
     (void)close(fds[0]);
     if (strncmp(s->pty, "/dev/", 5) != 0)
         TEST_FAIL_MESSAGE("j288-sim did not print its pty path (is it built?)");
+}
+
+static void sim_start(int k, const char *ids)
+{
+    sim_start_with(k, ids, NULL);
 }
 
 static void sim_stop(int k)
@@ -599,6 +607,26 @@ static void test_close_stops_after_an_unanswered_command(void)
     TEST_ASSERT_TRUE(log_wait(0, " id=15 status=0 wd=1"));
 }
 
+/* A joint a hair beyond its limits (zeroed against a hard stop) is held at the nearest
+ * limit; one farther out is refused and keeps its lock. */
+static void test_hold_just_beyond_a_limit(void)
+{
+    static const char *const start[] = {"--start-angle", "1:0.48", "--start-angle", "2:0.3", NULL};
+    unsigned j;
+    sim_start_with(0, "1,2", start);
+    make_config(1, LOADED_MARGIN_US);
+    g_cfg.njoints = 2;
+    for (j = 0; j < 2; j++) {
+        g_cfg.joint[j].has_limits = true;
+        g_cfg.joint[j].pos_min = 0.5;
+        g_cfg.joint[j].pos_max = 1.0;
+    }
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_robot_open(&g_robot, &g_cfg, NULL));
+    cycle_until_known();
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_robot_hold(&g_robot, 0));
+    TEST_ASSERT_EQUAL_INT(J288_ERR_LIMIT_POS, j288_robot_hold(&g_robot, 1));
+}
+
 int main(void)
 {
     UNITY_BEGIN();
@@ -610,5 +638,6 @@ int main(void)
     RUN_TEST(test_stop_waits_for_a_long_margin);
     RUN_TEST(test_exchange_on_one_port);
     RUN_TEST(test_close_stops_after_an_unanswered_command);
+    RUN_TEST(test_hold_just_beyond_a_limit);
     return UNITY_END();
 }

@@ -18,6 +18,7 @@
 #include "args.h"
 #include "cli.h"
 #include "j288_linux.h"
+#include "j288_robot.h"
 #include "j288_robot_config.h"
 #include "json.h"
 
@@ -174,8 +175,9 @@ void cli_robot_fill_bus(const cli_robot_t *r, const j288_robot_config_joint_t *r
 void cli_joint_target_error(const j288_joint_t *j, const char *name, const char *what, int rc);
 
 /* How far beyond its limits a joint may be for hold and move to start: from the nearest
- * limit, so that the first command pulls it in by at most this (rad). */
-#define CLI_JOINT_START_OUTSIDE_MAX 0.05
+ * limit, so that the first command pulls it in by at most this (rad); the runner's hold
+ * allows the same. */
+#define CLI_JOINT_START_OUTSIDE_MAX J288_ROBOT_HOLD_BEYOND_MAX
 
 /* The joint-frame pose hold and move start from, given the joint's angle q: q inside the
  * limits (or a clamping joint), else the nearest limit when q is beyond it by at most
