@@ -195,6 +195,24 @@ static void test_real_refusals(void)
     }
 }
 
+static void test_real_in_range(void)
+{
+    double v = 0.0;
+    TEST_ASSERT_EQUAL_INT(0, cli_parse_real_in("--rate", "50", 50.0, 5000.0, &v));
+    TEST_ASSERT_EQUAL_DOUBLE(50.0, v);
+    TEST_ASSERT_EQUAL_INT(0, cli_parse_real_in("--rate", "5000", 50.0, 5000.0, &v));
+    assert_no_error();
+    TEST_ASSERT_EQUAL_INT(-1, cli_parse_real_in("--rate", "5000.1", 50.0, 5000.0, &v));
+    TEST_ASSERT_EQUAL_INT(-1, cli_parse_real_in("--rate", "nan", 50.0, 5000.0, &v));
+}
+
+static void test_real_in_range_message(void)
+{
+    double v = 0.0;
+    TEST_ASSERT_EQUAL_INT(-1, cli_parse_real_in("--rate", "49.9", 50.0, 5000.0, &v));
+    assert_one_error("j288 test: --rate: 49.9 is out of range 50..5000");
+}
+
 static void test_choice(void)
 {
     static const char *const modes[] = {"lock", "foc", NULL};
@@ -351,6 +369,8 @@ int main(void)
     RUN_TEST(test_int_overflow);
     RUN_TEST(test_real);
     RUN_TEST(test_real_refusals);
+    RUN_TEST(test_real_in_range);
+    RUN_TEST(test_real_in_range_message);
     RUN_TEST(test_choice);
     RUN_TEST(test_id_list);
     RUN_TEST(test_id_list_refusals);

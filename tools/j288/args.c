@@ -140,6 +140,18 @@ int cli_parse_real(const char *opt, const char *text, double *out)
     return 0;
 }
 
+int cli_parse_real_in(const char *opt, const char *text, double lo, double hi, double *out)
+{
+    if (cli_parse_real(opt, text, out) != 0) {
+        return -1;
+    }
+    if (*out < lo || *out > hi) {
+        cli_error("%s: %s is out of range %g..%g", opt, text, lo, hi);
+        return -1;
+    }
+    return 0;
+}
+
 int cli_parse_choice(const char *opt, const char *text, const char *const *choices, int *out)
 {
     int i;

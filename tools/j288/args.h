@@ -49,6 +49,9 @@ int cli_parse_int(const char *opt, const char *text, long long lo, long long hi,
 /* Finite real number (strtod syntax, no trailing characters). */
 int cli_parse_real(const char *opt, const char *text, double *out);
 
+/* Finite real number in [lo, hi] ("OPT: TEXT is out of range LO..HI" otherwise). */
+int cli_parse_real_in(const char *opt, const char *text, double lo, double hi, double *out);
+
 /* One of choices (NULL-terminated); *out is its index. */
 int cli_parse_choice(const char *opt, const char *text, const char *const *choices, int *out);
 

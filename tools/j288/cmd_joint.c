@@ -27,18 +27,6 @@ typedef struct {
 
 static cli_robot_t g_robot;
 
-static int parse_range(const char *opt, const char *v, double lo, double hi, double *out)
-{
-    if (cli_parse_real(opt, v, out) != 0) {
-        return -1;
-    }
-    if (*out < lo || *out > hi) {
-        cli_error("%s: %s is out of range %g..%g", opt, v, lo, hi);
-        return -1;
-    }
-    return 0;
-}
-
 static int parse_joint_opt(void *ctx, int key, const char *v)
 {
     joint_args_t *a = ctx;
@@ -49,17 +37,17 @@ static int parse_joint_opt(void *ctx, int key, const char *v)
         a->joint = v;
         return 0;
     case OPT_RANGE:
-        return parse_range("--range", v, 0.02, 1.0, &a->range);
+        return cli_parse_real_in("--range", v, 0.02, 1.0, &a->range);
     case OPT_SPEED:
-        return parse_range("--speed", v, 0.001, 1.0, &a->speed);
+        return cli_parse_real_in("--speed", v, 0.001, 1.0, &a->speed);
     case OPT_RATE:
-        return parse_range("--rate", v, 50.0, 5000.0, &a->rate_hz);
+        return cli_parse_real_in("--rate", v, 50.0, 5000.0, &a->rate_hz);
     case OPT_KP:
         a->have_kp = true;
-        return parse_range("--kp", v, 0.0, 2000.0, &a->kp);
+        return cli_parse_real_in("--kp", v, 0.0, 2000.0, &a->kp);
     case OPT_KD:
         a->have_kd = true;
-        return parse_range("--kd", v, 0.0, 20.0, &a->kd);
+        return cli_parse_real_in("--kd", v, 0.0, 20.0, &a->kd);
     default:
         return 1;
     }

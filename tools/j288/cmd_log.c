@@ -89,18 +89,6 @@ typedef struct {
     uint32_t latency_n, latency_max;
 } servo_acc_t;
 
-static int parse_positive(const char *opt, const char *v, double lo, double hi, double *out)
-{
-    if (cli_parse_real(opt, v, out) != 0) {
-        return -1;
-    }
-    if (*out < lo || *out > hi) {
-        cli_error("%s: %s is out of range %g..%g", opt, v, lo, hi);
-        return -1;
-    }
-    return 0;
-}
-
 static int parse_log_opt(log_args_t *a, int key, const char *v)
 {
     static const char *const sides[] = {"rotor", "output", "joint", NULL};
@@ -110,9 +98,9 @@ static int parse_log_opt(log_args_t *a, int key, const char *v)
     case OPT_IDS:
         return cli_parse_id_list("--id", v, J288_MAX_ID, &a->ids);
     case OPT_RATE:
-        return parse_positive("--rate", v, 1.0, 5000.0, &a->rate_hz);
+        return cli_parse_real_in("--rate", v, 1.0, 5000.0, &a->rate_hz);
     case OPT_DURATION:
-        return parse_positive("--duration", v, 0.001, 86400.0, &a->duration_s);
+        return cli_parse_real_in("--duration", v, 0.001, 86400.0, &a->duration_s);
     case OPT_CSV:
         a->csv = v;
         return 0;
@@ -132,7 +120,7 @@ static int parse_log_opt(log_args_t *a, int key, const char *v)
         return cli_parse_real("--swing", v, &a->amp);
     case OPT_PERIOD:
         a->have_period = true;
-        return parse_positive("--period", v, 0.01, 86400.0, &a->period_s);
+        return cli_parse_real_in("--period", v, 0.01, 86400.0, &a->period_s);
     case OPT_KP:
         a->have_kp = true;
         return cli_parse_real("--kp", v, &a->kp);

@@ -77,17 +77,6 @@ bool cli_robot_takes(const char *command, int argc, char **argv, const cli_globa
     return config && !named;
 }
 
-static int parse_real_in(const char *opt, const char *v, double lo, double hi, double *out)
-{
-    if (cli_parse_real(opt, v, out) != 0)
-        return -1;
-    if (*out < lo || *out > hi) {
-        cli_error("%s: %s is out of range %g..%g", opt, v, lo, hi);
-        return -1;
-    }
-    return 0;
-}
-
 static int parse_robot_args(int argc, char **argv, const cli_global_t *g, robot_args_t *a,
                             int *exit_code)
 {
@@ -126,10 +115,10 @@ static int parse_robot_args(int argc, char **argv, const cli_global_t *g, robot_
             a->margin_us = (uint32_t)n;
             break;
         case OPT_RATE:
-            rc = parse_real_in("--rate", v, 0.0, 100000.0, &a->rate_hz);
+            rc = cli_parse_real_in("--rate", v, 0.0, 100000.0, &a->rate_hz);
             break;
         case OPT_DURATION:
-            rc = parse_real_in("--duration", v, 0.001, 86400.0, &a->duration_s);
+            rc = cli_parse_real_in("--duration", v, 0.001, 86400.0, &a->duration_s);
             a->have_duration = true;
             break;
         case OPT_CSV:
