@@ -19,7 +19,7 @@ import ctypes.util
 import os
 from ctypes import (POINTER, Structure, c_bool, c_char_p, c_double, c_int, c_size_t, c_uint,
                     c_uint8, c_uint32, c_void_p)
-from typing import Optional
+from typing import Optional, TypeVar
 
 MAX_SERVOS = 15
 BROADCAST_ID = 15
@@ -176,3 +176,53 @@ def error_text(robot: Optional[ctypes.Array]) -> str:
     if robot is None:
         return ""
     return LIB.j288_robot_error(robot).decode(errors="replace")
+
+
+_H = TypeVar("_H", bound="Handle")
+
+
+class Handle:
+    """What Bus and Robot share: one open j288_robot_t, stopped and closed once.
+
+    Used as a context manager, the servos get the broadcast lock on exit (an exception or
+    Ctrl-C included), then the handle closes; close() alone sends it only if something that
+    moves a servo went out since the last stop.
+    """
+
+    _r: Optional[ctypes.Array] = None
+    _kind = "handle"  # "bus" or "robot", for the closed-handle message
+
+    def _open(self, rc: int, where: str) -> None:
+        """Keep the handle if rc (of the open call on self._r) is 0, else raise."""
+        if rc != 0:
+            from .errors import error_for  # errors imports nothing of this module
+            detail = error_text(self._r)
+            self._r = None
+            raise error_for(rc, detail, where)
+
+    def _robot(self) -> ctypes.Array:
+        if self._r is None:
+            raise ValueError(f"the {self._kind} is closed")
+        return self._r
+
+    def close(self) -> None:
+        """Stop (if a command went out since the last stop) and close. Safe twice."""
+        if self._r is not None:
+            LIB.j288_robot_close(self._r)
+            self._r = None
+
+    def __enter__(self: _H) -> _H:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        try:
+            if self._r is not None:
+                LIB.j288_robot_stop(self._r)
+        finally:
+            self.close()
+
+    def __del__(self) -> None:
+        try:
+            self.close()
+        except Exception:  # interpreter shutdown: the library may be gone already
+            pass

@@ -44,7 +44,7 @@ class ServoStatus:
                            bool(r.watchdog_tripped), r.latency_us)
 
 
-class Bus:
+class Bus(_native.Handle):
     """A servo bus on a serial device (a USB adapter, or j288-sim's pseudo-terminal).
 
     Every frame of the protocol commands the servo: scan and status send lock (no torque) to
@@ -66,20 +66,14 @@ class Bus:
             by another program, or is not a serial device.
     """
 
+    _kind = "bus"
+
     def __init__(self, port: str, baud: int = 0, margin_us: int = 0) -> None:
         self._r: Optional[ctypes.Array] = _native.new_robot()
         opt = _native.Options(port=None, baud=baud, margin_us=margin_us)
         rc = LIB.j288_robot_open_port(self._r, port.encode(), ctypes.byref(opt))
-        if rc != 0:
-            detail = _native.error_text(self._r)
-            self._r = None
-            raise error_for(rc, detail, port)
+        self._open(rc, port)
         self.port = port
-
-    def _robot(self) -> ctypes.Array:
-        if self._r is None:
-            raise ValueError("the bus is closed")
-        return self._r
 
     def _exchange(self, servo_id: int, target: Optional[Target]) -> ServoStatus:
         reply = ServoReply()
@@ -126,24 +120,3 @@ class Bus:
         if rc != 0:
             raise error_for(rc, _native.error_text(self._r), self.port)
 
-    def close(self) -> None:
-        """Stop (if a command went out since the last stop) and close. Safe twice."""
-        if self._r is not None:
-            LIB.j288_robot_close(self._r)
-            self._r = None
-
-    def __enter__(self) -> "Bus":
-        return self
-
-    def __exit__(self, *exc: object) -> None:
-        try:
-            if self._r is not None:
-                LIB.j288_robot_stop(self._r)
-        finally:
-            self.close()
-
-    def __del__(self) -> None:
-        try:
-            self.close()
-        except Exception:  # interpreter shutdown: the library may be gone already
-            pass

@@ -67,7 +67,7 @@ def _doubles(values: Optional[Vector], n: int) -> Tuple[Any, Any]:
     return buf, ctypes.cast(buf, ctypes.POINTER(c_double))
 
 
-class Robot:
+class Robot(_native.Handle):
     """Every bus and joint of a robot config file (YAML: buses, joints with name, bus, id,
     direction, zero, limits, gains; see port/linux/j288_robot_config.h).
 
@@ -99,6 +99,8 @@ class Robot:
             device that cannot be opened (OfflineError), ...
     """
 
+    _kind = "robot"
+
     def __init__(self, config: str, port: Optional[str] = None, margin_us: int = 0,
                  down_after: int = 0) -> None:
         if not 0 <= down_after <= 255:
@@ -107,10 +109,7 @@ class Robot:
         opt = _native.Options(port=port.encode() if port else None, margin_us=margin_us,
                               down_after=down_after)
         rc = LIB.j288_robot_open_file(self._r, config.encode(), ctypes.byref(opt))
-        if rc != 0:
-            detail = _native.error_text(self._r)
-            self._r = None
-            raise error_for(rc, detail, config)
+        self._open(rc, config)
         r = self._r
         self.joints: List[str] = [LIB.j288_robot_joint_name(r, j).decode()
                                   for j in range(LIB.j288_robot_njoints(r))]
@@ -123,11 +122,6 @@ class Robot:
         self._known = (c_uint8 * self._n)()
 
     # ---- plumbing
-    def _robot(self) -> ctypes.Array:
-        if self._r is None:
-            raise ValueError("the robot is closed")
-        return self._r
-
     def _check(self, rc: int, what: str = "") -> None:
         if rc != 0:
             raise error_for(rc, _native.error_text(self._r), what)
@@ -270,29 +264,6 @@ class Robot:
         out = {"fresh_cycles": s.fresh_cycles, "stale_cycles": s.stale_cycles}
         out.update({f: getattr(s.servo, f) for f, _ in s.servo._fields_})
         return out
-
-    # ---- lifetime
-    def close(self) -> None:
-        """Stop (if targets went out since the last stop) and close every bus. Safe twice."""
-        if self._r is not None:
-            LIB.j288_robot_close(self._r)
-            self._r = None
-
-    def __enter__(self) -> "Robot":
-        return self
-
-    def __exit__(self, *exc: object) -> None:
-        try:
-            if self._r is not None:
-                LIB.j288_robot_stop(self._r)
-        finally:
-            self.close()
-
-    def __del__(self) -> None:
-        try:
-            self.close()
-        except Exception:  # interpreter shutdown: the library may be gone already
-            pass
 
 
 __all__ = ["Robot", "Cycle", "State", "J288Error"]
