@@ -35,7 +35,9 @@
  * - the same input with every byte handed to on_rx on its own (so that the parser never sees a
  *   whole frame at once and, with advance_in_isr, the bus takes each byte as it comes) gives
  *   the same callbacks (id, result, each attempt's result, reply, times) and the same bus and
- *   parser statistics: the whole-frame fast paths and the byte paths agree. With the bus
+ *   parser statistics: the whole-frame fast paths and the byte paths agree; the byte-by-byte
+ *   run submits each valid command as a frame encoded beforehand (the scheduler's way in,
+ *   sent from where it lies), so that way is compared with j288_bus_submit() too. With the bus
  *   advanced in the event calls this is not compared after an estop, or when bytes came
  *   while a deadline or guard end had passed unseen (no arm_timeout): the machine then
  *   changes state in the middle of a delivery for a reason other than its bytes (the first
@@ -48,6 +50,8 @@
 
 #include "j288/bus.h"
 #include "j288/frame.h"
+
+#include "../../lib/src/internal.h" /* j288_bus_submit_frame() */
 
 #include <string.h>
 
@@ -199,6 +203,8 @@ static void check_stats_add_up(unsigned calling_back)
     FUZZ_CHECK(st->transactions == st->ok + st->failed + st->aborted + pending);
 }
 
+static uint8_t frames[2][J288_CMD_LEN]; /* frames submitted ready-made (bytewise run) */
+
 static void try_submit(uint8_t id, bool valid_fields)
 {
     j288_cmd_raw_t c;
@@ -214,7 +220,16 @@ static void try_submit(uint8_t id, bool valid_fields)
     w.fifo_id[w.fifo_n] = id;
     w.fifo_pre_estop[w.fifo_n] = false;
     w.fifo_n++;
-    rc = j288_bus_submit(&bus, &c, w.now, on_done, &w);
+    if (bytewise && valid_fields && (id <= 15u)) {
+        /* The scheduler's way in, compared with j288_bus_submit() of the other run: a frame
+         * encoded beforehand, sent from where it lies. Two buffers: the frame of the
+         * transaction still under way (the bus's) is left alone when this one is refused. */
+        uint8_t *f = (bus.tx_frame == frames[0]) ? frames[1] : frames[0];
+        FUZZ_CHECK(j288_cmd_encode(&c, f, NULL) == J288_OK);
+        rc = j288_bus_submit_frame(&bus, f, id, w.now, on_done, &w);
+    } else {
+        rc = j288_bus_submit(&bus, &c, w.now, on_done, &w);
+    }
     FUZZ_CHECK(rc == J288_OK || rc == J288_ERR_BUSY || rc == J288_ERR_BAD_ID ||
                rc == J288_ERR_BAD_STATUS);
     if (id > 15u) {
