@@ -86,7 +86,11 @@ $(OBJ)/test/linux/%.o: test/linux/%.c port/linux/j288_linux.h $(TEST_HDR) $(UNIT
 	@mkdir -p $(@D)
 	$(CC) $(TEST_CPPFLAGS) -Iport/linux -DJ288_SIM_DEFAULT='"$(SIM_BIN)"' $(CFLAGS_COMMON) -c $< -o $@
 
-$(LINUX_PORT_TEST): $(OBJ)/test/linux/test_linux_port.o $(UNITY_OBJ) $(LINUX_A) $(LIB_A)
+# j288-sim as a child process, for the tests that drive it (test/linux/sim_process.c).
+SIM_PROCESS_OBJ := $(OBJ)/test/linux/sim_process.o
+$(SIM_PROCESS_OBJ) $(OBJ)/test/linux/test_linux_port.o $(OBJ)/test/linux/test_robot.o: test/linux/sim_process.h
+
+$(LINUX_PORT_TEST): $(OBJ)/test/linux/test_linux_port.o $(SIM_PROCESS_OBJ) $(UNITY_OBJ) $(LINUX_A) $(LIB_A)
 	@mkdir -p $(@D)
 	$(CC) $(CFLAGS_COMMON) $^ -o $@ $(LDFLAGS_COMMON) -lm
 
