@@ -27,8 +27,7 @@ stop_sim() {
 # wait_exit PID [SECONDS]: wait up to SECONDS (default 30) for PID to exit, returning as soon
 # as it does; its exit status, or 124 on time-out.
 wait_exit() {
-    local i
-    for i in $(seq 1 $((${2:-30} * 20))); do
+    for _ in $(seq 1 $((${2:-30} * 20))); do
         if ! kill -0 "$1" 2>/dev/null; then wait "$1"; return $?; fi
         sleep 0.05
     done
@@ -39,13 +38,13 @@ wait_exit() {
 # $SIM_DIR/NAME.pty, logging received commands to $SIM_DIR/NAME.log; sets SIM_PID and DEV.
 # Fails, saying why, when it has not started within 30 s (a loaded machine, or valgrind).
 sim_start_linked() {
-    local name=$1 i; shift
+    local name=$1; shift
     DEV=$SIM_DIR/$name.pty
     "${SIM_WRAP[@]}" "$SIM" --link "$DEV" --log "$SIM_DIR/$name.log" "$@" \
         >"$SIM_DIR/$name.out" 2>"$SIM_DIR/$name.err" &
     SIM_PID=$!
     SIM_PIDS+=("$SIM_PID")
-    for i in $(seq 1 600); do
+    for _ in $(seq 1 600); do
         [ -L "$DEV" ] && [ -s "$SIM_DIR/$name.out" ] && return 0
         sleep 0.05
     done
@@ -57,14 +56,14 @@ sim_start_linked() {
 # $SIM_DIR/pty.K, its pid in SIM_PID_K; "{k}" in an option stands for K (--log "$d/log.{k}").
 # Waits (up to 30 s each) for the path lines.
 start_sims() {
-    local n=$1 k i; shift
+    local n=$1 k; shift
     for k in $(seq 0 $((n - 1))); do
         "$SIM" --ids 1,2,3 --quiet "${@//\{k\}/$k}" >"$SIM_DIR/pty.$k" 2>/dev/null &
         SIM_PIDS+=($!)
         eval "SIM_PID_$k=$!"
     done
     for k in $(seq 0 $((n - 1))); do
-        for i in $(seq 1 600); do [ -s "$SIM_DIR/pty.$k" ] && break; sleep 0.05; done
+        for _ in $(seq 1 600); do [ -s "$SIM_DIR/pty.$k" ] && break; sleep 0.05; done
     done
 }
 
