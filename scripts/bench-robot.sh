@@ -15,11 +15,7 @@ PYTHON=${PYTHON:-python3}
 tmp=$(mktemp -d)
 SIM_DIR=$tmp
 . test/e2e/lib_sim.sh
-cleanup() {
-    stop_pids TERM "${SIM_PIDS[@]}"
-    rm -rf "$tmp"
-}
-trap cleanup EXIT
+trap 'sim_cleanup TERM' EXIT
 for f in "$BIN/j288" "$SIM"; do
     [ -x "$f" ] || { echo "bench-robot: $f missing (make first)" >&2; exit 1; }
 done

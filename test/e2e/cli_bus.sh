@@ -18,23 +18,15 @@ e2e_need_python
 SIM_DIR=$E2E_TMP
 . test/e2e/lib_sim.sh
 SIM_WRAP=(timeout -k 2 120)
-BG_PIDS=()
 BIG_MARGIN=250000
 M=(--margin-us "$BIG_MARGIN")
 # Where absent ids are asked too (scan: 12 ids, 4 tries each; log's probe sweeps), each
 # miss costs a margin: 50 ms, still ten times what a busy machine stalls a pty exchange.
 M50=(--margin-us 50000)
 
-cleanup() {
-    stop_pids TERM "${BG_PIDS[@]}" "${SIM_PIDS[@]}"
-    e2e_cleanup_tmp
-}
-trap cleanup EXIT
+trap 'sim_cleanup TERM' EXIT
 trap 'exit 130' INT TERM
-
-for f in "$J288" "$SIM"; do
-    [ -x "$f" ] || { echo "$f not built"; exit 1; }
-done
+need_built "$J288" "$SIM"
 
 # start_sim NAME [sim options...]: a quiet simulator serving on $E2E_TMP/NAME.pty, logging
 # received commands to $E2E_TMP/NAME.log; sets SIM_PID and DEV.

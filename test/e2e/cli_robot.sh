@@ -12,11 +12,7 @@ cd "$(dirname "$0")/../.."
 . test/e2e/lib_e2e.sh
 SIM_DIR=$E2E_TMP
 . test/e2e/lib_sim.sh
-cleanup() {
-    stop_pids KILL "${SIM_PIDS[@]}"
-    e2e_cleanup_tmp
-}
-trap cleanup EXIT
+trap 'sim_cleanup KILL' EXIT
 
 # logged FILE NEEDLE: wait (bounded, 20 s) until the simulator has logged it
 logged() {

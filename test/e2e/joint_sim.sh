@@ -22,15 +22,9 @@ SEEDS=${J288_JOINT_SEEDS:-"11 12 13"}
 M=(--margin-us 250000 --retries 1)
 E2E_CMD_TIMEOUT=60
 
-cleanup() {
-    stop_pids TERM "${SIM_PIDS[@]}"
-    e2e_cleanup_tmp
-}
-trap cleanup EXIT
+trap 'sim_cleanup TERM' EXIT
 trap 'exit 130' INT TERM
-for f in "$J288" "$SIM"; do
-    [ -x "$f" ] || { echo "$f not built"; exit 1; }
-done
+need_built "$J288" "$SIM"
 
 # start_sim NAME [sim options...]: a simulator on $E2E_TMP/NAME.pty, logging frames to
 # NAME.log and its truth to NAME.truth; sets SIM_PID, DEV, TRUTH and SLOG. No SIM_WRAP (no

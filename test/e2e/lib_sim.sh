@@ -1,5 +1,5 @@
 # Helpers for the scripts that drive j288-sim (sourced, not run): start simulators (each
-# remembered in SIM_PIDS), stop them, wait for a process to end, and write a robot config
+# remembered in SIM_PIDS), stop them and clean up, wait for a process to end, and write a robot config
 # over several simulators. The script sets BIN (where the binaries are) and SIM_DIR (a scratch
 # folder) before sourcing; J288_SIM may name another simulator binary (make test-valgrind
 # points it at test/e2e/valgrind-wrap.sh). Every wait polls and is bounded.
@@ -7,6 +7,7 @@
 
 SIM=${J288_SIM:-$BIN/j288-sim}
 SIM_PIDS=()
+BG_PIDS=() # other processes the script starts in the background, stopped with the simulators
 SIM_WRAP=() # a command prefix for sim_start_linked's simulators (e.g. timeout ...); none by default
 
 # stop_pids SIGNAL PID...: send SIGNAL to every PID, then reap them all. Always succeeds (an
@@ -15,6 +16,21 @@ stop_pids() {
     local sig=$1 p; shift
     for p in "$@"; do kill -s "$sig" "$p" 2>/dev/null || true; done
     for p in "$@"; do wait "$p" 2>/dev/null || true; done
+}
+
+# sim_cleanup SIGNAL: for the script's EXIT trap: SIGNAL to every process in BG_PIDS and
+# SIM_PIDS, all reaped, and SIM_DIR removed.
+sim_cleanup() {
+    stop_pids "$1" "${BG_PIDS[@]}" "${SIM_PIDS[@]}"
+    rm -rf "$SIM_DIR"
+}
+
+# need_built FILE...: exit 1, naming it, when a FILE is not an executable (not built yet).
+need_built() {
+    local f
+    for f in "$@"; do
+        [ -x "$f" ] || { echo "$f not built"; exit 1; }
+    done
 }
 
 # stop_sim [PID]: SIGTERM to PID (default: the last simulator started) and its exit status.

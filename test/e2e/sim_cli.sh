@@ -13,11 +13,7 @@ cd "$(dirname "$0")/../.."
 . test/e2e/lib_e2e.sh
 SIM_DIR=$E2E_TMP
 . test/e2e/lib_sim.sh
-cleanup() {
-    stop_pids KILL "${SIM_PIDS[@]}"
-    e2e_cleanup_tmp
-}
-trap cleanup EXIT
+trap 'sim_cleanup KILL' EXIT
 
 # Start the simulator in the background; sets SIM_PID, SIM_PTY (waits for the path line).
 start_sim() {
