@@ -14,7 +14,7 @@ $(OBJ)/test/linux/test_robot.o: test/linux/test_robot.c $(ROBOT_HDR) $(TEST_HDR)
 	@mkdir -p $(@D)
 	$(CC) $(TEST_CPPFLAGS) -Iport/linux -DJ288_SIM_DEFAULT='"$(SIM_BIN)"' $(CFLAGS_COMMON) -c $< -o $@
 
-$(ROBOT_TEST): $(OBJ)/test/linux/test_robot.o $(ROBOT_OBJ) $(CONFIG_OBJ) $(UNITY_OBJ) $(LINUX_A) $(LIB_A) \
+$(ROBOT_TEST): $(OBJ)/test/linux/test_robot.o $(SIM_PROCESS_OBJ) $(ROBOT_OBJ) $(CONFIG_OBJ) $(UNITY_OBJ) $(LINUX_A) $(LIB_A) \
     $(YAML_ENV)
 	@mkdir -p $(@D)
 	$(CC) $(CFLAGS_COMMON) $(filter-out $(YAML_ENV),$^) -o $@ $(LDFLAGS_COMMON) $(call yaml_var,YAML_LIBS) -lm

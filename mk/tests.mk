@@ -16,7 +16,11 @@ $(OBJ)/test/cli/%.o: test/cli/%.c $(J288_HDR) $(TEST_HDR) $(UNITY)/unity.c
 	@mkdir -p $(@D)
 	$(CC) $(TEST_CPPFLAGS) -Itools/j288 $(TOOL_CPPFLAGS) $(CFLAGS_COMMON) -c $< -o $@
 
-$(CLI_TEST): $(OBJ)/test/cli/test_cli_helpers.o \
+# The captured error stream both tool tests check (test/cli/cli_capture.c).
+CLI_CAPTURE_OBJ := $(OBJ)/test/cli/cli_capture.o
+$(CLI_CAPTURE_OBJ) $(OBJ)/test/cli/test_cli_helpers.o $(OBJ)/test/cli/test_cli_joint.o: test/cli/cli_capture.h
+
+$(CLI_TEST): $(OBJ)/test/cli/test_cli_helpers.o $(CLI_CAPTURE_OBJ) \
     $(addprefix $(OBJ)/tools/j288/,args.o hexparse.o json.o frameview.o report.o) $(UNITY_OBJ) $(LIB_A)
 	@mkdir -p $(@D)
 	$(CC) $(CFLAGS_COMMON) $^ -o $@ $(LDFLAGS_COMMON) -lm
@@ -28,7 +32,7 @@ $(OBJ)/test/cli/test_cli_joint.o: test/cli/test_cli_joint.c $(J288_HDR) $(TEST_H
 	@mkdir -p $(@D)
 	$(CC) $(TEST_CPPFLAGS) -Itools/j288 $(TOOL_CPPFLAGS) $(call yaml_var,YAML_CFLAGS) $(CFLAGS_COMMON) -c $< -o $@
 
-$(CLI_JOINT_TEST): $(OBJ)/test/cli/test_cli_joint.o \
+$(CLI_JOINT_TEST): $(OBJ)/test/cli/test_cli_joint.o $(CLI_CAPTURE_OBJ) \
     $(addprefix $(OBJ)/tools/j288/,cli_joint.o cli_bus.o args.o json.o report.o) $(CONFIG_OBJ) \
     $(UNITY_OBJ) $(LINUX_A) $(LIB_A)
 	@mkdir -p $(@D)
@@ -82,7 +86,11 @@ $(OBJ)/test/linux/%.o: test/linux/%.c port/linux/j288_linux.h $(TEST_HDR) $(UNIT
 	@mkdir -p $(@D)
 	$(CC) $(TEST_CPPFLAGS) -Iport/linux -DJ288_SIM_DEFAULT='"$(SIM_BIN)"' $(CFLAGS_COMMON) -c $< -o $@
 
-$(LINUX_PORT_TEST): $(OBJ)/test/linux/test_linux_port.o $(UNITY_OBJ) $(LINUX_A) $(LIB_A)
+# j288-sim as a child process, for the tests that drive it (test/linux/sim_process.c).
+SIM_PROCESS_OBJ := $(OBJ)/test/linux/sim_process.o
+$(SIM_PROCESS_OBJ) $(OBJ)/test/linux/test_linux_port.o $(OBJ)/test/linux/test_robot.o: test/linux/sim_process.h
+
+$(LINUX_PORT_TEST): $(OBJ)/test/linux/test_linux_port.o $(SIM_PROCESS_OBJ) $(UNITY_OBJ) $(LINUX_A) $(LIB_A)
 	@mkdir -p $(@D)
 	$(CC) $(CFLAGS_COMMON) $^ -o $@ $(LDFLAGS_COMMON) -lm
 

@@ -13,47 +13,21 @@ BIN=$BUILD/bin
 DURATION=${DURATION:-3}
 PYTHON=${PYTHON:-python3}
 tmp=$(mktemp -d)
-pids=()
-cleanup() {
-    for p in "${pids[@]}"; do kill -TERM "$p" 2>/dev/null || true; wait "$p" 2>/dev/null || true; done
-    rm -rf "$tmp"
-}
-trap cleanup EXIT
-for f in "$BIN/j288" "$BIN/j288-sim"; do
+SIM_DIR=$tmp
+. test/e2e/lib_sim.sh
+trap 'sim_cleanup TERM' EXIT
+for f in "$BIN/j288" "$SIM"; do
     [ -x "$f" ] || { echo "bench-robot: $f missing (make first)" >&2; exit 1; }
 done
 
-# start_sims N: N simulators with servos 1, 2, 3; their ptys in $tmp/pty.K
-start_sims() {
-    local k
-    for k in $(seq 0 $(($1 - 1))); do
-        "$BIN/j288-sim" --ids 1,2,3 --quiet --exit-after 300 >"$tmp/pty.$k" 2>/dev/null &
-        pids+=($!)
-    done
-    for k in $(seq 0 $(($1 - 1))); do
-        for _ in $(seq 1 200); do [ -s "$tmp/pty.$k" ] && break; sleep 0.05; done
-    done
-}
-# config N FILE: N buses of the first N simulators, joints <bus>_1..3
-config() {
-    local k j
-    { echo "buses:"
-      for k in $(seq 0 $(($1 - 1))); do
-          echo "  - {name: leg$k, port: $(head -n1 "$tmp/pty.$k"), margin_us: 5000}"
-      done
-      echo "joints:"
-      for k in $(seq 0 $(($1 - 1))); do
-          for j in 1 2 3; do echo "  - {name: leg${k}_$j, bus: leg$k, id: $j, kp: 5, kd: 0.1}"; done
-      done; } >"$2"
-}
 rate() { # config file -> cycles/s (JSON field)
     "$BIN/j288" --config "$1" log --rate 0 --duration "$DURATION" --json |
         sed -n 's/.*"cycles_per_s": *\([0-9.]*\).*/\1/p'
 }
 
-start_sims 4
-config 1 "$tmp/one.yaml"
-config 4 "$tmp/four.yaml"
+start_sims 4 --exit-after 300
+robot_config 1 "$tmp/one.yaml" 5000 5 0.1
+robot_config 4 "$tmp/four.yaml" 5000 5 0.1
 one=$(rate "$tmp/one.yaml")
 four=$(rate "$tmp/four.yaml")
 # The wire: a 20-byte command and a 26-byte reply at 6 Mbit/s, 10 bits a byte (76.7 us), and

@@ -60,15 +60,23 @@ static void emit_bus(j288_robot_t *r, j288_robot_event_kind_t kind, unsigned bus
 
 /* ---- scheduler and joint hooks (called from inside j288_sched_poll) -------------------------- */
 
+/* An event about servo id on bus b, with the joint that servo drives (-1: none). */
+static j288_robot_event_t servo_on_bus(const j288_robot_bus_t *b, j288_robot_event_kind_t kind,
+                                       uint8_t id)
+{
+    j288_robot_event_t ev;
+    memset(&ev, 0, sizeof ev);
+    ev.kind = kind;
+    ev.bus = b->index;
+    ev.id = id;
+    ev.joint = (id < J288_MAX_SERVOS) ? b->joint_of[id] : -1;
+    return ev;
+}
+
 static void on_servo_event(void *user, const j288_event_t *sev)
 {
     j288_robot_bus_t *b = user;
-    j288_robot_event_t ev;
-    memset(&ev, 0, sizeof ev);
-    ev.kind = J288_ROBOT_EV_SERVO;
-    ev.bus = b->index;
-    ev.id = sev->id;
-    ev.joint = (sev->id < J288_MAX_SERVOS) ? b->joint_of[sev->id] : -1;
+    j288_robot_event_t ev = servo_on_bus(b, J288_ROBOT_EV_SERVO, sev->id);
     ev.servo_ev = *sev;
     emit(b->robot, &ev);
 }
@@ -76,12 +84,7 @@ static void on_servo_event(void *user, const j288_event_t *sev)
 static void on_joint_event(void *user, const j288_joint_event_t *jev)
 {
     j288_robot_bus_t *b = user;
-    j288_robot_event_t ev;
-    memset(&ev, 0, sizeof ev);
-    ev.kind = J288_ROBOT_EV_JOINT;
-    ev.bus = b->index;
-    ev.id = jev->id;
-    ev.joint = (jev->id < J288_MAX_SERVOS) ? b->joint_of[jev->id] : -1;
+    j288_robot_event_t ev = servo_on_bus(b, J288_ROBOT_EV_JOINT, jev->id);
     ev.joint_kind = jev->kind;
     ev.value = (double)jev->value;
     emit(b->robot, &ev);

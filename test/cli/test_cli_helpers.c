@@ -9,55 +9,21 @@
 
 #include "args.h"
 #include "cli.h"
+#include "cli_capture.h"
 #include "frameview.h"
 #include "hexparse.h"
 #include "json.h"
 
 static FILE *err;
 
-void setUp(void)
-{
-    err = tmpfile();
-    cli_set_error_stream(err);
-    cli_set_command("test");
-}
+void setUp(void) { err = cli_capture_begin(); }
 
-void tearDown(void)
-{
-    cli_set_error_stream(NULL);
-    fclose(err);
-}
-
-/* Lines written to the error stream since setUp, and the first of them in line. */
-static int error_lines(char *line, size_t len)
-{
-    int n = 0, c;
-    size_t i = 0;
-    fflush(err);
-    rewind(err);
-    line[0] = '\0';
-    while ((c = fgetc(err)) != EOF) {
-        if (c == '\n') {
-            n++;
-        } else if (n == 0 && i + 1u < len) {
-            line[i++] = (char)c;
-            line[i] = '\0';
-        }
-    }
-    return n;
-}
-
-static void assert_one_error(const char *needle)
-{
-    char line[256];
-    TEST_ASSERT_EQUAL_INT(1, error_lines(line, sizeof line));
-    TEST_ASSERT_NOT_NULL_MESSAGE(strstr(line, needle), line);
-}
+void tearDown(void) { cli_capture_end(); }
 
 static void assert_no_error(void)
 {
     char line[256];
-    TEST_ASSERT_EQUAL_INT_MESSAGE(0, error_lines(line, sizeof line), line);
+    TEST_ASSERT_EQUAL_INT_MESSAGE(0, cli_error_lines(line, sizeof line), line);
 }
 
 /* ---- hex ------------------------------------------------------------------------------------- */
@@ -161,7 +127,7 @@ static void test_int_range_message(void)
 {
     long long v = 42;
     TEST_ASSERT_EQUAL_INT(-1, cli_parse_int("--id", "16", 0, 15, &v));
-    assert_one_error("j288 test: --id: 16 is out of range 0..15");
+    cli_expect_one_error("j288 test: --id: 16 is out of range 0..15");
     TEST_ASSERT_EQUAL_INT64(42, v);
 }
 
@@ -170,7 +136,7 @@ static void test_int_overflow(void)
     long long v = 42;
     TEST_ASSERT_EQUAL_INT(
         -1, cli_parse_int("--pos-raw", "99999999999999999999", INT32_MIN, INT32_MAX, &v));
-    assert_one_error("out of range");
+    cli_expect_one_error("out of range");
 }
 
 static void test_real(void)
@@ -210,7 +176,7 @@ static void test_real_in_range_message(void)
 {
     double v = 0.0;
     TEST_ASSERT_EQUAL_INT(-1, cli_parse_real_in("--rate", "49.9", 50.0, 5000.0, &v));
-    assert_one_error("j288 test: --rate: 49.9 is out of range 50..5000");
+    cli_expect_one_error("j288 test: --rate: 49.9 is out of range 50..5000");
 }
 
 static void test_choice(void)
@@ -220,7 +186,7 @@ static void test_choice(void)
     TEST_ASSERT_EQUAL_INT(0, cli_parse_choice("--mode", "foc", modes, &c));
     TEST_ASSERT_EQUAL_INT(1, c);
     TEST_ASSERT_EQUAL_INT(-1, cli_parse_choice("--mode", "FOC", modes, &c));
-    assert_one_error("--mode: 'FOC' is not lock or foc");
+    cli_expect_one_error("--mode: 'FOC' is not lock or foc");
 }
 
 static void test_id_list(void)
@@ -279,7 +245,7 @@ static void test_args_errors(void)
     const char *v;
     cli_args_init(&a, 2, missing);
     TEST_ASSERT_EQUAL_INT(CLI_ARG_ERROR, cli_args_next(&a, opts, &v));
-    assert_one_error("option --id needs a value");
+    cli_expect_one_error("option --id needs a value");
     rewind(err);
     cli_args_init(&a, 2, unknown);
     TEST_ASSERT_EQUAL_INT(CLI_ARG_ERROR, cli_args_next(&a, opts, &v));

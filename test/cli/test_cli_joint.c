@@ -11,50 +11,21 @@
 #include <unistd.h>
 
 #include "cli_bus.h"
+#include "cli_capture.h"
 
-static FILE *err;
 static cli_robot_t robot;
 static char dir[64];
 static char path[128];
 
 void setUp(void)
 {
-    err = tmpfile();
-    cli_set_error_stream(err);
-    cli_set_command("test");
+    cli_capture_begin();
     memset(&robot, 0, sizeof robot);
 }
 
 void tearDown(void)
 {
-    cli_set_error_stream(NULL);
-    fclose(err);
-}
-
-/* Lines written to the error stream since setUp; the first in line. */
-static int error_lines(char *line, size_t len)
-{
-    int n = 0, c;
-    size_t i = 0;
-    fflush(err);
-    rewind(err);
-    line[0] = '\0';
-    while ((c = fgetc(err)) != EOF) {
-        if (c == '\n') {
-            n++;
-        } else if (n == 0 && i + 1 < len) {
-            line[i++] = (char)c;
-            line[i] = '\0';
-        }
-    }
-    return n;
-}
-
-static void expect_one_error(const char *part)
-{
-    char line[600];
-    TEST_ASSERT_EQUAL_INT_MESSAGE(1, error_lines(line, sizeof line), line);
-    TEST_ASSERT_NOT_NULL_MESSAGE(strstr(line, part), line);
+    cli_capture_end();
 }
 
 static void opts(cli_bus_opts_t *o)
@@ -80,7 +51,7 @@ static void test_no_config(void)
     TEST_ASSERT_EQUAL_DOUBLE(0.0, (double)sel.jc.pos_min);
     TEST_ASSERT_EQUAL_DOUBLE(0.0, (double)sel.jc.pos_max);
     TEST_ASSERT_NULL(o.port);
-    TEST_ASSERT_EQUAL_INT(0, error_lines(line, sizeof line));
+    TEST_ASSERT_EQUAL_INT(0, cli_error_lines(line, sizeof line));
 }
 
 static void test_no_config_refusals(void)
@@ -89,7 +60,7 @@ static void test_no_config_refusals(void)
     cli_joint_sel_t sel;
     opts(&o);
     TEST_ASSERT_EQUAL_INT(-1, cli_joint_select(&robot, "hip", -1, &o, &sel));
-    expect_one_error("--joint hip needs --config FILE");
+    cli_expect_one_error("--joint hip needs --config FILE");
 }
 
 static void test_neither_or_both(void)
@@ -98,7 +69,7 @@ static void test_neither_or_both(void)
     cli_joint_sel_t sel;
     opts(&o);
     TEST_ASSERT_EQUAL_INT(-1, cli_joint_select(&robot, NULL, -1, &o, &sel));
-    expect_one_error("--id N or --joint NAME is required");
+    cli_expect_one_error("--id N or --joint NAME is required");
 }
 
 static void test_both(void)
@@ -107,7 +78,7 @@ static void test_both(void)
     cli_joint_sel_t sel;
     opts(&o);
     TEST_ASSERT_EQUAL_INT(-1, cli_joint_select(&robot, "hip", 1, &o, &sel));
-    expect_one_error("exclude each other");
+    cli_expect_one_error("exclude each other");
 }
 
 /* The default range [-pi, pi] when both limits are 0; the configured one; clamp allows all. */
@@ -201,7 +172,7 @@ static void test_by_id(void)
     TEST_ASSERT_EQUAL_STRING("servo 5", sel.name);
     opts(&o);
     TEST_ASSERT_EQUAL_INT(-1, cli_joint_select(&robot, NULL, 1, &o, &sel));
-    expect_one_error("id 1 is used on 2 buses");
+    cli_expect_one_error("id 1 is used on 2 buses");
 }
 
 static void test_unknown_name(void)
@@ -212,7 +183,7 @@ static void test_unknown_name(void)
     TEST_ASSERT_EQUAL_INT(0, cli_robot_load(&robot, path));
     opts(&o);
     TEST_ASSERT_EQUAL_INT(-1, cli_joint_select(&robot, "ankle", -1, &o, &sel));
-    expect_one_error("no joint named 'ankle'");
+    cli_expect_one_error("no joint named 'ankle'");
 }
 
 /* A value the file allows but the library does not (|zero| > 64): "FILE:LINE: joint ...". */
@@ -226,7 +197,7 @@ static void test_library_refusal_names_the_line(void)
     opts(&o);
     TEST_ASSERT_EQUAL_INT(-1, cli_joint_select(&robot, "knee", -1, &o, &sel));
     snprintf(want, sizeof want, "%s:15: joint knee: ", path);
-    expect_one_error(want);
+    cli_expect_one_error(want);
 }
 
 static void test_load_error(void)
@@ -235,7 +206,7 @@ static void test_load_error(void)
     write_config("joints:\n  - name: a\n    id: 99\n");
     TEST_ASSERT_EQUAL_INT(-1, cli_robot_load(&robot, path));
     snprintf(want, sizeof want, "%s:3: ", path);
-    expect_one_error(want);
+    cli_expect_one_error(want);
 }
 
 #endif

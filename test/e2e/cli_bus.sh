@@ -15,51 +15,22 @@ set -u
 cd "$(dirname "$0")/../.."
 . test/e2e/lib_e2e.sh
 e2e_need_python
-SIM=${J288_SIM:-$BIN/j288-sim}
-SIM_PIDS=()
-BG_PIDS=()
+SIM_DIR=$E2E_TMP
+. test/e2e/lib_sim.sh
+SIM_WRAP=(timeout -k 2 120)
 BIG_MARGIN=250000
 M=(--margin-us "$BIG_MARGIN")
 # Where absent ids are asked too (scan: 12 ids, 4 tries each; log's probe sweeps), each
 # miss costs a margin: 50 ms, still ten times what a busy machine stalls a pty exchange.
 M50=(--margin-us 50000)
 
-cleanup() {
-    local p
-    for p in "${BG_PIDS[@]}" "${SIM_PIDS[@]}"; do
-        kill -TERM "$p" 2>/dev/null
-    done
-    for p in "${BG_PIDS[@]}" "${SIM_PIDS[@]}"; do
-        wait "$p" 2>/dev/null
-    done
-    e2e_cleanup_tmp
-}
-trap cleanup EXIT
+trap 'sim_cleanup TERM' EXIT
 trap 'exit 130' INT TERM
+need_built "$J288" "$SIM"
 
-for f in "$J288" "$SIM"; do
-    [ -x "$f" ] || { echo "$f not built"; exit 1; }
-done
-
-# start_sim NAME [sim options...]: a simulator serving on $E2E_TMP/NAME.pty, logging
+# start_sim NAME [sim options...]: a quiet simulator serving on $E2E_TMP/NAME.pty, logging
 # received commands to $E2E_TMP/NAME.log; sets SIM_PID and DEV.
-start_sim() {
-    local name=$1; shift
-    DEV=$E2E_TMP/$name.pty
-    timeout -k 2 120 "$SIM" --link "$DEV" --log "$E2E_TMP/$name.log" --quiet "$@" \
-        >"$E2E_TMP/$name.out" 2>"$E2E_TMP/$name.err" &
-    SIM_PID=$!
-    SIM_PIDS+=("$SIM_PID")
-    local i
-    for i in $(seq 1 600); do # up to 30 s: a loaded machine, or valgrind
-        [ -L "$DEV" ] && [ -s "$E2E_TMP/$name.out" ] && return 0
-        sleep 0.05
-    done
-    echo "simulator $name did not start: $(cat "$E2E_TMP/$name.err")"
-    return 1
-}
-
-stop_sim() { kill -TERM "$1" 2>/dev/null; wait "$1" 2>/dev/null; }
+start_sim() { sim_start_linked "$1" --quiet "${@:2}"; }
 
 # json_check NAME PYTHON_EXPR: evaluate a Python assertion block on $E2E_OUT (parsed as o).
 json_check() {

@@ -16,44 +16,24 @@ set -u
 cd "$(dirname "$0")/../.."
 . test/e2e/lib_e2e.sh
 e2e_need_python
-SIM=${J288_SIM:-$BIN/j288-sim}
+SIM_DIR=$E2E_TMP
+. test/e2e/lib_sim.sh
 SEEDS=${J288_JOINT_SEEDS:-"11 12 13"}
-SIM_PIDS=()
 M=(--margin-us 250000 --retries 1)
 E2E_CMD_TIMEOUT=60
 
-cleanup() {
-    local p
-    for p in "${SIM_PIDS[@]}"; do kill -TERM "$p" 2>/dev/null; done
-    for p in "${SIM_PIDS[@]}"; do wait "$p" 2>/dev/null; done
-    e2e_cleanup_tmp
-}
-trap cleanup EXIT
+trap 'sim_cleanup TERM' EXIT
 trap 'exit 130' INT TERM
-for f in "$J288" "$SIM"; do
-    [ -x "$f" ] || { echo "$f not built"; exit 1; }
-done
+need_built "$J288" "$SIM"
 
 # start_sim NAME [sim options...]: a simulator on $E2E_TMP/NAME.pty, logging frames to
-# NAME.log and its truth to NAME.truth; sets SIM_PID and DEV.
+# NAME.log and its truth to NAME.truth; sets SIM_PID, DEV, TRUTH and SLOG. No SIM_WRAP (no
+# timeout wrapper): the signals (SIGWINCH, SIGPWR) must reach the simulator itself.
 start_sim() {
-    local name=$1 i; shift
-    DEV=$E2E_TMP/$name.pty
-    TRUTH=$E2E_TMP/$name.truth
-    SLOG=$E2E_TMP/$name.log
-    # No timeout wrapper: the signals (SIGWINCH, SIGPWR) must reach the simulator itself.
-    "$SIM" --exit-after 300 --link "$DEV" --log "$SLOG" --truth "$TRUTH" "$@" \
-        >"$E2E_TMP/$name.out" 2>"$E2E_TMP/$name.err" &
-    SIM_PID=$!
-    SIM_PIDS+=("$SIM_PID")
-    for i in $(seq 1 600); do
-        [ -L "$DEV" ] && [ -s "$E2E_TMP/$name.out" ] && return 0
-        sleep 0.05
-    done
-    echo "simulator $name did not start: $(cat "$E2E_TMP/$name.err")"
-    return 1
+    TRUTH=$E2E_TMP/$1.truth
+    SLOG=$E2E_TMP/$1.log
+    sim_start_linked "$1" --exit-after 300 --truth "$TRUTH" "${@:2}"
 }
-stop_sim() { kill -TERM "$SIM_PID" 2>/dev/null; wait "$SIM_PID" 2>/dev/null; }
 
 truth_seq() { sed -n '1s/^# j288-sim truth seq=\([0-9]*\) .*/\1/p' "$TRUTH" 2>/dev/null; }
 # truth_now: ask the simulator for its truth (SIGWINCH) and wait until it is written.

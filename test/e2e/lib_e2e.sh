@@ -75,6 +75,13 @@ expect_true() {
     fi
 }
 
+# e2e_check NAME CMD...: one check, passing when CMD (a test function; its output goes
+# through, to say why it failed) succeeds.
+e2e_check() {
+    local name=$1; shift
+    if "$@"; then e2e_pass "$name"; else e2e_fail "$name" "$1 failed"; fi
+}
+
 e2e_summary() {
     echo
     echo "-----------------------"

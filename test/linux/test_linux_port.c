@@ -29,10 +29,8 @@
 
 #include "j288/j288.h"
 #include "j288_linux.h"
+#include "sim_process.h"
 
-#ifndef J288_SIM_DEFAULT
-#define J288_SIM_DEFAULT "build/bin/j288-sim"
-#endif
 
 static pid_t g_sim = -1;
 static char g_pty[128];
@@ -42,95 +40,36 @@ static j288_bus_t g_bus;
 
 /* ---- the simulator ---------------------------------------------------------------------- */
 
-static const char *sim_path(void)
-{
-    const char *p = getenv("J288_SIM");
-    return (p != NULL && *p != '\0') ? p : J288_SIM_DEFAULT;
-}
-
 /* Start j288-sim with extra arguments (NULL-terminated) and read its pty path. */
 static void sim_start(const char *arg0, ...)
 {
-    const char *argv[32];
-    int n = 0, fds[2];
+    const char *args[SIM_PROCESS_MAX_ARGS + 1];
+    int n = 0;
     va_list ap;
     const char *a;
-    size_t got = 0;
-    struct pollfd pfd;
 
-    argv[n++] = sim_path();
-    argv[n++] = "--quiet";
-    argv[n++] = "--exit-after";
-    argv[n++] = "30";
-    argv[n++] = "--log";
-    argv[n++] = g_log;
+    args[n++] = "--quiet";
+    args[n++] = "--exit-after";
+    args[n++] = "30";
+    args[n++] = "--log";
+    args[n++] = g_log;
     va_start(ap, arg0);
-    for (a = arg0; a != NULL && n < 30; a = va_arg(ap, const char *))
-        argv[n++] = a;
+    for (a = arg0; a != NULL && n < SIM_PROCESS_MAX_ARGS; a = va_arg(ap, const char *))
+        args[n++] = a;
     va_end(ap);
-    argv[n] = NULL;
-
-    TEST_ASSERT_EQUAL_INT(0, pipe(fds));
-    g_sim = fork();
-    TEST_ASSERT_TRUE(g_sim >= 0);
-    if (g_sim == 0) {
-        (void)dup2(fds[1], 1);
-        (void)close(fds[0]);
-        (void)close(fds[1]);
-        execv(argv[0], (char *const *)argv);
-        fprintf(stderr, "cannot run %s: %s\n", argv[0], strerror(errno));
-        _exit(127);
-    }
-    (void)close(fds[1]);
-    pfd.fd = fds[0];
-    pfd.events = POLLIN;
-    while (got < sizeof g_pty - 1u) {
-        ssize_t r;
-        if (poll(&pfd, 1, 30000) <= 0)
-            break;
-        r = read(fds[0], g_pty + got, 1);
-        if (r <= 0 || g_pty[got] == '\n')
-            break;
-        got++;
-    }
-    g_pty[got] = '\0';
-    (void)close(fds[0]);
-    if (strncmp(g_pty, "/dev/", 5) != 0)
-        TEST_FAIL_MESSAGE("j288-sim did not print its pty path (is it built?)");
+    args[n] = NULL;
+    sim_process_start(args, &g_sim, g_pty, sizeof g_pty);
 }
 
 /* Stop it (SIGTERM, then SIGKILL after 20 s) and reap it. Returns its exit status. */
 static int sim_stop(void)
 {
-    int status = -1, i;
-    if (g_sim <= 0)
-        return -1;
-    (void)kill(g_sim, SIGTERM);
-    for (i = 0; i < 2000; i++) {
-        if (waitpid(g_sim, &status, WNOHANG) == g_sim) {
-            g_sim = -1;
-            return status;
-        }
-        usleep(10000);
-    }
-    (void)kill(g_sim, SIGKILL);
-    (void)waitpid(g_sim, &status, 0);
+    int status = sim_process_stop(g_sim);
     g_sim = -1;
     return status;
 }
 
-static bool log_contains(const char *needle)
-{
-    char line[256];
-    bool found = false;
-    FILE *f = fopen(g_log, "r");
-    if (f == NULL)
-        return false;
-    while (!found && fgets(line, sizeof line, f) != NULL)
-        found = strstr(line, needle) != NULL;
-    fclose(f);
-    return found;
-}
+static bool log_contains(const char *needle) { return sim_log_contains(g_log, needle); }
 
 void setUp(void)
 {

@@ -24,10 +24,7 @@
 
 #include "j288/j288.h"
 #include "j288_robot.h"
-
-#ifndef J288_SIM_DEFAULT
-#define J288_SIM_DEFAULT "build/bin/j288-sim"
-#endif
+#include "sim_process.h"
 
 #define NSIM 4
 #define LOADED_MARGIN_US 250000u
@@ -45,60 +42,25 @@ static j288_robot_config_t g_cfg;
 
 /* ---- simulators ------------------------------------------------------------------------- */
 
-static const char *sim_path(void)
-{
-    const char *p = getenv("J288_SIM");
-    return (p != NULL && *p != '\0') ? p : J288_SIM_DEFAULT;
-}
-
 /* Start simulator k with servos ids (e.g. "1,2,3") and the options in extra (NULL-terminated,
  * or NULL), and read its pty path. */
 static void sim_start_with(int k, const char *ids, const char *const *extra)
 {
     sim_t *s = &g_sim[k];
-    const char *argv[16];
-    int n = 0, fds[2];
-    size_t got = 0;
-    struct pollfd pfd;
+    const char *args[16];
+    int n = 0;
 
-    argv[n++] = sim_path();
-    argv[n++] = "--quiet";
-    argv[n++] = "--exit-after";
-    argv[n++] = "60";
-    argv[n++] = "--ids";
-    argv[n++] = ids;
-    argv[n++] = "--log";
-    argv[n++] = s->log;
-    while (extra != NULL && *extra != NULL && n < 15)
-        argv[n++] = *extra++;
-    argv[n] = NULL;
-    TEST_ASSERT_EQUAL_INT(0, pipe(fds));
-    s->pid = fork();
-    TEST_ASSERT_TRUE(s->pid >= 0);
-    if (s->pid == 0) {
-        (void)dup2(fds[1], 1);
-        (void)close(fds[0]);
-        (void)close(fds[1]);
-        execv(argv[0], (char *const *)argv);
-        fprintf(stderr, "cannot run %s: %s\n", argv[0], strerror(errno));
-        _exit(127);
-    }
-    (void)close(fds[1]);
-    pfd.fd = fds[0];
-    pfd.events = POLLIN;
-    while (got < sizeof s->pty - 1u) {
-        ssize_t r;
-        if (poll(&pfd, 1, 30000) <= 0)
-            break;
-        r = read(fds[0], s->pty + got, 1);
-        if (r <= 0 || s->pty[got] == '\n')
-            break;
-        got++;
-    }
-    s->pty[got] = '\0';
-    (void)close(fds[0]);
-    if (strncmp(s->pty, "/dev/", 5) != 0)
-        TEST_FAIL_MESSAGE("j288-sim did not print its pty path (is it built?)");
+    args[n++] = "--quiet";
+    args[n++] = "--exit-after";
+    args[n++] = "60";
+    args[n++] = "--ids";
+    args[n++] = ids;
+    args[n++] = "--log";
+    args[n++] = s->log;
+    while (extra != NULL && *extra != NULL && n < 14)
+        args[n++] = *extra++;
+    args[n] = NULL;
+    sim_process_start(args, &s->pid, s->pty, sizeof s->pty);
 }
 
 static void sim_start(int k, const char *ids)
@@ -109,36 +71,15 @@ static void sim_start(int k, const char *ids)
 static void sim_stop(int k)
 {
     sim_t *s = &g_sim[k];
-    int status, i;
     if (s->pid <= 0)
         return;
     if (s->stopped)
         (void)kill(s->pid, SIGCONT);
-    (void)kill(s->pid, SIGTERM);
-    for (i = 0; i < 2000; i++) {
-        if (waitpid(s->pid, &status, WNOHANG) == s->pid) {
-            s->pid = -1;
-            return;
-        }
-        usleep(10000);
-    }
-    (void)kill(s->pid, SIGKILL);
-    (void)waitpid(s->pid, &status, 0);
+    (void)sim_process_stop(s->pid);
     s->pid = -1;
 }
 
-static bool log_contains(int k, const char *needle)
-{
-    char line[256];
-    bool found = false;
-    FILE *f = fopen(g_sim[k].log, "r");
-    if (f == NULL)
-        return false;
-    while (!found && fgets(line, sizeof line, f) != NULL)
-        found = strstr(line, needle) != NULL;
-    fclose(f);
-    return found;
-}
+static bool log_contains(int k, const char *needle) { return sim_log_contains(g_sim[k].log, needle); }
 
 /* Wait (bounded, 20 s) until simulator k has logged needle. */
 static bool log_wait(int k, const char *needle)
