@@ -135,6 +135,8 @@ TEST_SCRIPTS += test/e2e/cli_offline.sh test/e2e/cli_bus.sh tools/vectors/check-
     test/e2e/sim_cli.sh test/e2e/example_linux.sh test/abi/check-abi.sh
 # The joint frame end to end against the simulator's truth (the tool, the config, the sim).
 TEST_SCRIPTS += test/e2e/joint_sim.sh
+# The scripts' own process helpers (whom they signal, what their cleanup removes).
+TEST_SCRIPTS += test/e2e/lib_sim_check.sh
 TEST_DEPS += $(J288_BIN) $(SIM_BIN) $(EXAMPLE_LINUX) $(LIB_A)
 ALL_TARGETS += $(CLI_TEST) $(FUZZ_REPLAY_TESTS) $(LINUX_PORT_TEST) $(CONFIG_TEST) $(SIM_MODEL_TEST) \
     $(STM32_TEST)

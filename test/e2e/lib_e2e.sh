@@ -10,7 +10,8 @@ E2E_TESTS=0
 E2E_FAILURES=0
 E2E_TMP=$(mktemp -d "${TMPDIR:-/tmp}/j288-e2e.XXXXXX")
 
-e2e_cleanup_tmp() { rm -rf "$E2E_TMP"; }
+# For an EXIT trap; a no-op in a subshell (bash runs the trap in a subshell killed by a signal).
+e2e_cleanup_tmp() { [ "$BASHPID" = "$$" ] && rm -rf "$E2E_TMP"; return 0; }
 
 E2E_NAME=$(basename "$0" .sh)
 e2e_pass() { E2E_TESTS=$((E2E_TESTS + 1)); echo "$E2E_NAME:$1:PASS"; }

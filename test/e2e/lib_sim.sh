@@ -10,17 +10,30 @@ SIM_PIDS=()
 BG_PIDS=() # other processes the script starts in the background, stopped with the simulators
 SIM_WRAP=() # a command prefix for sim_start_linked's simulators (e.g. timeout ...); none by default
 
-# stop_pids SIGNAL PID...: send SIGNAL to every PID, then reap them all. Always succeeds (an
-# EXIT trap under set -e must get to its end).
+# own_child PID: whether PID is still a child of this shell. A process of ours that has ended
+# has been reaped, and its pid may already name another program's process (pids wrap within
+# minutes while the tests run in parallel): that one must never be signalled.
+own_child() {
+    local stat
+    { read -r stat <"/proc/$1/stat"; } 2>/dev/null || return 1
+    stat=${stat##*) } # after the command name: state, then the parent's pid
+    set -- $stat
+    [ "${2:-}" = "$BASHPID" ]
+}
+
+# stop_pids SIGNAL PID...: send SIGNAL to every PID still a child of this shell, then reap
+# them all. Always succeeds (an EXIT trap under set -e must get to its end).
 stop_pids() {
     local sig=$1 p; shift
-    for p in "$@"; do kill -s "$sig" "$p" 2>/dev/null || true; done
+    for p in "$@"; do own_child "$p" && { kill -s "$sig" "$p" 2>/dev/null || true; }; done
     for p in "$@"; do wait "$p" 2>/dev/null || true; done
 }
 
 # sim_cleanup SIGNAL: for the script's EXIT trap: SIGNAL to every process in BG_PIDS and
-# SIM_PIDS, all reaped, and SIM_DIR removed.
+# SIM_PIDS, all reaped, and SIM_DIR removed. Bash also runs the EXIT trap in a subshell killed
+# by a signal: there it does nothing, so the script goes on with its files.
 sim_cleanup() {
+    [ "$BASHPID" = "$$" ] || return 0
     stop_pids "$1" "${BG_PIDS[@]}" "${SIM_PIDS[@]}"
     rm -rf "$SIM_DIR"
 }
@@ -36,7 +49,7 @@ need_built() {
 # stop_sim [PID]: SIGTERM to PID (default: the last simulator started) and its exit status.
 stop_sim() {
     local p=${1:-$SIM_PID}
-    kill -TERM "$p" 2>/dev/null
+    own_child "$p" && kill -TERM "$p" 2>/dev/null
     wait "$p" 2>/dev/null
 }
 
