@@ -706,17 +706,8 @@ J288_NOINLINE static bool reply_fast(j288_bus_t *bus, const uint8_t *data, size_
 
 /* ---- public entry points */
 
-/* Whether a new transaction may be accepted now (the lock held where it is needed). */
-static bool can_accept(const j288_bus_t *bus)
-{
-    uint8_t st = bus->state;
-    return !(bus->estop_pending || bus->estop_active || bus->queued || bus->retry_pending) &&
-           ((st == (uint8_t)J288_BUS_IDLE) || (st == (uint8_t)J288_BUS_GUARD));
-}
-
-/* The transaction of frame (to id) begins (the lock held where it is needed). */
-static void accept(j288_bus_t *bus, const uint8_t *frame, uint8_t id, uint32_t now_us,
-                   j288_bus_done_fn done, void *user)
+void j288_bus_accept_frame(j288_bus_t *bus, const uint8_t *frame, uint8_t id, uint32_t now_us,
+                           j288_bus_done_fn done, void *user)
 {
     bus->tx_frame = frame;
     begin_txn(bus, id, done, user);
@@ -738,14 +729,14 @@ int j288_bus_submit(j288_bus_t *bus, const j288_cmd_raw_t *cmd, uint32_t now_us,
         return J288_ERR_NULL;
     }
     j288_bus_lock(bus);
-    if (!can_accept(bus)) {
+    if (!j288_bus_accepts(bus)) {
         j288_bus_unlock(bus);
         return J288_ERR_BUSY;
     }
     /* The transmit buffer is free: the previous transmit has completed. */
     err = j288_cmd_encode(cmd, bus->tx_buf, &bus->crc);
     if (err == J288_OK) {
-        accept(bus, bus->tx_buf, cmd->id, now_us, done, user);
+        j288_bus_accept_frame(bus, bus->tx_buf, cmd->id, now_us, done, user);
     }
     j288_bus_unlock(bus);
     return err;
@@ -755,11 +746,11 @@ int j288_bus_submit_frame(j288_bus_t *bus, const uint8_t frame[J288_CMD_LEN], ui
                           uint32_t now_us, j288_bus_done_fn done, void *user)
 {
     j288_bus_lock(bus);
-    if (!can_accept(bus)) {
+    if (!j288_bus_accepts(bus)) {
         j288_bus_unlock(bus);
         return J288_ERR_BUSY;
     }
-    accept(bus, frame, id, now_us, done, user); /* sent from where it is */
+    j288_bus_accept_frame(bus, frame, id, now_us, done, user); /* sent from where it is */
     j288_bus_unlock(bus);
     return J288_OK;
 }
