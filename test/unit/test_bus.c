@@ -1350,6 +1350,8 @@ static void test_isr_spurious_tx_done_changes_nothing(void)
     j288_bus_on_tx_done(&bus);
     j288_bus_on_rx(&bus, WORKED_REPLY3, J288_REPLY_LEN);
     TEST_ASSERT_EQUAL_INT(J288_OK, cb.txn.result);
+    TEST_ASSERT_EQUAL_INT32(5215, cb.txn.reply.pos);
+    TEST_ASSERT_EQUAL_UINT32(1u, j288_bus_parser_stats(&bus)->frames);
     TEST_ASSERT_EQUAL_INT(J288_BUS_GUARD, j288_bus_state(&bus));
     j288_bus_on_tx_done(&bus);
     TEST_ASSERT_EQUAL_INT(J288_BUS_GUARD, j288_bus_state(&bus));
@@ -1428,6 +1430,49 @@ static void test_isr_reply_with_bad_head_refused(void)
     TEST_ASSERT_EQUAL_INT(0, cb.calls);
     TEST_ASSERT_EQUAL_INT(J288_BUS_WAIT_REPLY, j288_bus_state(&bus));
     TEST_ASSERT_EQUAL_UINT32(0u, j288_bus_parser_stats(&bus)->frames);
+}
+
+/* Whole replies that are not ours, each in one call: with a bad CRC (counted), from another
+ * id (noted, the reply still awaited), then ours, taken and counted once by the parser. */
+static void test_isr_whole_replies_wrong_id_bad_crc_then_ours(void)
+{
+    j288_cmd_raw_t cmd = worked_cmd();
+    j288_reply_raw_t r7 = reply_for(7u, 7);
+    uint8_t other[J288_REPLY_LEN], bad[J288_REPLY_LEN];
+    fake_port_encode_reply(&r7, other);
+    memcpy(bad, WORKED_REPLY3, J288_REPLY_LEN);
+    bad[12] ^= 0x40u;
+    setup_isr_manual(false);
+    submit_ok(&cmd);
+    j288_bus_on_tx_done(&bus);
+    j288_bus_on_rx(&bus, bad, sizeof bad);
+    TEST_ASSERT_EQUAL_INT(0, cb.calls);
+    TEST_ASSERT_EQUAL_UINT32(1u, j288_bus_stats(&bus)->crc_errors);
+    j288_bus_on_rx(&bus, other, sizeof other);
+    TEST_ASSERT_EQUAL_INT(0, cb.calls);
+    TEST_ASSERT_EQUAL_UINT32(1u, j288_bus_stats(&bus)->wrong_id);
+    TEST_ASSERT_EQUAL_INT(J288_BUS_WAIT_REPLY, j288_bus_state(&bus));
+    j288_bus_on_rx(&bus, WORKED_REPLY3, J288_REPLY_LEN);
+    TEST_ASSERT_EQUAL_INT(1, cb.calls);
+    TEST_ASSERT_EQUAL_INT(J288_OK, cb.txn.result);
+    TEST_ASSERT_EQUAL_INT32(5215, cb.txn.reply.pos);
+    TEST_ASSERT_EQUAL_UINT32(2u, j288_bus_parser_stats(&bus)->frames); /* id 7's and ours */
+}
+
+/* The first whole reply after the transmit, from another id: noted, not taken. */
+static void test_isr_first_whole_reply_from_another_id(void)
+{
+    j288_cmd_raw_t cmd = worked_cmd();
+    j288_reply_raw_t r7 = reply_for(7u, 7);
+    uint8_t other[J288_REPLY_LEN];
+    fake_port_encode_reply(&r7, other);
+    setup_isr_manual(false);
+    submit_ok(&cmd);
+    j288_bus_on_tx_done(&bus);
+    j288_bus_on_rx(&bus, other, sizeof other);
+    TEST_ASSERT_EQUAL_INT(0, cb.calls);
+    TEST_ASSERT_EQUAL_UINT32(1u, j288_bus_stats(&bus)->wrong_id);
+    TEST_ASSERT_EQUAL_INT(J288_BUS_WAIT_REPLY, j288_bus_state(&bus));
 }
 
 /* Without advance_in_isr the event calls only record: the state moves at the next poll. */
@@ -2008,6 +2053,8 @@ int main(void)
     RUN_TEST(test_isr_reply_with_trailing_byte);
     RUN_TEST(test_isr_whole_reply_after_partial);
     RUN_TEST(test_isr_reply_with_bad_head_refused);
+    RUN_TEST(test_isr_whole_replies_wrong_id_bad_crc_then_ours);
+    RUN_TEST(test_isr_first_whole_reply_from_another_id);
     RUN_TEST(test_poll_mode_tx_done_waits_for_poll);
     RUN_TEST(test_failure_ranking);
     RUN_TEST(test_noise_while_idle_is_not_echo);
