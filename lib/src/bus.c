@@ -714,8 +714,9 @@ J288_NOINLINE static bool reply_fast(j288_bus_t *bus, const uint8_t *data, size_
 
 /* ---- public entry points */
 
-void j288_bus_accept_frame(j288_bus_t *bus, const uint8_t *frame, uint8_t id, uint32_t now_us,
-                           j288_bus_done_fn done, void *user)
+/* The transaction of frame (to id) begins (the lock held where it is needed). */
+static J288_INLINE_HOT void accept(j288_bus_t *bus, const uint8_t *frame, uint8_t id,
+                                   uint32_t now_us, j288_bus_done_fn done, void *user)
 {
     bus->tx_frame = frame;
     begin_txn(bus, id, done, user);
@@ -726,6 +727,12 @@ void j288_bus_accept_frame(j288_bus_t *bus, const uint8_t *frame, uint8_t id, ui
     if (!bus->in_advance) {
         advance(bus, now_us);
     }
+}
+
+void j288_bus_accept_frame(j288_bus_t *bus, const uint8_t *frame, uint8_t id, uint32_t now_us,
+                           j288_bus_done_fn done, void *user)
+{
+    accept(bus, frame, id, now_us, done, user);
 }
 
 int j288_bus_submit(j288_bus_t *bus, const j288_cmd_raw_t *cmd, uint32_t now_us,
@@ -744,7 +751,7 @@ int j288_bus_submit(j288_bus_t *bus, const j288_cmd_raw_t *cmd, uint32_t now_us,
     /* The transmit buffer is free: the previous transmit has completed. */
     err = j288_cmd_encode(cmd, bus->tx_buf, &bus->crc);
     if (err == J288_OK) {
-        j288_bus_accept_frame(bus, bus->tx_buf, cmd->id, now_us, done, user);
+        accept(bus, bus->tx_buf, cmd->id, now_us, done, user);
     }
     j288_bus_unlock(bus);
     return err;
@@ -758,7 +765,7 @@ int j288_bus_submit_frame(j288_bus_t *bus, const uint8_t frame[J288_CMD_LEN], ui
         j288_bus_unlock(bus);
         return J288_ERR_BUSY;
     }
-    j288_bus_accept_frame(bus, frame, id, now_us, done, user); /* sent from where it is */
+    accept(bus, frame, id, now_us, done, user); /* sent from where it is */
     j288_bus_unlock(bus);
     return J288_OK;
 }
