@@ -648,12 +648,18 @@ static void advance_from_event(j288_bus_t *bus)
  * event counter, the ring, the parser's hunt) is skipped. Each does exactly what advance()
  * would do for that event and falls back to it in every other case. */
 
+/* No event counter moved but tx_done_events transmit-completes. */
+static bool only_these_events(const j288_bus_t *bus, uint32_t tx_done_events)
+{
+    return ((bus->ev_tx_done - bus->seen_tx_done) == tx_done_events) &&
+           (bus->ev_line == bus->seen_line) && (bus->ev_gone == bus->seen_gone);
+}
+
 /* Only the event being handled is new: no other event counter moved, no byte waits. */
 static bool only_this_event(const j288_bus_t *bus, uint32_t tx_done_events)
 {
-    return ((bus->ev_tx_done - bus->seen_tx_done) == tx_done_events) &&
-           (bus->ev_line == bus->seen_line) && (bus->ev_gone == bus->seen_gone) &&
-           (bus->ring_head == bus->ring_tail) && (bus->direct_len == 0u);
+    return only_these_events(bus, tx_done_events) && (bus->ring_head == bus->ring_tail) &&
+           (bus->direct_len == 0u);
 }
 
 /* Transmit complete, no echo expected, the deadline not passed: wait for the reply. */
@@ -678,16 +684,18 @@ static bool tx_done_fast(j288_bus_t *bus)
 
 /* Exactly one reply from the addressed servo, in one piece, while it is awaited: taken as
  * take_bytes() takes it (the parser's whole-frame case, then take_frame()), inside the
- * machine (in_advance: a submit from the completion only queues). Nothing changes unless it
- * is taken; then *now is the time it was taken at. */
+ * machine (in_advance: a submit from the completion only queues). Called from on_rx outside
+ * an advance with the ring empty (so no bytes wait in place either). In WAIT_REPLY every byte
+ * still in the ring's past came after the transmit (before it, the state was TX or ECHO), and
+ * with nothing held by the parser the byte path would find this frame where it starts.
+ * Nothing changes unless it is taken; then *now is the time it was taken at. */
 J288_NOINLINE static bool reply_fast(j288_bus_t *bus, const uint8_t *data, size_t len,
                                      uint32_t *now)
 {
     uint32_t head = bus->ring_head;
 
     if ((len != J288_REPLY_LEN) || (bus->state != (uint8_t)J288_BUS_WAIT_REPLY) ||
-        !only_this_event(bus, 0u) || (bus->parser.len != 0u) ||
-        (!bus->cfg.echo && (bus->txdone_mark != head)) ||
+        !only_these_events(bus, 0u) || (bus->parser.len != 0u) ||
         (j288_get_u16le(data) != J288_REPLY_HEAD16) || ((data[2] & 0x0Fu) != bus->tx_id) ||
         !j288_reply_crc_ok(&bus->crc, data)) {
         return false;
@@ -706,17 +714,9 @@ J288_NOINLINE static bool reply_fast(j288_bus_t *bus, const uint8_t *data, size_
 
 /* ---- public entry points */
 
-/* Whether a new transaction may be accepted now (the lock held where it is needed). */
-static bool can_accept(const j288_bus_t *bus)
-{
-    uint8_t st = bus->state;
-    return !(bus->estop_pending || bus->estop_active || bus->queued || bus->retry_pending) &&
-           ((st == (uint8_t)J288_BUS_IDLE) || (st == (uint8_t)J288_BUS_GUARD));
-}
-
 /* The transaction of frame (to id) begins (the lock held where it is needed). */
-static void accept(j288_bus_t *bus, const uint8_t *frame, uint8_t id, uint32_t now_us,
-                   j288_bus_done_fn done, void *user)
+static J288_INLINE_HOT void accept(j288_bus_t *bus, const uint8_t *frame, uint8_t id,
+                                   uint32_t now_us, j288_bus_done_fn done, void *user)
 {
     bus->tx_frame = frame;
     begin_txn(bus, id, done, user);
@@ -729,6 +729,12 @@ static void accept(j288_bus_t *bus, const uint8_t *frame, uint8_t id, uint32_t n
     }
 }
 
+void j288_bus_accept_frame(j288_bus_t *bus, const uint8_t *frame, uint8_t id, uint32_t now_us,
+                           j288_bus_done_fn done, void *user)
+{
+    accept(bus, frame, id, now_us, done, user);
+}
+
 int j288_bus_submit(j288_bus_t *bus, const j288_cmd_raw_t *cmd, uint32_t now_us,
                     j288_bus_done_fn done, void *user)
 {
@@ -738,7 +744,7 @@ int j288_bus_submit(j288_bus_t *bus, const j288_cmd_raw_t *cmd, uint32_t now_us,
         return J288_ERR_NULL;
     }
     j288_bus_lock(bus);
-    if (!can_accept(bus)) {
+    if (!j288_bus_accepts(bus)) {
         j288_bus_unlock(bus);
         return J288_ERR_BUSY;
     }
@@ -755,7 +761,7 @@ int j288_bus_submit_frame(j288_bus_t *bus, const uint8_t frame[J288_CMD_LEN], ui
                           uint32_t now_us, j288_bus_done_fn done, void *user)
 {
     j288_bus_lock(bus);
-    if (!can_accept(bus)) {
+    if (!j288_bus_accepts(bus)) {
         j288_bus_unlock(bus);
         return J288_ERR_BUSY;
     }

@@ -236,6 +236,22 @@ static inline void j288_bus_unlock(const j288_bus_t *bus)
     }
 }
 
+/* Whether the bus accepts a new transaction now (j288_bus_submit()'s J288_ERR_BUSY test:
+ * idle or in the guard, nothing queued, no retry or estop pending). Call it, and
+ * j288_bus_accept_frame() after it, under one j288_bus_lock(). */
+static inline bool j288_bus_accepts(const j288_bus_t *bus)
+{
+    uint8_t st = bus->state;
+    return !(bus->estop_pending || bus->estop_active || bus->queued || bus->retry_pending) &&
+           ((st == (uint8_t)J288_BUS_IDLE) || (st == (uint8_t)J288_BUS_GUARD));
+}
+
+/* The transaction of frame (J288_CMD_LEN bytes, addressed to id, CRC in place) begins, once
+ * j288_bus_accepts() said yes under the same lock; the frame is sent from where it is, for
+ * every attempt and the echo check, and must stay untouched until the completion call. */
+void j288_bus_accept_frame(j288_bus_t *bus, const uint8_t *frame, uint8_t id, uint32_t now_us,
+                           j288_bus_done_fn done, void *user);
+
 /* j288_bus_submit() for a command already encoded and checked (the scheduler keeps each
  * slot's frame): frame (J288_CMD_LEN bytes, addressed to id, CRC in place) is sent from where
  * it is, for every attempt and the echo check, so it must stay untouched until the

@@ -182,24 +182,41 @@ static void end_sweep(j288_sched_t *s, uint32_t now)
 /* Submit slot id's command. The frame encoded for it is reused while the command stays the
  * same (its checks were made by set_cmd, its CRC once); a watchdog clear goes out as a
  * one-off frame. frame[id] is the bus's frame until the completion: only this function
- * writes it, and only when slot id is submitted again. */
+ * writes it, and only once the bus has accepted a new transaction (until then frame[id] may
+ * still be on the wire, in a transaction an estop is ending), under the lock that set_cmd
+ * takes (its stale mark is not lost). */
 static int submit_slot(j288_sched_t *s, uint8_t id, uint32_t now)
 {
     const j288_slot_t *slot = &s->slot[id];
+    j288_bus_t *bus = s->bus;
     uint16_t bit = (uint16_t)((uint32_t)1u << id);
+    bool locked;
+    int rc;
 
     if (slot->clear_watchdog) {
         j288_cmd_raw_t cleared = slot->cmd;
         cleared.watchdog = false;
-        return j288_bus_submit(s->bus, &cleared, now, sched_done, s);
+        return j288_bus_submit(bus, &cleared, now, sched_done, s);
     }
-    if ((s->frame_stale & bit) != 0u) {
-        /* Checked fields (set_cmd, init and estop make only such commands), its id the
-         * slot's */
-        j288_cmd_pack(&slot->cmd, s->frame[id], &s->bus->crc);
-        s->frame_stale &= (uint16_t)~bit;
+    locked = j288_bus_needs_lock(bus); /* once: the same before and after the submit */
+    if (locked) {
+        bus->port->lock(bus->port_ctx);
     }
-    return j288_bus_submit_frame(s->bus, s->frame[id], id, now, sched_done, s);
+    rc = J288_ERR_BUSY;
+    if (j288_bus_accepts(bus)) {
+        if ((s->frame_stale & bit) != 0u) {
+            /* Checked fields (set_cmd, init and estop make only such commands), its id the
+             * slot's */
+            j288_cmd_pack(&slot->cmd, s->frame[id], &bus->crc);
+            s->frame_stale &= (uint16_t)~bit;
+        }
+        j288_bus_accept_frame(bus, s->frame[id], id, now, sched_done, s);
+        rc = J288_OK;
+    }
+    if (locked) {
+        bus->port->unlock(bus->port_ctx);
+    }
+    return rc;
 }
 
 /* Submit the next enabled slot of this sweep; end the sweep (and start the next one when

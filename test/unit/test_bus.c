@@ -1308,6 +1308,187 @@ static void test_isr_tx_done_after_deadline_times_out(void)
     TEST_ASSERT_EQUAL_INT(J288_BUS_GUARD, j288_bus_state(&bus));
 }
 
+/* ---- the event calls' fast paths (advance_in_isr): each case the general pass treats
+ * differently from "the awaited transition" must still be treated that way. Events are
+ * delivered by hand, as the interrupts would, with nobody polling. */
+
+static void setup_isr_manual(bool echo)
+{
+    j288_bus_config_t cfg;
+    memset(&cfg, 0, sizeof cfg);
+    cfg.advance_in_isr = true;
+    cfg.echo = echo;
+    setup_cfg(&cfg);
+    fp.poll_fn = NULL;
+    fp.txdone = FAKE_TXDONE_MANUAL;
+}
+
+/* Transmit complete before its echo was heard whole: the echo is still awaited. */
+static void test_isr_tx_done_before_echo_waits_for_echo(void)
+{
+    j288_cmd_raw_t cmd = worked_cmd();
+    setup_isr_manual(true);
+    submit_ok(&cmd);
+    j288_bus_on_rx(&bus, WORKED_CMD3, 10u);
+    j288_bus_on_tx_done(&bus);
+    TEST_ASSERT_EQUAL_INT(J288_BUS_ECHO, j288_bus_state(&bus));
+    j288_bus_on_rx(&bus, &WORKED_CMD3[10], 10u);
+    TEST_ASSERT_EQUAL_INT(J288_BUS_WAIT_REPLY, j288_bus_state(&bus));
+    j288_bus_on_rx(&bus, WORKED_REPLY3, J288_REPLY_LEN);
+    TEST_ASSERT_EQUAL_INT(1, cb.calls);
+    TEST_ASSERT_EQUAL_INT(J288_OK, cb.txn.result);
+}
+
+/* A transmit-complete nobody asked for (idle, or a second one in the guard) changes no state. */
+static void test_isr_spurious_tx_done_changes_nothing(void)
+{
+    j288_cmd_raw_t cmd = worked_cmd();
+    setup_isr_manual(false);
+    j288_bus_on_tx_done(&bus);
+    TEST_ASSERT_EQUAL_INT(J288_BUS_IDLE, j288_bus_state(&bus));
+    submit_ok(&cmd);
+    j288_bus_on_tx_done(&bus);
+    j288_bus_on_rx(&bus, WORKED_REPLY3, J288_REPLY_LEN);
+    TEST_ASSERT_EQUAL_INT(J288_OK, cb.txn.result);
+    TEST_ASSERT_EQUAL_INT32(5215, cb.txn.reply.pos);
+    TEST_ASSERT_EQUAL_UINT32(1u, j288_bus_parser_stats(&bus)->frames);
+    TEST_ASSERT_EQUAL_INT(J288_BUS_GUARD, j288_bus_state(&bus));
+    j288_bus_on_tx_done(&bus);
+    TEST_ASSERT_EQUAL_INT(J288_BUS_GUARD, j288_bus_state(&bus));
+    j288_bus_on_rx(&bus, WORKED_REPLY3, J288_REPLY_LEN);
+    TEST_ASSERT_EQUAL_INT(1, cb.calls);
+    TEST_ASSERT_EQUAL_UINT32(J288_REPLY_LEN, j288_bus_stats(&bus)->stale_bytes);
+}
+
+/* The stop is a broadcast: done at its transmit-complete, no reply awaited. */
+static void test_isr_estop_ends_at_tx_done(void)
+{
+    setup_isr_manual(false);
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_bus_estop(&bus, 0u));
+    TEST_ASSERT_EQUAL_INT(J288_BUS_TX, j288_bus_state(&bus));
+    j288_bus_on_tx_done(&bus);
+    TEST_ASSERT_EQUAL_INT(J288_BUS_GUARD, j288_bus_state(&bus));
+    TEST_ASSERT_EQUAL_UINT32(1u, j288_bus_stats(&bus)->estops);
+    TEST_ASSERT_EQUAL_UINT32(0u, j288_bus_stats(&bus)->estop_failures);
+    TEST_ASSERT_EQUAL_UINT32(1u, fp.nframes);
+}
+
+/* A whole reply heard before our transmit completed belongs to nobody. */
+static void test_isr_reply_before_tx_done_is_stale(void)
+{
+    j288_cmd_raw_t cmd = worked_cmd();
+    setup_isr_manual(false);
+    submit_ok(&cmd);
+    j288_bus_on_rx(&bus, WORKED_REPLY3, J288_REPLY_LEN);
+    TEST_ASSERT_EQUAL_INT(0, cb.calls);
+    TEST_ASSERT_EQUAL_UINT32(J288_REPLY_LEN, j288_bus_stats(&bus)->stale_bytes);
+    j288_bus_on_tx_done(&bus);
+    TEST_ASSERT_EQUAL_INT(J288_BUS_WAIT_REPLY, j288_bus_state(&bus));
+}
+
+/* A reply and one more byte in one call: the reply is taken, the byte counted stale. */
+static void test_isr_reply_with_trailing_byte(void)
+{
+    j288_cmd_raw_t cmd = worked_cmd();
+    uint8_t rx[J288_REPLY_LEN + 1u];
+    memcpy(rx, WORKED_REPLY3, J288_REPLY_LEN);
+    rx[J288_REPLY_LEN] = 0x5au;
+    setup_isr_manual(false);
+    submit_ok(&cmd);
+    j288_bus_on_tx_done(&bus);
+    j288_bus_on_rx(&bus, rx, sizeof rx);
+    TEST_ASSERT_EQUAL_INT(J288_OK, cb.txn.result);
+    TEST_ASSERT_EQUAL_UINT32(1u, j288_bus_stats(&bus)->stale_bytes);
+}
+
+/* A partial frame held by the parser, then a whole reply in one call: the held head and the
+ * new bytes make one bad frame first (the byte path's order), then the reply is found. */
+static void test_isr_whole_reply_after_partial(void)
+{
+    j288_cmd_raw_t cmd = worked_cmd();
+    setup_isr_manual(false);
+    submit_ok(&cmd);
+    j288_bus_on_tx_done(&bus);
+    j288_bus_on_rx(&bus, WORKED_REPLY3, 10u);
+    j288_bus_on_rx(&bus, WORKED_REPLY3, J288_REPLY_LEN);
+    TEST_ASSERT_EQUAL_INT(1, cb.calls);
+    TEST_ASSERT_EQUAL_INT(J288_OK, cb.txn.result);
+    TEST_ASSERT_EQUAL_UINT32(1u, j288_bus_stats(&bus)->crc_errors);
+}
+
+/* The CRC does not cover the head: a frame with a wrong head but a good CRC is no reply. */
+static void test_isr_reply_with_bad_head_refused(void)
+{
+    j288_cmd_raw_t cmd = worked_cmd();
+    uint8_t rx[J288_REPLY_LEN];
+    memcpy(rx, WORKED_REPLY3, J288_REPLY_LEN);
+    rx[1] = 0xefu;
+    setup_isr_manual(false);
+    submit_ok(&cmd);
+    j288_bus_on_tx_done(&bus);
+    j288_bus_on_rx(&bus, rx, sizeof rx);
+    TEST_ASSERT_EQUAL_INT(0, cb.calls);
+    TEST_ASSERT_EQUAL_INT(J288_BUS_WAIT_REPLY, j288_bus_state(&bus));
+    TEST_ASSERT_EQUAL_UINT32(0u, j288_bus_parser_stats(&bus)->frames);
+}
+
+/* Whole replies that are not ours, each in one call: with a bad CRC (counted), from another
+ * id (noted, the reply still awaited), then ours, taken and counted once by the parser. */
+static void test_isr_whole_replies_wrong_id_bad_crc_then_ours(void)
+{
+    j288_cmd_raw_t cmd = worked_cmd();
+    j288_reply_raw_t r7 = reply_for(7u, 7);
+    uint8_t other[J288_REPLY_LEN], bad[J288_REPLY_LEN];
+    fake_port_encode_reply(&r7, other);
+    memcpy(bad, WORKED_REPLY3, J288_REPLY_LEN);
+    bad[12] ^= 0x40u;
+    setup_isr_manual(false);
+    submit_ok(&cmd);
+    j288_bus_on_tx_done(&bus);
+    j288_bus_on_rx(&bus, bad, sizeof bad);
+    TEST_ASSERT_EQUAL_INT(0, cb.calls);
+    TEST_ASSERT_EQUAL_UINT32(1u, j288_bus_stats(&bus)->crc_errors);
+    j288_bus_on_rx(&bus, other, sizeof other);
+    TEST_ASSERT_EQUAL_INT(0, cb.calls);
+    TEST_ASSERT_EQUAL_UINT32(1u, j288_bus_stats(&bus)->wrong_id);
+    TEST_ASSERT_EQUAL_INT(J288_BUS_WAIT_REPLY, j288_bus_state(&bus));
+    j288_bus_on_rx(&bus, WORKED_REPLY3, J288_REPLY_LEN);
+    TEST_ASSERT_EQUAL_INT(1, cb.calls);
+    TEST_ASSERT_EQUAL_INT(J288_OK, cb.txn.result);
+    TEST_ASSERT_EQUAL_INT32(5215, cb.txn.reply.pos);
+    TEST_ASSERT_EQUAL_UINT32(2u, j288_bus_parser_stats(&bus)->frames); /* id 7's and ours */
+}
+
+/* The first whole reply after the transmit, from another id: noted, not taken. */
+static void test_isr_first_whole_reply_from_another_id(void)
+{
+    j288_cmd_raw_t cmd = worked_cmd();
+    j288_reply_raw_t r7 = reply_for(7u, 7);
+    uint8_t other[J288_REPLY_LEN];
+    fake_port_encode_reply(&r7, other);
+    setup_isr_manual(false);
+    submit_ok(&cmd);
+    j288_bus_on_tx_done(&bus);
+    j288_bus_on_rx(&bus, other, sizeof other);
+    TEST_ASSERT_EQUAL_INT(0, cb.calls);
+    TEST_ASSERT_EQUAL_UINT32(1u, j288_bus_stats(&bus)->wrong_id);
+    TEST_ASSERT_EQUAL_INT(J288_BUS_WAIT_REPLY, j288_bus_state(&bus));
+}
+
+/* Without advance_in_isr the event calls only record: the state moves at the next poll. */
+static void test_poll_mode_tx_done_waits_for_poll(void)
+{
+    j288_cmd_raw_t cmd = worked_cmd();
+    setup();
+    fp.poll_fn = NULL;
+    fp.txdone = FAKE_TXDONE_MANUAL;
+    submit_ok(&cmd);
+    j288_bus_on_tx_done(&bus);
+    TEST_ASSERT_EQUAL_INT(J288_BUS_TX, j288_bus_state(&bus));
+    j288_bus_poll(&bus, 0u);
+    TEST_ASSERT_EQUAL_INT(J288_BUS_WAIT_REPLY, j288_bus_state(&bus));
+}
+
 static void test_failure_ranking(void)
 {
     j288_cmd_raw_t cmd = lock_cmd(3u);
@@ -1865,6 +2046,16 @@ int main(void)
     RUN_TEST(test_advance_in_isr_chains_without_poll);
     RUN_TEST(test_advance_in_isr_with_inline_tx_done);
     RUN_TEST(test_isr_tx_done_after_deadline_times_out);
+    RUN_TEST(test_isr_tx_done_before_echo_waits_for_echo);
+    RUN_TEST(test_isr_spurious_tx_done_changes_nothing);
+    RUN_TEST(test_isr_estop_ends_at_tx_done);
+    RUN_TEST(test_isr_reply_before_tx_done_is_stale);
+    RUN_TEST(test_isr_reply_with_trailing_byte);
+    RUN_TEST(test_isr_whole_reply_after_partial);
+    RUN_TEST(test_isr_reply_with_bad_head_refused);
+    RUN_TEST(test_isr_whole_replies_wrong_id_bad_crc_then_ours);
+    RUN_TEST(test_isr_first_whole_reply_from_another_id);
+    RUN_TEST(test_poll_mode_tx_done_waits_for_poll);
     RUN_TEST(test_failure_ranking);
     RUN_TEST(test_noise_while_idle_is_not_echo);
     RUN_TEST(test_bytes_after_broadcast_in_same_poll);

@@ -490,6 +490,46 @@ static void test_estop_while_sweeping(void)
     TEST_ASSERT_EQUAL_INT(0, fp.lock_errors);
 }
 
+/* A sweep started while the stop waits for the transaction on the wire is refused, and the
+ * frame on the wire stays as it was sent: with echo on, its echo still matches (no collision),
+ * and the aborted transaction's frame is the command that was set. */
+static void test_start_refused_under_estop_leaves_the_frame_on_the_wire(void)
+{
+    static const uint8_t ids[1] = {1u};
+    j288_cmd_raw_t c = foc(1u, 4321);
+    j288_bus_config_t bc;
+    j288_sched_config_t sc;
+    memset(&bc, 0, sizeof bc);
+    memset(&sc, 0, sizeof sc);
+    bc.echo = true;
+    fake_port_init(&fp);
+    fp.echo = true;
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_bus_init(&bus, &fp.ops, &fp, &bc));
+    fake_port_attach(&fp, &bus);
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_sched_init(&sch, &bus, &sc));
+    fp.poll_fn = fake_port_poll_sched;
+    fp.poll_user = &sch;
+    add_servos(ids, 1u);
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_sched_set_cmd(&sch, &c));
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_sched_start_sweep(&sch, 0u));
+    fake_port_run_until(&fp, 10u * US); /* the command half sent, half its echo heard */
+    TEST_ASSERT_EQUAL_INT(J288_BUS_TX, j288_bus_state(&bus));
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_sched_estop(&sch, fake_port_now_us(&fp)));
+    TEST_ASSERT_EQUAL_INT(J288_ERR_BUSY, j288_sched_start_sweep(&sch, fake_port_now_us(&fp)));
+    fake_port_run_until(&fp, 2000u * US);
+    TEST_ASSERT_EQUAL_UINT32(2u, fp.nframes); /* the command, then the stop */
+    assert_frame_cmd(0u, &c);
+    TEST_ASSERT_EQUAL_UINT32(0u, j288_bus_stats(&bus)->collisions);
+    TEST_ASSERT_EQUAL_UINT32(1u, j288_bus_stats(&bus)->aborted);
+    TEST_ASSERT_EQUAL_UINT32(1u, j288_bus_stats(&bus)->estops);
+    /* the next sweep sends the lock estop made */
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_sched_start_sweep(&sch, fake_port_now_us(&fp)));
+    fake_port_run_until(&fp, 4000u * US);
+    TEST_ASSERT_EQUAL_UINT32(3u, fp.nframes);
+    TEST_ASSERT_EQUAL_UINT8(J288_MODE_LOCK, fp.servo[1].last_cmd.status);
+    TEST_ASSERT_EQUAL_UINT8(1u, fp.servo[1].last_cmd.id);
+}
+
 static void estop_on_fault(void *user, const j288_event_t *ev)
 {
     on_event(user, ev);
@@ -703,6 +743,7 @@ int main(void)
     RUN_TEST(test_wrong_id_and_crc_in_slot_stats);
     RUN_TEST(test_collision_in_slot_stats);
     RUN_TEST(test_estop_while_sweeping);
+    RUN_TEST(test_start_refused_under_estop_leaves_the_frame_on_the_wire);
     RUN_TEST(test_estop_from_an_event_callback);
     RUN_TEST(test_estop_from_on_sweep_ends_continuous_sweeps);
     RUN_TEST(test_isr_sweeps_without_lock_ops);
