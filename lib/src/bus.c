@@ -757,19 +757,6 @@ int j288_bus_submit(j288_bus_t *bus, const j288_cmd_raw_t *cmd, uint32_t now_us,
     return err;
 }
 
-int j288_bus_submit_frame(j288_bus_t *bus, const uint8_t frame[J288_CMD_LEN], uint8_t id,
-                          uint32_t now_us, j288_bus_done_fn done, void *user)
-{
-    j288_bus_lock(bus);
-    if (!j288_bus_accepts(bus)) {
-        j288_bus_unlock(bus);
-        return J288_ERR_BUSY;
-    }
-    accept(bus, frame, id, now_us, done, user); /* sent from where it is */
-    j288_bus_unlock(bus);
-    return J288_OK;
-}
-
 void j288_bus_poll(j288_bus_t *bus, uint32_t now_us)
 {
     if (bus == NULL) {

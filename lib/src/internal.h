@@ -252,14 +252,6 @@ static inline bool j288_bus_accepts(const j288_bus_t *bus)
 void j288_bus_accept_frame(j288_bus_t *bus, const uint8_t *frame, uint8_t id, uint32_t now_us,
                            j288_bus_done_fn done, void *user);
 
-/* j288_bus_submit() for a command already encoded and checked (the scheduler keeps each
- * slot's frame): frame (J288_CMD_LEN bytes, addressed to id, CRC in place) is sent from where
- * it is, for every attempt and the echo check, so it must stay untouched until the
- * transaction's completion call. Same results and effects as j288_bus_submit() with that
- * command; bus and frame must not be NULL. */
-int j288_bus_submit_frame(j288_bus_t *bus, const uint8_t frame[J288_CMD_LEN], uint8_t id,
-                          uint32_t now_us, j288_bus_done_fn done, void *user);
-
 /* ---- parser */
 
 /* j288_parser_reset() for the bus, which owns its parser: drop a partial frame. */
