@@ -23,6 +23,7 @@
 
 #include "../target/icount.h"
 #include "crc_unit_model.h"
+#include "../support/worked_cmd.h"
 
 #ifndef ITERATIONS
 #define ITERATIONS 300u
@@ -338,22 +339,9 @@ FLOOR_ENTRY void floor_on_timer(void)
 
 /* ---- rows */
 
-static j288_cmd_raw_t bench_cmd(void)
-{
-    j288_cmd_raw_t cmd;
-    memset(&cmd, 0, sizeof cmd);
-    cmd.id = 3u;
-    cmd.status = J288_MODE_FOC;
-    cmd.watchdog = true;
-    cmd.pos = 5215;
-    cmd.kp = 1280;
-    cmd.kd = 12800;
-    return cmd;
-}
-
 static uint32_t run_floor_codec(bool with_unit)
 {
-    j288_cmd_raw_t cmd = bench_cmd();
+    j288_cmd_raw_t cmd = worked_cmd();
     j288_reply_raw_t r;
     uint32_t frame[5];
     uint32_t i, t0, t1;
@@ -383,7 +371,7 @@ static uint32_t run_floor_engine(void)
     uint8_t id;
     memset(&fl, 0, sizeof fl);
     for (id = 0u; id < J288_MAX_SERVOS; id++) {
-        fl.slot[id].cmd = bench_cmd();
+        fl.slot[id].cmd = worked_cmd();
         fl.slot[id].cmd.id = id;
     }
     fl.id = J288_MAX_ID;
@@ -405,7 +393,7 @@ static uint32_t run_floor_engine(void)
 static uint32_t run_codec(const j288_crc_t *crc)
 {
     j288_parser_t parser;
-    j288_cmd_raw_t cmd = bench_cmd();
+    j288_cmd_raw_t cmd = worked_cmd();
     j288_reply_raw_t r;
     uint8_t frame[J288_CMD_LEN];
     uint32_t i, t0, t1;
@@ -427,7 +415,7 @@ static uint32_t run_codec(const j288_crc_t *crc)
 
 static uint32_t run_bus_poll(void)
 {
-    j288_cmd_raw_t cmd = bench_cmd();
+    j288_cmd_raw_t cmd = worked_cmd();
     uint32_t i, t0, t1;
     (void)j288_bus_init(&bus, &port, NULL, NULL);
     t0 = icount_now();
@@ -462,7 +450,7 @@ static uint32_t run_sched_isr(bool new_cmds)
     (void)j288_bus_init(&bus, &port, NULL, &bc);
     (void)j288_sched_init(&sch, &bus, &sc);
     for (id = 0u; id < J288_MAX_SERVOS; id++) {
-        j288_cmd_raw_t cmd = bench_cmd();
+        j288_cmd_raw_t cmd = worked_cmd();
         cmd.id = id;
         (void)j288_sched_enable(&sch, id, true);
         (void)j288_sched_set_cmd(&sch, &cmd);
@@ -472,7 +460,7 @@ static uint32_t run_sched_isr(bool new_cmds)
     t0 = icount_now();
     for (i = 0u; i < ITERATIONS; i++) {
         if (new_cmds) {
-            j288_cmd_raw_t cmd = bench_cmd();
+            j288_cmd_raw_t cmd = worked_cmd();
             cmd.id = (uint8_t)((last_id == J288_MAX_ID) ? 0u : last_id + 1u);
             cmd.pos = (int32_t)(i & 7u);
             (void)j288_sched_set_cmd(&sch, &cmd);
@@ -587,7 +575,7 @@ int main(void)
         memcpy((uint8_t *)floor_replies[id] + 2, replies[id], J288_REPLY_LEN);
     }
     {
-        j288_cmd_raw_t cmd = bench_cmd();
+        j288_cmd_raw_t cmd = worked_cmd();
         uint8_t f[J288_CMD_LEN];
         (void)j288_cmd_encode(&cmd, f, &soft_engine);
         bench_unit_answer[0] = j288_frame_crc_field(f, J288_CMD_LEN);
