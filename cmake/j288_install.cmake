@@ -15,8 +15,8 @@ endif()
 if(TARGET j288_shared)
     install(TARGETS j288_shared LIBRARY DESTINATION "${CMAKE_INSTALL_LIBDIR}")
     install(FILES "${PROJECT_SOURCE_DIR}/port/linux/j288_linux.h"
-                  "${PROJECT_SOURCE_DIR}/port/linux/j288_robot.h"
-                  "${PROJECT_SOURCE_DIR}/port/linux/j288_robot_config.h"
+                  "${PROJECT_SOURCE_DIR}/host/j288_robot.h"
+                  "${PROJECT_SOURCE_DIR}/host/j288_robot_config.h"
             DESTINATION "${CMAKE_INSTALL_INCLUDEDIR}/j288")
     # Relative to ${pcfiledir}: the file holds wherever the prefix is installed (--prefix,
     # DESTDIR) or moved.

@@ -15,9 +15,10 @@ target_link_libraries(j288_linux PUBLIC j288::j288)
 
 find_library(J288_YAML_LIB yaml)
 find_path(J288_YAML_INCLUDE yaml.h)
-set(_j288_robot_sources "${PROJECT_SOURCE_DIR}/port/linux/j288_robot.c"
-                        "${PROJECT_SOURCE_DIR}/port/linux/j288_robot_config.c")
+set(_j288_robot_sources "${PROJECT_SOURCE_DIR}/host/j288_robot.c"
+                        "${PROJECT_SOURCE_DIR}/host/j288_robot_config.c")
 add_library(j288_robot STATIC ${_j288_robot_sources})
+target_include_directories(j288_robot PUBLIC "${PROJECT_SOURCE_DIR}/host")
 target_link_libraries(j288_robot PUBLIC j288_linux)
 # The installed package's j288::robot is libj288.so; in the tree, the static runner.
 add_library(j288::robot ALIAS j288_robot)
@@ -26,7 +27,7 @@ file(GLOB _j288_shared_sources CONFIGURE_DEPENDS "${PROJECT_SOURCE_DIR}/lib/src/
 add_library(j288_shared SHARED ${_j288_shared_sources} "${PROJECT_SOURCE_DIR}/port/linux/j288_linux.c"
             ${_j288_robot_sources})
 target_include_directories(j288_shared PUBLIC "${PROJECT_SOURCE_DIR}/lib/include"
-                           "${PROJECT_SOURCE_DIR}/port/linux")
+                           "${PROJECT_SOURCE_DIR}/port/linux" "${PROJECT_SOURCE_DIR}/host")
 get_target_property(_j288_defs j288 INTERFACE_COMPILE_DEFINITIONS)
 target_compile_definitions(j288_shared PUBLIC ${_j288_defs})
 set_target_properties(j288_shared PROPERTIES OUTPUT_NAME j288 VERSION ${PROJECT_VERSION}

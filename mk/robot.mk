@@ -1,18 +1,18 @@
-# The multi-bus runner (port/linux/j288_robot.c) and its tests.
+# The multi-bus runner (host/j288_robot.c) and its tests.
 #   $(ROBOT_OBJ)       the runner; link with $(CONFIG_OBJ), $(LINUX_A), $(LIB_A) and the yaml libs
 #   test/linux/test_robot.c   several j288-sim buses from one loop (HOST_TESTS)
 #   test/e2e/cli_robot.sh     j288 --config FILE log|status|hold|stop (TEST_SCRIPTS)
-ROBOT_OBJ := $(OBJ)/port/linux/j288_robot.o
-ROBOT_HDR := port/linux/j288_robot.h port/linux/j288_robot_config.h port/linux/j288_linux.h
+ROBOT_OBJ := $(OBJ)/host/j288_robot.o
+ROBOT_HDR := host/j288_robot.h host/j288_robot_config.h port/linux/j288_linux.h
 
-$(ROBOT_OBJ): port/linux/j288_robot.c $(ROBOT_HDR) $(LIB_HDR)
+$(ROBOT_OBJ): host/j288_robot.c $(ROBOT_HDR) $(LIB_HDR)
 	@mkdir -p $(@D)
-	$(CC) $(LINUX_CPPFLAGS) $(CFLAGS_COMMON) -c $< -o $@
+	$(CC) $(HOST_CPPFLAGS) $(CFLAGS_COMMON) -c $< -o $@
 
 ROBOT_TEST := $(BUILD)/test/test_robot
 $(OBJ)/test/linux/test_robot.o: test/linux/test_robot.c $(ROBOT_HDR) $(TEST_HDR) $(UNITY)/unity.c
 	@mkdir -p $(@D)
-	$(CC) $(TEST_CPPFLAGS) -Iport/linux -DJ288_SIM_DEFAULT='"$(SIM_BIN)"' $(CFLAGS_COMMON) -c $< -o $@
+	$(CC) $(TEST_CPPFLAGS) -Iport/linux -Ihost -DJ288_SIM_DEFAULT='"$(SIM_BIN)"' $(CFLAGS_COMMON) -c $< -o $@
 
 $(ROBOT_TEST): $(OBJ)/test/linux/test_robot.o $(SIM_PROCESS_OBJ) $(ROBOT_OBJ) $(CONFIG_OBJ) $(UNITY_OBJ) $(LINUX_A) $(LIB_A) \
     $(YAML_ENV)

@@ -28,7 +28,7 @@ $(CLI_TEST): $(OBJ)/test/cli/test_cli_helpers.o $(CLI_CAPTURE_OBJ) \
 # The tool's robot config and joint selection (cli_joint.c), with the bus plumbing it calls.
 CLI_JOINT_TEST := $(BUILD)/test/test_cli_joint
 $(OBJ)/test/cli/test_cli_joint.o: test/cli/test_cli_joint.c $(J288_HDR) $(TEST_HDR) $(UNITY)/unity.c \
-    port/linux/j288_robot_config.h $(YAML_ENV)
+    host/j288_robot_config.h $(YAML_ENV)
 	@mkdir -p $(@D)
 	$(CC) $(TEST_CPPFLAGS) -Itools/j288 $(TOOL_CPPFLAGS) $(call yaml_var,YAML_CFLAGS) $(CFLAGS_COMMON) -c $< -o $@
 
@@ -84,7 +84,7 @@ $(foreach n,$(FUZZ_NAMES),$(eval $(BUILD)/test/fuzz_replay_$(n): $(FUZZ_EXTRA_$(
 LINUX_PORT_TEST := $(BUILD)/test/test_linux_port
 $(OBJ)/test/linux/%.o: test/linux/%.c port/linux/j288_linux.h $(TEST_HDR) $(UNITY)/unity.c
 	@mkdir -p $(@D)
-	$(CC) $(TEST_CPPFLAGS) -Iport/linux -DJ288_SIM_DEFAULT='"$(SIM_BIN)"' $(CFLAGS_COMMON) -c $< -o $@
+	$(CC) $(TEST_CPPFLAGS) -Iport/linux -Ihost -DJ288_SIM_DEFAULT='"$(SIM_BIN)"' $(CFLAGS_COMMON) -c $< -o $@
 
 # j288-sim as a child process, for the tests that drive it (test/linux/sim_process.c).
 SIM_PROCESS_OBJ := $(OBJ)/test/linux/sim_process.o
@@ -95,10 +95,10 @@ $(LINUX_PORT_TEST): $(OBJ)/test/linux/test_linux_port.o $(SIM_PROCESS_OBJ) $(UNI
 	$(CC) $(CFLAGS_COMMON) $^ -o $@ $(LDFLAGS_COMMON) -lm
 
 CONFIG_TEST := $(BUILD)/test/test_robot_config
-$(OBJ)/test/linux/test_robot_config.o: test/linux/test_robot_config.c port/linux/j288_robot_config.h \
+$(OBJ)/test/linux/test_robot_config.o: test/linux/test_robot_config.c host/j288_robot_config.h \
     $(TEST_HDR) $(UNITY)/unity.c $(YAML_ENV)
 	@mkdir -p $(@D)
-	$(CC) $(TEST_CPPFLAGS) -Iport/linux $(call yaml_var,YAML_CFLAGS) $(CFLAGS_COMMON) -c $< -o $@
+	$(CC) $(TEST_CPPFLAGS) -Iport/linux -Ihost $(call yaml_var,YAML_CFLAGS) $(CFLAGS_COMMON) -c $< -o $@
 
 $(CONFIG_TEST): $(OBJ)/test/linux/test_robot_config.o $(CONFIG_OBJ) $(UNITY_OBJ) $(LIB_A)
 	@mkdir -p $(@D)

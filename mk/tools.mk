@@ -9,6 +9,7 @@
 .PHONY: linux cli sim demo vectors
 
 LINUX_CPPFLAGS := $(CPPFLAGS_LIB) -Iport/linux
+HOST_CPPFLAGS := $(LINUX_CPPFLAGS) -Ihost
 $(OBJ)/port/linux/%.o: port/linux/%.c port/linux/j288_linux.h $(LIB_HDR)
 	@mkdir -p $(@D)
 	$(CC) $(LINUX_CPPFLAGS) $(CFLAGS_COMMON) -c $< -o $@
@@ -19,15 +20,15 @@ $(LINUX_A): $(OBJ)/port/linux/j288_linux.o
 	$(AR) rcs $@ $^
 
 # The tools are POSIX programs (signals, realpath, popen for gnuplot); lib/ stays pure C99.
-TOOL_CPPFLAGS := $(LINUX_CPPFLAGS) -D_XOPEN_SOURCE=700
+TOOL_CPPFLAGS := $(HOST_CPPFLAGS) -D_XOPEN_SOURCE=700
 J288_SRC := $(sort $(wildcard tools/j288/*.c))
 J288_HDR := $(wildcard tools/j288/*.h)
 $(OBJ)/tools/j288/%.o: tools/j288/%.c $(J288_HDR) $(LIB_HDR) port/linux/j288_linux.h \
-    port/linux/j288_robot_config.h
+    host/j288_robot_config.h
 	@mkdir -p $(@D)
 	$(CC) $(TOOL_CPPFLAGS) $(CFLAGS_COMMON) -c $< -o $@
 
-$(J288_BIN): $(J288_SRC:%.c=$(OBJ)/%.o) $(OBJ)/port/linux/j288_robot_config.o $(LINUX_A) $(LIB_A)
+$(J288_BIN): $(J288_SRC:%.c=$(OBJ)/%.o) $(OBJ)/host/j288_robot_config.o $(LINUX_A) $(LIB_A)
 	@mkdir -p $(@D)
 	$(CC) $(CFLAGS_COMMON) $^ -o $@ $(LDFLAGS_COMMON) $(call yaml_var,YAML_LIBS) -lm
 
@@ -41,20 +42,20 @@ $(SIM_BIN): $(SIM_MODEL_OBJ) $(OBJ)/tools/j288-sim/sim_main.o $(LIB_A)
 	@mkdir -p $(@D)
 	$(CC) $(CFLAGS_COMMON) $^ -o $@ $(LDFLAGS_COMMON) -lm
 
-# The robot config reader (port/linux/j288_robot_config.c, not in the archive: it needs
+# The robot config reader (host/j288_robot_config.c, not in the archive: it needs
 # libyaml). scripts/libyaml.sh finds libyaml (the system's, else Debian's package fetched into
 # $(BUILD)/libyaml) and writes the flags into $(YAML_ENV); without it the reader builds as
 # stubs that say so. Users: $(CONFIG_OBJ), and $(call yaml_var,YAML_LIBS) in a recipe.
 YAML_ENV := $(BUILD)/libyaml/libyaml.env
 yaml_var = $$(sed -n 's/^$(1)=//p' $(YAML_ENV))
-CONFIG_OBJ := $(OBJ)/port/linux/j288_robot_config.o
+CONFIG_OBJ := $(OBJ)/host/j288_robot_config.o
 
 $(YAML_ENV):
 	bash scripts/libyaml.sh $(BUILD)/libyaml "$(CC)"
 
-$(CONFIG_OBJ): port/linux/j288_robot_config.c port/linux/j288_robot_config.h $(YAML_ENV)
+$(CONFIG_OBJ): host/j288_robot_config.c host/j288_robot_config.h $(YAML_ENV)
 	@mkdir -p $(@D)
-	$(CC) $(LINUX_CPPFLAGS) $(call yaml_var,YAML_CFLAGS) $(CFLAGS_COMMON) -c $< -o $@
+	$(CC) $(HOST_CPPFLAGS) $(call yaml_var,YAML_CFLAGS) $(CFLAGS_COMMON) -c $< -o $@
 
 EXAMPLE_LINUX := $(BIN)/linux-status
 $(OBJ)/examples/linux/%.o: examples/linux/%.c port/linux/j288_linux.h $(LIB_HDR)

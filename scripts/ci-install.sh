@@ -9,7 +9,7 @@ packages=(
     make gcc clang-14 coreutils
     gnuplot-nox                     # make demo / cli_bus.sh plot test (PNG); CI treats it as required
     cmake                           # scripts/check-consumers.sh
-    libyaml-dev                     # robot config reader (port/linux/j288_robot_config.c, test_robot_config)
+    libyaml-dev                     # robot config reader (host/j288_robot_config.c, test_robot_config)
     gcc-arm-none-eabi libnewlib-arm-none-eabi  # make arm, test-target, size, check-symbols
     qemu-system-arm                 # make test-target, bench-target, bench-bus-target (Cortex-M)
     # hardening (mk/hardening.mk)

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Find libyaml for the robot config reader (port/linux/j288_robot_config.c) and write what the build
+# Find libyaml for the robot config reader (host/j288_robot_config.c) and write what the build
 # needs into DIR/libyaml.env, one VAR=value per line (read by mk/tools.mk and mk/tests.mk):
 #   YAML_FOUND=1 or 0
 #   YAML_CFLAGS=-DJ288_HAVE_LIBYAML [-I<include dir>]   (empty when not found)

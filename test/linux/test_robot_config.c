@@ -1,4 +1,4 @@
-/* Unit tests of the robot config reader and writer (port/linux/j288_robot_config.c). */
+/* Unit tests of the robot config reader and writer (host/j288_robot_config.c). */
 #define _XOPEN_SOURCE 700 /* mkdtemp, symlink, readlink under -std=c99 */
 
 #include "unity.h"

@@ -1,5 +1,5 @@
 /* `j288 --config robot.yaml log|status|hold|stop`: every bus and joint of a robot config from
- * one loop (port/linux/j288_robot.h), when no --id or --joint picks one servo. */
+ * one loop (host/j288_robot.h), when no --id or --joint picks one servo. */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
