@@ -388,7 +388,12 @@ static bool add_i32(int32_t a, int32_t b, int32_t *sum)
     if ((((ua ^ us) & (ub ^ us)) & 0x80000000u) != 0u) {
         return false;
     }
-    *sum = (us <= (uint32_t)INT32_MAX) ? (int32_t)us : ((int32_t)(us - 0x80000000u) - INT32_MAX - 1);
+    if (us <= (uint32_t)INT32_MAX) {
+        *sum = (int32_t)us;
+    } else {
+        uint32_t below = us - 0x80000000u; /* us - 2^32 = below - 2^31, without overflow */
+        *sum = (int32_t)below - INT32_MAX - 1;
+    }
     return true;
 }
 

@@ -12,21 +12,19 @@
 
 typedef enum { Q_TORQUE, Q_SPEED, Q_POS, Q_KP, Q_KD } quantity_t;
 
-/* LSB per SI unit, by side and quantity. Rotor angle = N * output angle, rotor torque =
- * output torque / N, rotor gains = output gains / N^2. A table of constants: the conversion
- * of a whole command looks each factor up instead of computing it (a division each on the
- * output side). */
-static const j288_real_t lsb_per_unit_tab[2][5] = {
-    {(j288_real_t)J288_SCALE_TORQUE, (j288_real_t)J288_SCALE_SPEED,
-     (j288_real_t)J288_SCALE_POS, (j288_real_t)J288_SCALE_KP, (j288_real_t)J288_SCALE_KD},
-    {(j288_real_t)J288_SCALE_TORQUE / N_RATIO, (j288_real_t)J288_SCALE_SPEED * N_RATIO,
-     (j288_real_t)J288_SCALE_POS * N_RATIO, (j288_real_t)J288_SCALE_KP / (N_RATIO * N_RATIO),
-     (j288_real_t)J288_SCALE_KD / (N_RATIO * N_RATIO)}};
-
-/* side is J288_SIDE_ROTOR or J288_SIDE_OUTPUT (checked by every caller). */
+/* LSB per SI unit on the requested side (J288_SIDE_ROTOR or J288_SIDE_OUTPUT, checked by
+ * every caller). Rotor angle = N * output angle, rotor torque = output torque / N, rotor
+ * gains = output gains / N^2. A table of constants: converting a whole command looks each
+ * factor up instead of computing it (a division each on the output side). */
 static j288_real_t lsb_per_unit(quantity_t q, j288_side_t side)
 {
-    return lsb_per_unit_tab[(side == J288_SIDE_OUTPUT) ? 1 : 0][q];
+    static const j288_real_t k[2][5] = {
+        {(j288_real_t)J288_SCALE_TORQUE, (j288_real_t)J288_SCALE_SPEED,
+         (j288_real_t)J288_SCALE_POS, (j288_real_t)J288_SCALE_KP, (j288_real_t)J288_SCALE_KD},
+        {(j288_real_t)J288_SCALE_TORQUE / N_RATIO, (j288_real_t)J288_SCALE_SPEED * N_RATIO,
+         (j288_real_t)J288_SCALE_POS * N_RATIO, (j288_real_t)J288_SCALE_KP / (N_RATIO * N_RATIO),
+         (j288_real_t)J288_SCALE_KD / (N_RATIO * N_RATIO)}};
+    return k[(side == J288_SIDE_OUTPUT) ? 1 : 0][q];
 }
 
 static bool side_ok(j288_side_t side)
