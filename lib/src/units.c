@@ -157,7 +157,8 @@ static J288_INLINE_HOT int convert(j288_real_t si, quantity_t q, j288_side_t sid
         return J288_OK;
     }
     v = si * lsb_per_unit(q, side);
-    if (!(is_gain ? round_gain(v, hi, &r) : round_into(v, lo, hi, &r))) { /* also NaN, which fails the window */
+    /* NaN fails every window: it is told apart only here */
+    if (!(is_gain ? round_gain(v, hi, &r) : round_into(v, lo, hi, &r))) {
         if (si != si) {
             return J288_ERR_NOT_FINITE;
         }
