@@ -27,8 +27,11 @@
 #endif
 
 /* A small function on a hot path that has more than one caller: inlined in each (the
- * compiler would otherwise keep one out-of-line copy and a call). Only a hint. */
-#if defined(__GNUC__)
+ * compiler would otherwise keep one out-of-line copy and a call). Only a hint, and only when
+ * optimising: at -O0 (make coverage, debugging) forced inlining speeds nothing and would
+ * multiply the branches that coverage counts, each inlined copy of a test on a constant
+ * argument counting as a branch taken one way. */
+#if defined(__GNUC__) && defined(__OPTIMIZE__)
 #define J288_INLINE_HOT inline __attribute__((always_inline))
 #else
 #define J288_INLINE_HOT inline
