@@ -27,7 +27,7 @@ FUZZ_CFLAGS := -std=c99 -g -O1 -fsanitize=fuzzer,address,undefined -fno-sanitize
     -Ilib/include -Itest/fuzz -Itest/support
 FUZZ_BINS := $(FUZZ_NAMES:%=$(BUILD)/fuzz/fuzz_%)
 
-$(BUILD)/fuzz/fuzz_%: test/fuzz/fuzz_%.c $(LIB_SRC) $(TEST_HDR) $(wildcard test/fuzz/*.h tools/j288/*.[ch])
+$(BUILD)/fuzz/fuzz_%: test/fuzz/fuzz_%.c $(LIB_SRC) $(TEST_HDR) $(wildcard test/fuzz/*.h tools/j288/*.[ch] host/j288_number.[ch])
 	@mkdir -p $(@D)
 	$(FUZZ_CC) $(FUZZ_CFLAGS) $(FUZZ_CPPFLAGS_$*) $< $(FUZZ_EXTRA_$*) $(LIB_SRC) -o $@ -lm
 
