@@ -137,6 +137,8 @@ TEST_SCRIPTS += test/e2e/cli_offline.sh test/e2e/cli_bus.sh tools/vectors/check-
     test/e2e/sim_cli.sh test/e2e/example_linux.sh test/abi/check-abi.sh
 # The joint frame end to end against the simulator's truth (the tool, the config, the sim).
 TEST_SCRIPTS += test/e2e/joint_sim.sh
+# j288 top on a terminal (tmux: capture-pane, send-keys) and through a pipe.
+TEST_SCRIPTS += test/e2e/cli_top.sh
 # The scripts' own process helpers (whom they signal, what their cleanup removes).
 TEST_SCRIPTS += test/e2e/lib_sim_check.sh
 TEST_DEPS += $(J288_BIN) $(SIM_BIN) $(EXAMPLE_LINUX) $(LIB_A)
