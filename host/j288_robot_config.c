@@ -1235,7 +1235,6 @@ static int replace_file(const char *real, const char *shown, const char *data, s
         (size_t)snprintf(tmp, sizeof tmp, "%s/.%s" TEMP_TAG "%ld.XXXXXX", dir, base,
                          (long)getpid()) >= sizeof tmp)
         return set_error(err, errlen, "%s: path too long", shown);
-    remove_stale_temps(dir, base);
     fd = mkstemp(tmp);
     if (fd < 0)
         return set_error(err, errlen, "%s: cannot create a file beside it: %s", shown,
@@ -1276,11 +1275,15 @@ int j288_robot_config_write_joint(const char *path, const char *joint, const j28
     char *text = NULL, *out;
     size_t len, outlen, outcap;
     int rc;
+    char dir[PATH_MAX];
+    const char *base;
     if (j288_robot_config_check_writable(path, err, errlen) != 0)
         return -1;
     /* The file a symlink points at is the one to replace, not the link. */
     if (realpath(path, real) == NULL || stat(real, &st) != 0)
         return set_error(err, errlen, "%s: %s", path, strerror(errno));
+    if (split_path(real, dir, sizeof dir, &base) == 0)
+        remove_stale_temps(dir, base); /* whatever this write-back's own outcome */
     if (read_file(real, &text, &len, err, errlen) != 0)
         return -1;
     /* Each added line is at most 160 bytes (indentation up to 100, then key and value). */

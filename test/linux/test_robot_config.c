@@ -11,6 +11,7 @@
 #include <string.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
+#include <time.h>
 #include <unistd.h>
 
 #include "j288_robot_config.h"
@@ -797,6 +798,55 @@ static void test_file_stale_temp_removed(void)
     TEST_ASSERT_EQUAL_INT(0, unlink(path));
 }
 
+/* A write-back killed at any point (SIGKILL: nothing runs after it) leaves the config whole,
+ * old or new, and the next write-back leaves no temporary file, wherever the kill landed.
+ * The kills land where they land (no timing is asserted); each round waits until the child
+ * has replaced the file at least once, so that it is killed while writing on and on. */
+static void test_file_killed_write_back(void)
+{
+    static char big[600000];
+    char path[128];
+    size_t n = 0, round;
+    j288_robot_config_update_t u = phase_upd(0.25);
+    (void)snprintf(path, sizeof path, "%s/robot.yaml", g_dir);
+    n += (size_t)snprintf(big, sizeof big, "joints:\n  - name: a\n    id: 1\n    phase: 0.5\n");
+    while (n + 64u < sizeof big) /* a large file: the write takes a while */
+        n += (size_t)snprintf(big + n, sizeof big - n, "# padding padding padding padding\n");
+    for (round = 0; round < 10u; round++) {
+        struct stat st0, st;
+        unsigned waited;
+        pid_t child;
+        write_text(path, big);
+        TEST_ASSERT_EQUAL_INT(0, stat(path, &st0));
+        child = fork();
+        TEST_ASSERT_TRUE(child >= 0);
+        if (child == 0) {
+            char err[J288_ROBOT_CONFIG_ERROR_MAX];
+            for (;;) {
+                u.phase = (u.phase == 0.25) ? -0.25 : 0.25;
+                (void)j288_robot_config_write_joint(path, "a", &u, err, sizeof err);
+            }
+        }
+        /* Until the child has replaced the file once (a new inode), at most 60 s. */
+        for (waited = 0; waited < 60000u; waited++) {
+            if (stat(path, &st) == 0 && st.st_ino != st0.st_ino)
+                break;
+            const struct timespec ms = {0, 1000000L};
+            (void)nanosleep(&ms, NULL);
+        }
+        TEST_ASSERT_EQUAL_INT(0, kill(child, SIGKILL));
+        TEST_ASSERT_EQUAL_INT(child, waitpid(child, NULL, 0));
+        TEST_ASSERT_TRUE_MESSAGE(st.st_ino != st0.st_ino, "the child never replaced the file");
+        TEST_ASSERT_EQUAL_INT_MESSAGE(0, j288_robot_config_load(path, &g_cfg, g_err, sizeof g_err),
+                                      g_err);
+        TEST_ASSERT_EQUAL_DOUBLE(0.25, fabs(g_cfg.joint[0].phase)); /* one write or another */
+        TEST_ASSERT_EQUAL_INT_MESSAGE(
+            0, j288_robot_config_write_joint(path, "a", &u, g_err, sizeof g_err), g_err);
+        TEST_ASSERT_EQUAL_UINT(1, files_in_dir());
+    }
+    TEST_ASSERT_EQUAL_INT(0, unlink(path));
+}
+
 /* The example every doc points at is a file this reader takes. */
 static void test_example_loads(void)
 {
@@ -853,6 +903,7 @@ int main(void)
     RUN_TEST(test_file_relative_port);
     RUN_TEST(test_file_read_only);
     RUN_TEST(test_file_stale_temp_removed);
+    RUN_TEST(test_file_killed_write_back);
     RUN_TEST(test_example_loads);
     RUN_TEST(test_file_too_large);
     (void)rmdir(g_dir);
