@@ -280,20 +280,34 @@ static bool is_null(const yaml_node_t *n)
     return false;
 }
 
+/* s for a message: its first 40 bytes, control characters (a folded scalar's line breaks)
+ * as '?', "..." when cut: a message stays one line whatever the file holds. */
+static const char *printable(const char *s, char *buf, size_t cap)
+{
+    size_t i, n = 0;
+    for (i = 0; s[i] != '\0' && i < 40u && n + 4u < cap; i++)
+        buf[n++] = ((unsigned char)s[i] < 0x20u || s[i] == 0x7F) ? '?' : s[i];
+    if (s[i] != '\0' && n + 4u <= cap) {
+        memcpy(buf + n, "...", 3);
+        n += 3u;
+    }
+    buf[n] = '\0';
+    return buf;
+}
+
 /* What a node is, for "expected X, got Y". */
 static const char *describe(const yaml_node_t *n, char *buf, size_t cap)
 {
+    char text[48];
     if (n->type == YAML_MAPPING_NODE)
         return "a mapping";
     if (n->type == YAML_SEQUENCE_NODE)
         return "a list";
     if (is_null(n))
         return "nothing";
-    if (n->data.scalar.style != YAML_PLAIN_SCALAR_STYLE) {
-        (void)snprintf(buf, cap, "the quoted text '%.40s'", scalar(n));
-        return buf;
-    }
-    (void)snprintf(buf, cap, "'%.40s'%s", scalar(n), strlen(scalar(n)) > 40u ? "..." : "");
+    (void)snprintf(buf, cap, "%s'%s'",
+                   n->data.scalar.style != YAML_PLAIN_SCALAR_STYLE ? "the quoted text " : "",
+                   printable(scalar(n), text, sizeof text));
     return buf;
 }
 
@@ -362,6 +376,7 @@ static int get_bool(ctx_t *x, const yaml_node_t *v, const char *key, bool *out)
 static int get_text(ctx_t *x, const yaml_node_t *v, const char *key, bool is_name, char *buf,
                     size_t cap)
 {
+    char shown[48];
     size_t i, n;
     if (v->type != YAML_SCALAR_NODE || is_null(v))
         return expected(x, v, key, is_name ? "a name" : "text");
@@ -371,7 +386,8 @@ static int get_text(ctx_t *x, const yaml_node_t *v, const char *key, bool is_nam
     for (i = 0; i < n; i++) {
         unsigned char ch = v->data.scalar.value[i];
         if (ch < 0x20u || ch == 0x7Fu || (is_name && ch == ' '))
-            return fail(x, line_of(v), "%s: '%s' has a %s", key, scalar(v),
+            return fail(x, line_of(v), "%s: '%s' has a %s", key,
+                        printable(scalar(v), shown, sizeof shown),
                         ch == ' ' ? "blank" : "control character");
     }
     memcpy(buf, v->data.scalar.value, n);
@@ -383,6 +399,7 @@ static int get_text(ctx_t *x, const yaml_node_t *v, const char *key, bool is_nam
 static int check_keys(ctx_t *x, const yaml_node_t *m, const char *const *allowed, size_t nallowed,
                       const char *allowed_text)
 {
+    char shown[48];
     yaml_node_pair_t *p, *q;
     for (p = m->data.mapping.pairs.start; p < m->data.mapping.pairs.top; p++) {
         yaml_node_t *k = node_at(x, p->key);
@@ -394,10 +411,12 @@ static int check_keys(ctx_t *x, const yaml_node_t *m, const char *const *allowed
         for (i = 0; i < nallowed; i++)
             known = known || strcmp(scalar(k), allowed[i]) == 0;
         if (!known)
-            return fail(x, line_of(k), "unknown key '%.40s' (known: %s)", scalar(k), allowed_text);
+            return fail(x, line_of(k), "unknown key '%s' (known: %s)",
+                        printable(scalar(k), shown, sizeof shown), allowed_text);
         for (q = m->data.mapping.pairs.start; q < p; q++)
             if (strcmp(scalar(node_at(x, q->key)), scalar(k)) == 0)
-                return fail(x, line_of(k), "'%s' given twice (first on line %zu)", scalar(k),
+                return fail(x, line_of(k), "'%s' given twice (first on line %zu)",
+                            printable(scalar(k), shown, sizeof shown),
                             line_of(node_at(x, q->key)));
     }
     return 0;
@@ -421,10 +440,14 @@ static const char *peek_name(ctx_t *x, const yaml_node_t *m)
     for (p = m->data.mapping.pairs.start; p < m->data.mapping.pairs.top; p++) {
         yaml_node_t *k = node_at(x, p->key);
         yaml_node_t *v = node_at(x, p->value);
-        if (k->type == YAML_SCALAR_NODE && strcmp(scalar(k), "name") == 0 &&
-            v->type == YAML_SCALAR_NODE && v->data.scalar.length < J288_ROBOT_CONFIG_NAME_MAX &&
-            strlen(scalar(v)) == v->data.scalar.length)
-            return scalar(v);
+        size_t i, n;
+        if (k->type != YAML_SCALAR_NODE || strcmp(scalar(k), "name") != 0 ||
+            v->type != YAML_SCALAR_NODE || v->data.scalar.length >= J288_ROBOT_CONFIG_NAME_MAX)
+            continue;
+        for (i = 0, n = v->data.scalar.length; i < n; i++)
+            if (v->data.scalar.value[i] < 0x20u || v->data.scalar.value[i] == 0x7Fu)
+                return NULL; /* get_text() will say what is wrong with it */
+        return scalar(v);
     }
     return NULL;
 }
@@ -805,6 +828,7 @@ static int check_event(ctx_t *x, const yaml_event_t *e, int *docs, unsigned *dep
 {
     static const char yaml_prefix[] = "tag:yaml.org,2002:"; /* what libyaml makes of "!!" */
     const char *tag = event_tag(e);
+    char shown[48];
     size_t line = e->start_mark.line + 1u;
     if (e->type == YAML_ALIAS_EVENT)
         return fail(x, line, "aliases (*%s) are not supported: write the value out",
@@ -815,8 +839,9 @@ static int check_event(ctx_t *x, const yaml_event_t *e, int *docs, unsigned *dep
      * another (id: !!str 1), and ignoring it would silently read what the tag contradicts. */
     if (tag != NULL) {
         bool core = strncmp(tag, yaml_prefix, sizeof yaml_prefix - 1u) == 0;
-        return fail(x, line, "YAML tags (%s%.40s) are not supported: write the value alone",
-                    core ? "!!" : "", core ? tag + sizeof yaml_prefix - 1u : tag);
+        return fail(x, line, "YAML tags (%s%s) are not supported: write the value alone",
+                    core ? "!!" : "",
+                    printable(core ? tag + sizeof yaml_prefix - 1u : tag, shown, sizeof shown));
     }
     if (e->type == YAML_SEQUENCE_START_EVENT || e->type == YAML_MAPPING_START_EVENT) {
         if (++*depth > J288_ROBOT_CONFIG_MAX_DEPTH)

@@ -67,6 +67,12 @@ FUZZ_NAMES := $(sort $(patsubst test/fuzz/fuzz_%.c,%,$(wildcard test/fuzz/fuzz_*
 FUZZ_REPLAY_TESTS := $(FUZZ_NAMES:%=$(BUILD)/test/fuzz_replay_%)
 FUZZ_EXTRA_cli := tools/j288/hexparse.c tools/j288/args.c host/j288_number.c
 FUZZ_CPPFLAGS_cli := -Itools/j288 $(TOOL_CPPFLAGS)
+# The config target links the reader and libyaml (FUZZ_LIBS_<name>: a target's libraries).
+FUZZ_EXTRA_config := host/j288_robot_config.c host/j288_number.c
+FUZZ_CPPFLAGS_config := -Ihost $(call yaml_var,YAML_CFLAGS)
+FUZZ_LIBS_config := $(call yaml_var,YAML_LIBS)
+$(OBJ)/test/fuzz/fuzz_config.o: host/j288_robot_config.h $(YAML_ENV)
+$(BUILD)/test/fuzz_replay_config: LDFLAGS_COMMON += $(FUZZ_LIBS_config)
 
 $(OBJ)/test/fuzz/replay_%.o: test/fuzz/replay_main.c test/fuzz/fuzz_common.h
 	@mkdir -p $(@D)

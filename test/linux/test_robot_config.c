@@ -236,6 +236,14 @@ static void test_errors_keys(void)
     check_error("buses:\n  - name: l\njoints: []\n", 2, "bus 'l': 'port' is missing");
     check_error("buses:\n  - port: /dev/a\n", 2, "bus 1: 'name' is missing");
     check_error("joints:\n  - name: a\n    id: 1\n    [x]: 2\n", 4, "a key must be a name");
+    /* A folded scalar holds line breaks: the message shows them as '?', one line (found by
+     * fuzz_config). */
+    check_error("joints:\n  - name: a\n    id: 1\n    clamp: ab\n\n      cd\n", 4,
+                "clamp: expected true or false, got 'ab?cd'");
+    check_error("joints:\n  - name: a\n    id: 1\n    ? ab\n\n      cd\n    : 1\n", 4,
+                "unknown key 'ab?cd'");
+    check_error("joints:\n  - {name: \"a\\nb\", id: 1}\n", 2, "name: 'a?b' has a control character");
+    check_error("joints:\n  - name: a\n    id: !a%0Ab 1\n", 3, "YAML tags (!a?b)");
 }
 
 static void test_errors_types(void)
