@@ -145,7 +145,7 @@ static void print_joints(FILE *f, const j288_robot_t *r, const char *eol)
 static void print_buses(FILE *f, const j288_robot_t *r, const char *eol)
 {
     unsigned b;
-    fprintf(f, "%-8s %-4s %8s %8s %7s %7s %6s %6s %6s %6s %6s %7s%s", "bus", "", "sweeps", "ok",
+    fprintf(f, "%-8s %-4s %8s %8s %7s %7s %6s %7s %6s %6s %6s %7s%s", "bus", "", "sweeps", "ok",
             "failed", "timeout", "crc", "wrongid", "collis", "line", "stale", "sweep", eol);
     for (b = 0; b < j288_robot_nbuses(r); b++) {
         j288_robot_bus_stats_t bs;
@@ -153,7 +153,7 @@ static void print_buses(FILE *f, const j288_robot_t *r, const char *eol)
         (void)j288_robot_bus_stats(r, b, &bs);
         if (w == NULL)
             continue;
-        fprintf(f, "%-8.8s %-4s %8lu %8lu %7lu %7lu %6lu %6lu %6lu %6lu %6lu %6luus%s",
+        fprintf(f, "%-8.8s %-4s %8lu %8lu %7lu %7lu %6lu %7lu %6lu %6lu %6lu %5luus%s",
                 j288_robot_bus_name(r, b), bs.gone ? "GONE" : (bs.up ? "up" : "DOWN"),
                 (unsigned long)bs.sweeps, (unsigned long)w->ok, (unsigned long)w->failed,
                 (unsigned long)w->timeouts, (unsigned long)w->crc_errors,
