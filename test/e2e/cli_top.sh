@@ -55,6 +55,8 @@ run_t pipe_one_frame t_pipe_one_frame
 run_t port_form t_port_form
 expect_bad no_bus 2 '^j288 top: no bus: give --config FILE or --port DEV' env -u J288_PORT "$J288" top
 expect_bad json_refused 2 '^j288 top: --json: top draws a screen' "$J288" top --config "$CFG" --json
+expect_bad retries_refused 2 '^j288 top: --retries: ' "$J288" top --config "$CFG" --retries 1
+expect_bad echo_with_config 2 '^j288 top: --echo: with --config' "$J288" top --config "$CFG" --echo
 expect_bad bad_rate 2 '^j288 top: --rate: 0 is out of range' "$J288" top --config "$CFG" --rate 0
 expect_bad no_servo 1 '^j288 top: no servo answered on ' "$J288" top --port "$DEV" --ids 9 --once --margin-us 20000
 

@@ -314,6 +314,15 @@ int cli_cmd_top(int argc, char **argv, const cli_global_t *g)
                   "--config FILE status --json` print a result");
         return CLI_EXIT_USAGE;
     }
+    if (o.retries >= 0) {
+        cli_error("--retries: top sends lock each cycle, never re-sent (a silent servo shows as "
+                  "such)");
+        return CLI_EXIT_USAGE;
+    }
+    if (o.echo && o.config != NULL) {
+        cli_error("--echo: with --config, each bus says it in the file (echo: true)");
+        return CLI_EXIT_USAGE;
+    }
     if (o.config == NULL && o.port == NULL) {
         cli_error("no bus: give --config FILE or --port DEV (or set $J288_PORT)");
         return CLI_EXIT_USAGE;
