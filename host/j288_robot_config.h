@@ -149,8 +149,7 @@ int j288_robot_config_check_writable(const char *path, char *err, size_t errlen)
  * (the library's defaults: [-pi, pi], no speed or torque limit beyond the wire's, no default
  * gains); the start's sample count and tolerances at the library's defaults (0). Checks
  * nothing: j288_joint_init() does, and the file's own checks keep its values in the ranges
- * the library takes. Works
- * without libyaml. NULL arguments are ignored. */
+ * the library takes. Works without libyaml. NULL arguments are ignored. */
 void j288_robot_config_joint_config(const j288_robot_config_joint_t *rj, j288_joint_config_t *jc);
 
 /* The text-level edit behind j288_robot_config_write_joint(): the len bytes of text in, the edited
