@@ -2,10 +2,12 @@
 #   $(ROBOT_OBJ)       the runner; link with $(CONFIG_OBJ), $(LINUX_A), $(LIB_A) and the yaml libs
 #   test/linux/test_robot.c   several j288-sim buses from one loop (HOST_TESTS)
 #   test/e2e/cli_robot.sh     j288 --config FILE log|status|hold|stop (TEST_SCRIPTS)
-ROBOT_OBJ := $(OBJ)/host/j288_robot.o
-ROBOT_HDR := host/j288_robot.h host/j288_robot_config.h port/linux/j288_linux.h
+# (the runner, and its one OS-specific call, the wait over every bus: host/j288_host_wait.c)
+ROBOT_OBJ := $(OBJ)/host/j288_robot.o $(OBJ)/host/j288_host_wait.o
+ROBOT_HDR := host/j288_robot.h host/j288_robot_config.h host/j288_host_wait.h \
+    port/linux/j288_linux.h
 
-$(ROBOT_OBJ): host/j288_robot.c $(ROBOT_HDR) $(LIB_HDR)
+$(ROBOT_OBJ): $(OBJ)/host/%.o: host/%.c $(ROBOT_HDR) $(LIB_HDR)
 	@mkdir -p $(@D)
 	$(CC) $(HOST_CPPFLAGS) $(CFLAGS_COMMON) -c $< -o $@
 

@@ -39,7 +39,8 @@ class ServoReply(Structure):
                 ("pos", c_double), ("speed", c_double), ("torque", c_double),
                 ("out_pos", c_double), ("case_temp_c", c_double),
                 ("winding_temp_c", c_double), ("voltage_v", c_double),
-                ("faults", c_uint32), ("warnings", c_uint8), ("latency_us", c_uint32)]
+                ("faults", c_uint32), ("warnings", c_uint8), ("latency_us", c_uint32),
+                ("watchdog_cleared", c_bool)]
 
 
 class JointState(Structure):
@@ -56,7 +57,8 @@ class CycleInfo(Structure):
     """j288_robot_cycle_t."""
 
     _fields_ = [("cycle", c_uint32), ("start_us", c_uint32), ("duration_us", c_uint32),
-                ("fresh", c_uint), ("joints", c_uint), ("complete", c_bool)]
+                ("fresh", c_uint), ("joints", c_uint), ("complete", c_bool),
+                ("watchdog", c_uint)]
 
 
 class RobotStats(Structure):
@@ -93,7 +95,8 @@ class Options(Structure):
 
     _fields_ = [("port", c_char_p), ("baud", c_uint32), ("margin_us", c_uint32),
                 ("down_after", c_uint8), ("no_low_latency", c_bool),
-                ("on_event", c_void_p), ("on_cycle", c_void_p), ("user", c_void_p)]
+                ("on_event", c_void_p), ("on_cycle", c_void_p), ("user", c_void_p),
+                ("stop_on_bus_loss", c_bool)]
 
 
 def _find() -> str:
@@ -149,6 +152,7 @@ def _bind(lib: ctypes.CDLL) -> None:
         "j288_robot_bus_stats": (c_int, [robot, c_uint, P(BusStats)]),
         "j288_robot_joint_stats": (c_int, [robot, c_uint, P(JointStats)]),
         "j288_robot_exchange": (c_int, [robot, c_uint, c_uint8, P(Target), P(ServoReply)]),
+        "j288_robot_set_stop_flag": (None, [robot, c_void_p]),
         "j288_robot_error": (c_char_p, [robot]),
     }
     for name, (res, args) in protos.items():

@@ -136,7 +136,7 @@ def test_bus_status_and_command(sims) -> None:
             bus.command(2, pos=1e9)
         assert e.value.name == "J288_ERR_RANGE_POS"
     assert sim.logged(" id=2 status=1 wd=1")
-    assert sim.logged(" id=15 status=0 wd=1"), "the with block's exit sends the broadcast lock"
+    assert sim.logged(" id=15 status=0 wd=0"), "the with block's exit sends the broadcast lock"
 
 
 def test_bus_errors(sims) -> None:
@@ -218,7 +218,7 @@ def test_robot_two_buses(sims, tmp_path: Path) -> None:
         assert robot.joint_stats("leg0_1")["fresh_cycles"] == stats["cycles"]
     for s in (s0, s1):
         assert s.logged(" id=2 status=1 wd=1")
-        assert s.logged(" id=15 status=0 wd=1")
+        assert s.logged(" id=15 status=0 wd=0")
 
 
 def test_robot_stop_on_exception(sims, tmp_path: Path) -> None:
@@ -230,7 +230,7 @@ def test_robot_stop_on_exception(sims, tmp_path: Path) -> None:
             robot.hold()
             robot.cycle()
             raise RuntimeError("the controller failed")
-    assert s0.logged(" id=15 status=0 wd=1")
+    assert s0.logged(" id=15 status=0 wd=0")
 
 
 def test_robot_bad_config(sims, tmp_path: Path) -> None:
@@ -284,7 +284,7 @@ def test_robot_bus_stops_answering(sims, tmp_path: Path) -> None:
             complete = robot.cycle().complete
         assert complete and robot.bus_stats("leg2")["up"]
     for x in s:
-        assert x.logged(" id=15 status=0 wd=1")
+        assert x.logged(" id=15 status=0 wd=0")
 
 
 def test_robot_bus_gone(sims, tmp_path: Path) -> None:
@@ -352,4 +352,4 @@ def test_ctrl_c_stops_every_bus(sims, tmp_path: Path, loop: str) -> None:
             proc.wait()
     assert proc.returncode != 0 and "KeyboardInterrupt" in err
     for s in (s0, s1):
-        assert s.logged(" id=15 status=0 wd=1")
+        assert s.logged(" id=15 status=0 wd=0")
