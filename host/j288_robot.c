@@ -270,6 +270,7 @@ static int open_bus(j288_robot_t *r, unsigned i, const char *name, const char *p
 {
     j288_robot_bus_t *b = &r->bus[i];
     j288_linux_options_t lo;
+    j288_bus_config_t bc;
     j288_sched_config_t sc;
     uint32_t baud = r->opt.baud;
     int rc;
@@ -278,6 +279,7 @@ static int open_bus(j288_robot_t *r, unsigned i, const char *name, const char *p
     memset(&lo, 0, sizeof lo);
     lo.margin_us = r->opt.margin_us;
     lo.no_low_latency = r->opt.no_low_latency;
+    lo.echo = r->opt.echo;
     if (cb != NULL) {
         if (cb->has_baud)
             baud = cb->baud;
@@ -301,7 +303,9 @@ static int open_bus(j288_robot_t *r, unsigned i, const char *name, const char *p
     }
     b->open = true;
     b->stats.up = true;
-    rc = j288_linux_bus_init(&b->lp, &b->bus, NULL);
+    j288_linux_bus_config(&b->lp, &bc);
+    bc.retries = r->opt.retries;
+    rc = j288_linux_bus_init(&b->lp, &b->bus, &bc);
     if (rc == J288_OK) {
         memset(&sc, 0, sizeof sc);
         sc.on_event = on_servo_event;
@@ -437,6 +441,12 @@ void j288_robot_close(j288_robot_t *r)
     if (r->driven)
         (void)j288_robot_stop(r);
     close_buses(r);
+}
+
+void j288_robot_close_keep(j288_robot_t *r)
+{
+    if (r != NULL)
+        close_buses(r);
 }
 
 void j288_robot_set_stop_flag(j288_robot_t *r, const volatile sig_atomic_t *flag)
@@ -1154,6 +1164,23 @@ int j288_robot_idle(j288_robot_t *r, uint32_t until_us)
             return J288_OK;
         wait_all(r, now, until_us);
     }
+}
+
+const char *j288_robot_notices(const j288_robot_t *r, unsigned bus)
+{
+    if (r == NULL || bus >= r->nbuses || !r->bus[bus].open)
+        return "";
+    return j288_linux_notices(&r->bus[bus].lp);
+}
+
+j288_sched_t *j288_robot_bus_sched(j288_robot_t *r, unsigned bus)
+{
+    return (r == NULL || bus >= r->nbuses) ? NULL : &r->bus[bus].sched;
+}
+
+const j288_bus_t *j288_robot_bus_engine(const j288_robot_t *r, unsigned bus)
+{
+    return (r == NULL || bus >= r->nbuses) ? NULL : &r->bus[bus].bus;
 }
 
 const char *j288_robot_error(const j288_robot_t *r) { return (r == NULL) ? "no robot" : r->err; }

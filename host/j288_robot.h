@@ -141,6 +141,8 @@ typedef struct {
     bool stop_on_bus_loss; /* a bus that goes down or vanishes stops every bus: the cycle
                               (and run) returns J288_ERR_OFFLINE after j288_robot_stop(), for
                               robots where half the joints holding is worse than all locked */
+    bool echo;             /* for buses that give none: the adapter hears its own transmit */
+    uint8_t retries;       /* re-sends of a failed transaction (0-3; bus.h's retries) */
 } j288_robot_options_t;
 
 typedef struct {
@@ -266,6 +268,11 @@ int j288_robot_open_port(j288_robot_t *r, const char *port, const j288_robot_opt
  * or failed robot, and twice. */
 void j288_robot_close(j288_robot_t *r);
 
+/* Close without that stop: the servos keep their last command (with the watchdog bit 1 they
+ * lock themselves 1 s later). For a front end's explicit "leave it running" (j288 --keep), or
+ * after it confirmed every lock itself. */
+void j288_robot_close_keep(j288_robot_t *r);
+
 /* Let cycles return J288_ERR_ABORTED (after j288_robot_stop()) once *flag is non-zero. */
 void j288_robot_set_stop_flag(j288_robot_t *r, const volatile sig_atomic_t *flag);
 
@@ -375,6 +382,19 @@ int j288_robot_transfer(j288_robot_t *r, unsigned bus, const j288_cmd_raw_t *cmd
  * between commands. J288_OK, J288_ERR_ABORTED (the stop flag: nothing is sent, the caller
  * stops), J288_ERR_OFFLINE (every bus is gone), J288_ERR_NULL. */
 int j288_robot_idle(j288_robot_t *r, uint32_t until_us);
+
+/* The port's notices from open (low latency refused, latency timer advice: zero or more
+ * lines, each ending in '\n'), "" when none or for a bad index. Never NULL. */
+const char *j288_robot_notices(const j288_robot_t *r, unsigned bus);
+
+/* A bus's scheduler, for a front end without joints (j288 log --id): it may enable slots and
+ * set their commands (j288_sched_enable(), j288_sched_set_cmd(), j288_sched_slot()) for
+ * j288_robot_cycle() to sweep, under the same watchdog policy; it must not start sweeps, poll
+ * or stop it itself. And the bus engine, for its counters and reply budget (j288_bus_stats(),
+ * j288_bus_parser_stats(), j288_bus_reply_budget_us()); never submit to it. NULL for a bad
+ * index. */
+j288_sched_t *j288_robot_bus_sched(j288_robot_t *r, unsigned bus);
+const j288_bus_t *j288_robot_bus_engine(const j288_robot_t *r, unsigned bus);
 
 /* The latest error, one line ("" if none). Never NULL. */
 const char *j288_robot_error(const j288_robot_t *r);

@@ -96,7 +96,7 @@ class Options(Structure):
     _fields_ = [("port", c_char_p), ("baud", c_uint32), ("margin_us", c_uint32),
                 ("down_after", c_uint8), ("no_low_latency", c_bool),
                 ("on_event", c_void_p), ("on_cycle", c_void_p), ("user", c_void_p),
-                ("stop_on_bus_loss", c_bool)]
+                ("stop_on_bus_loss", c_bool), ("echo", c_bool), ("retries", c_uint8)]
 
 
 def _find() -> str:
