@@ -2,6 +2,7 @@
 #   $(ROBOT_OBJ)       the runner; link with $(CONFIG_OBJ), $(LINUX_A), $(LIB_A) and the yaml libs
 #   test/linux/test_robot.c   several j288-sim buses from one loop (HOST_TESTS)
 #   test/e2e/cli_robot.sh     j288 --config FILE log|status|hold|stop (TEST_SCRIPTS)
+#   test/e2e/host_stack.sh    a second session after a stop, every front end (TEST_SCRIPTS)
 # (the runner, and its one OS-specific call, the wait over every bus: host/j288_host_wait.c)
 ROBOT_OBJ := $(OBJ)/host/j288_robot.o $(OBJ)/host/j288_host_wait.o
 ROBOT_HDR := host/j288_robot.h host/j288_robot_config.h host/j288_host_wait.h \
@@ -32,3 +33,6 @@ $(J288_BIN): $(ROBOT_OBJ) $(CONFIG_OBJ)
 $(J288_BIN): LDFLAGS_COMMON += $(LINUX_A) $(LIB_A) $(call yaml_var,YAML_LIBS)
 TEST_SCRIPTS += test/e2e/cli_robot.sh
 TEST_DEPS += $(J288_BIN)
+# One host stack: a second session after every form of stop holds a loaded joint (the CLI's
+# forms and Python's; the Python ones use the shared library, which python.mk adds).
+TEST_SCRIPTS += test/e2e/host_stack.sh
