@@ -1066,6 +1066,28 @@ static int run_txn(j288_robot_t *r, j288_robot_bus_t *b, const j288_cmd_raw_t *c
     return w.txn.result;
 }
 
+/* Servo id's joint for servo-level use (all-zero configuration), set up on first use. */
+static j288_joint_t *servo_joint(j288_robot_bus_t *b, uint8_t id)
+{
+    if ((b->servo_joint_on & (1u << id)) == 0u) {
+        j288_joint_config_t jc;
+        memset(&jc, 0, sizeof jc);
+        jc.id = id;
+        (void)j288_joint_init(&b->servo_joint[id], &jc); /* valid: defaults and an id 0-14 */
+        b->servo_joint_on = (uint16_t)(b->servo_joint_on | (1u << id));
+    }
+    return &b->servo_joint[id];
+}
+
+static void joint_into_servo(const j288_joint_t *j, j288_robot_servo_t *out)
+{
+    const j288_joint_state_t *st = j288_joint_state(j);
+    out->joint_known = st->known;
+    out->joint_pos = st->known ? (double)st->pos : 0.0;
+    out->joint_speed = (double)st->speed;
+    out->joint_torque = (double)st->torque;
+}
+
 /* Whether a reply to an FOC command shows a servo that did not take it: a trip reported, or
  * lock mode. */
 static bool foc_ignored(const j288_cmd_raw_t *cmd, const j288_reply_raw_t *reply)
@@ -1109,6 +1131,8 @@ int j288_robot_transfer(j288_robot_t *r, unsigned bus, const j288_cmd_raw_t *cmd
             *wd_cleared = true;
         emit(r, &ev);
     }
+    if (rc == J288_OK)
+        (void)j288_joint_take_reply(servo_joint(b, c.id), &t.reply, NULL);
     if (txn != NULL)
         *txn = t;
     return rc;
@@ -1145,6 +1169,56 @@ int j288_robot_exchange(j288_robot_t *r, unsigned bus, uint8_t id, const j288_ro
     if (rc == J288_OK && out != NULL) {
         servo_from_reply(&txn, out);
         out->watchdog_cleared = cleared;
+        joint_into_servo(servo_joint(&r->bus[bus], id), out);
+    }
+    return rc;
+}
+
+int j288_robot_exchange_joint(j288_robot_t *r, unsigned bus, uint8_t id,
+                              const j288_robot_target_t *foc, j288_robot_servo_t *out)
+{
+    j288_robot_servo_t local;
+    const j288_joint_t *j;
+    j288_joint_target_t jt;
+    j288_cmd_raw_t cmd;
+    j288_txn_t txn;
+    bool cleared = false;
+    unsigned n;
+    int rc = J288_OK;
+    if (r == NULL)
+        return J288_ERR_NULL;
+    if (bus >= r->nbuses)
+        return J288_ERR_BAD_ARG;
+    if (id >= J288_MAX_SERVOS)
+        return J288_ERR_BAD_ID;
+    if (out == NULL)
+        out = &local;
+    j = servo_joint(&r->bus[bus], id);
+    /* The start-up reads: locks until the angle is known (a silent servo: its first error). */
+    for (n = 0; n < J288_ROBOT_ACQUIRE_TRIES && !j288_joint_state(j)->known; n++) {
+        rc = j288_robot_exchange(r, bus, id, NULL, out);
+        if (rc == J288_ERR_OFFLINE || (rc != J288_OK && n == 0u))
+            return rc;
+    }
+    if (!j288_joint_state(j)->known)
+        return j288_joint_state(j)->cal_mismatch ? J288_ERR_CAL_MISMATCH : J288_ERR_ANGLE_UNKNOWN;
+    if (foc == NULL) {
+        lock_cmd(id, &cmd);
+    } else {
+        jt.pos = (j288_real_t)foc->pos;
+        jt.speed = (j288_real_t)foc->speed;
+        jt.torque = (j288_real_t)foc->torque;
+        jt.kp = (j288_real_t)foc->kp;
+        jt.kd = (j288_real_t)foc->kd;
+        rc = j288_joint_command(j, &jt, &cmd, NULL); /* watchdog bit 1 */
+        if (rc != J288_OK)
+            return rc;
+    }
+    rc = j288_robot_transfer(r, bus, &cmd, &txn, &cleared);
+    if (rc == J288_OK) {
+        servo_from_reply(&txn, out);
+        out->watchdog_cleared = cleared;
+        joint_into_servo(j, out);
     }
     return rc;
 }

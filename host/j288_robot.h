@@ -205,6 +205,13 @@ typedef struct {
     uint32_t latency_us;
     bool watchdog_cleared; /* the servo had tripped its watchdog: the command was sent again
                               with the bit 0 (clearing it), and this is that reply */
+    /* The joint frame of servo-level use (j288_robot_exchange_joint()): the library's joint
+     * with the all-zero configuration, the absolute output angle wrapped to [-pi, pi), as
+     * `j288 status --id N` without --config (its joint_pos). Fed by every exchange. */
+    bool joint_known;   /* joint_pos is valid (after the start's replies) */
+    double joint_pos;   /* rad */
+    double joint_speed; /* rad/s */
+    double joint_torque; /* N*m */
 } j288_robot_servo_t;
 
 typedef struct {
@@ -219,6 +226,8 @@ typedef struct {
     bool open;
     bool swept_ok;       /* the sweep in progress had a good reply */
     uint8_t lock_under_foc[J288_MAX_SERVOS]; /* replies in lock mode to FOC commands in a row */
+    j288_joint_t servo_joint[J288_MAX_SERVOS]; /* servo level's joint frame (exchanges) */
+    uint16_t servo_joint_on;                   /* bit id: servo_joint[id] initialised */
     uint8_t empty_run;   /* consecutive sweeps without a reply */
     uint32_t sweep_start_us;
     j288_robot_bus_stats_t stats;
@@ -364,6 +373,16 @@ int j288_robot_joint_stats(const j288_robot_t *r, unsigned joint, j288_robot_joi
  * (J288_ERR_TIMEOUT: no servo answered, ...), J288_ERR_OFFLINE. */
 int j288_robot_exchange(j288_robot_t *r, unsigned bus, uint8_t id, const j288_robot_target_t *foc,
                         j288_robot_servo_t *out);
+
+/* The same in the joint frame (see j288_robot_servo_t's joint_* members): foc NULL sends lock,
+ * else an FOC command from a joint-frame target (the joint layer's checks: J288_ERR_LIMIT_POS
+ * beyond [-pi, pi], ...). A servo whose angle is not known yet is first sent locks (watchdog
+ * bit 0) until it is, bounded (J288_ROBOT_ACQUIRE_TRIES): the start-up reads. Errors: those of
+ * j288_robot_exchange(), J288_ERR_ANGLE_UNKNOWN / J288_ERR_CAL_MISMATCH (the angle could not
+ * be found: encoder fault), the joint layer's. */
+#define J288_ROBOT_ACQUIRE_TRIES 40u
+int j288_robot_exchange_joint(j288_robot_t *r, unsigned bus, uint8_t id,
+                              const j288_robot_target_t *foc, j288_robot_servo_t *out);
 
 /* One transaction of a raw command on a bus, outside cycles, through the runner's loop (the
  * same waits, vanished-device handling and watchdog policy as cycles): a lock goes out with
