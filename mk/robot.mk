@@ -26,8 +26,8 @@ HOST_TESTS += $(ROBOT_TEST)
 ALL_TARGETS += $(ROBOT_TEST)
 TEST_DEPS += $(SIM_BIN)
 
-# The j288 tool's robot commands (tools/j288/cmd_robot.c) use the runner and the config reader.
-$(OBJ)/tools/j288/cmd_robot.o: $(ROBOT_HDR)
+# The j288 tool's bus commands use the runner (cli_bus.h includes it) and the config reader.
+$(J288_SRC:%.c=$(OBJ)/%.o): $(ROBOT_HDR)
 $(J288_BIN): $(ROBOT_OBJ) $(CONFIG_OBJ)
 # (the archives again after them: the tool's link rule lists its own prerequisites first)
 $(J288_BIN): LDFLAGS_COMMON += $(LINUX_A) $(LIB_A) $(call yaml_var,YAML_LIBS)

@@ -91,7 +91,8 @@ py_second_bus() {
     "$PY" - "$DEV" <<'EOF'
 import sys, time, j288
 with j288.Bus(sys.argv[1], margin_us=250000) as bus:
-    x = bus.status(1).pos + 0.5
+    p = bus.status(1).pos
+    x = p - 0.5 if p > 0 else p + 0.5  # joint frame: within [-pi, pi]
     end = time.monotonic() + 1.0
     while time.monotonic() < end:
         st = bus.command(1, pos=x, kp=20, kd=1)
