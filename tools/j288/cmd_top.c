@@ -106,6 +106,25 @@ static bool quit_pressed(void)
 
 /* ---- one frame ------------------------------------------------------------------------------- */
 
+/* The ports' notices (latency timer advice, low latency refused), each line ending in eol;
+ * nothing under J288_QUIET=1, as the other commands. */
+static void print_notices(FILE *f, const j288_robot_t *r, const char *eol)
+{
+    const char *quiet = getenv("J288_QUIET");
+    unsigned b;
+    if (quiet != NULL && strcmp(quiet, "1") == 0)
+        return;
+    for (b = 0; b < j288_robot_nbuses(r); b++) {
+        const char *n;
+        for (n = j288_robot_notices(r, b); *n != '\0'; n++) {
+            if (*n == '\n')
+                fputs(eol, f);
+            else
+                fputc(*n, f);
+        }
+    }
+}
+
 /* The fresh column: answered in the latest cycle, angle unknown, or never answered. */
 static char fresh_mark(const j288_robot_state_t *st, const j288_robot_joint_stats_t *js)
 {
@@ -176,6 +195,8 @@ static void draw(const j288_robot_t *r, const char *source, bool ansi)
     printf("j288 top  %s  cycle %lu (%lu complete), last %lu us%s%s", source,
            (unsigned long)rs.cycles, (unsigned long)rs.complete_cycles,
            (unsigned long)rs.last_cycle_us, ansi ? "  q or Ctrl-C quits" : "", eol);
+    if (ansi)
+        print_notices(stdout, r, eol);
     fputs(eol, stdout);
     print_joints(stdout, r, eol);
     fputs(eol, stdout);
@@ -187,8 +208,9 @@ static void draw(const j288_robot_t *r, const char *source, bool ansi)
 
 /* ---- the bus without a config ---------------------------------------------------------------- */
 
-/* A config with one bus (the common options' port, baud, margin, echo) and a joint "idN" for
- * every id in ids, at the defaults: the joint angle is the output encoder's, wrapped. */
+/* A config with one bus on the common options' port (its baud, margin and echo come with the
+ * runner's options) and a joint "idN" for every id in ids, at the defaults: the joint angle
+ * is the output encoder's, wrapped. */
 static void bus_config(const cli_bus_opts_t *o, uint32_t ids, j288_robot_config_t *cfg)
 {
     j288_robot_config_bus_t *b = &cfg->bus[0];
@@ -197,12 +219,6 @@ static void bus_config(const cli_bus_opts_t *o, uint32_t ids, j288_robot_config_
     cfg->nbuses = 1;
     (void)snprintf(b->name, sizeof b->name, "bus");
     (void)snprintf(b->port, sizeof b->port, "%s", o->port);
-    b->has_baud = o->baud != 0u;
-    b->baud = o->baud;
-    b->has_margin_us = o->margin_us != 0u;
-    b->margin_us = o->margin_us;
-    b->has_echo = o->echo;
-    b->echo = o->echo;
     for (id = 0; id <= J288_MAX_ID; id++) {
         j288_robot_config_joint_t *jt = &cfg->joint[cfg->njoints];
         if ((ids & (1ul << id)) == 0u)
@@ -315,15 +331,6 @@ int cli_cmd_top(int argc, char **argv, const cli_global_t *g)
                   "--config FILE status --json` print a result");
         return CLI_EXIT_USAGE;
     }
-    if (o.retries >= 0) {
-        cli_error("--retries: top sends lock each cycle, never re-sent (a silent servo shows as "
-                  "such)");
-        return CLI_EXIT_USAGE;
-    }
-    if (o.echo && o.config != NULL) {
-        cli_error("--echo: with --config, each bus says it in the file (echo: true)");
-        return CLI_EXIT_USAGE;
-    }
     if (o.config == NULL && o.port == NULL) {
         cli_error("no bus: give --config FILE or --port DEV (or set $J288_PORT)");
         return CLI_EXIT_USAGE;
@@ -332,6 +339,8 @@ int cli_cmd_top(int argc, char **argv, const cli_global_t *g)
     ro.port = o.port;
     ro.baud = o.baud;
     ro.margin_us = o.margin_us;
+    ro.echo = o.echo;
+    ro.retries = (uint8_t)(o.retries > 0 ? o.retries : 0);
     cli_signals_install();
     rc = (o.config != NULL) ? j288_robot_open_file(&robot, o.config, &ro)
                             : open_bus_ids(&robot, &o, &a, &ro);
@@ -343,6 +352,8 @@ int cli_cmd_top(int argc, char **argv, const cli_global_t *g)
     }
     j288_robot_set_stop_flag(&robot, &cli_stop_signal);
     ansi = !a.once && isatty(STDOUT_FILENO);
+    if (!ansi)
+        print_notices(stderr, &robot, "\n");
     rc = ansi ? live(&robot, &a, o.config != NULL ? o.config : o.port) : acquire_angles(&robot);
     if (!ansi && rc != J288_ERR_ABORTED)
         draw(&robot, o.config != NULL ? o.config : o.port, false);
