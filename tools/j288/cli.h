@@ -35,6 +35,10 @@ typedef struct {
     const char *config; /* --config FILE before the command, or NULL */
 } cli_global_t;
 
+/* Watchdog trips the host layer found and cleared in this process (cli_bus.c): main() turns
+ * a command's success into exit 1 when it is not 0. */
+extern unsigned cli_watchdog_trips;
+
 /* Name used as the message prefix ("encode" -> "j288 encode: ..."). NULL: plain "j288". */
 void cli_set_command(const char *name);
 
@@ -61,6 +65,7 @@ int cli_cmd_log(int argc, char **argv, const cli_global_t *g);
 int cli_cmd_plot(int argc, char **argv, const cli_global_t *g);
 int cli_cmd_zero(int argc, char **argv, const cli_global_t *g);
 int cli_cmd_calibrate(int argc, char **argv, const cli_global_t *g);
+int cli_cmd_top(int argc, char **argv, const cli_global_t *g);
 /* log, status, hold, stop over every bus of a robot config (cmd_robot.c): taken instead of
  * the one-servo command when cli_robot_takes() says so (a --config, no --id or --joint). */
 int cli_cmd_robot(int argc, char **argv, const cli_global_t *g);

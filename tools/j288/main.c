@@ -1,7 +1,7 @@
 /*
  * j288 - the command-line tool: an offline frame calculator (encode, decode) and, with
- * --port, a bus master for J288/S288 servos (scan, status, hold, move, torque, stop, log),
- * plus plot for the CSV that log writes.
+ * --port, a bus master for J288/S288 servos (scan, status, hold, move, torque, stop, log,
+ * top), plus plot for the CSV that log writes.
  */
 #include <stdio.h>
 #include <stdlib.h>
@@ -31,6 +31,7 @@ static const command_t commands[] = {
     {"plot", cli_cmd_plot, "plot a log CSV to PNG with gnuplot"},
     {"zero", cli_cmd_zero, "make a joint's current pose its zero (written to --config)"},
     {"calibrate", cli_cmd_calibrate, "fit a joint's rotor phase (written to --config)"},
+    {"top", cli_cmd_top, "live view of every joint and the bus counters (q quits)"},
     {NULL, NULL, NULL}};
 
 static void usage(FILE *f)
@@ -65,6 +66,12 @@ static const cli_opt_t global_opts[] = {{"--port", true, OPT_PORT},
                                         {"--baud", true, OPT_BAUD},
                                         {"--version", false, OPT_VERSION},
                                         {NULL, false, 0}};
+
+/* A servo whose watchdog tripped was cleared and reported (cli_bus.h): never exit 0 then. */
+static int watchdog_exit(int code)
+{
+    return (code == CLI_EXIT_OK && cli_watchdog_trips != 0u) ? CLI_EXIT_FAIL : code;
+}
 
 int main(int argc, char **argv)
 {
@@ -127,12 +134,12 @@ int main(int argc, char **argv)
     }
     if (cli_robot_takes(v, argc - (a.index - 1), argv + (a.index - 1), &g)) {
         cli_set_command(v);
-        return cli_cmd_robot(argc - (a.index - 1), argv + (a.index - 1), &g);
+        return watchdog_exit(cli_cmd_robot(argc - (a.index - 1), argv + (a.index - 1), &g));
     }
     for (c = commands; c->name != NULL; c++) {
         if (strcmp(v, c->name) == 0) {
             cli_set_command(c->name);
-            return c->fn(argc - (a.index - 1), argv + (a.index - 1), &g);
+            return watchdog_exit(c->fn(argc - (a.index - 1), argv + (a.index - 1), &g));
         }
     }
     cli_error("unknown command '%s' (try j288 --help)", v);
