@@ -61,7 +61,7 @@ $(DDS_GOLDEN): $(OBJ)/test/dds/dds_golden.o $(OBJ)/tools/j288-dds/unitree_crc.o 
 dds: $(DDS_BIN)
 ALL_TARGETS += $(DDS_BIN) $(DDS_TEST_PEER) $(DDS_GOLDEN)
 TEST_DEPS += $(DDS_BIN) $(DDS_TEST_PEER) $(DDS_GOLDEN) $(SIM_BIN)
-TEST_SCRIPTS += test/dds/golden.sh test/dds/bridge_e2e.sh
+TEST_SCRIPTS += test/dds/golden.sh test/dds/bridge_e2e.sh test/dds/unitree_e2e.sh
 
 install-dds: $(DDS_BIN)
 	install -d $(DESTDIR)$(BINDIR)

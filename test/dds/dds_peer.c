@@ -1,8 +1,8 @@
 /*
  * dds_peer - a DDS peer of j288-dds for the tests and the benchmark, written apart from the
  * bridge: it shares only the IDL (the wire contract, checked byte for byte by golden.sh) and
- * computes unitree's crc its own way, as unitree_sdk2 does (a C struct, its words in memory:
- * little-endian hosts only, which is what the tests run on).
+ * computes unitree's crc its own way, as unitree_sdk2 does (the message in a C struct's layout,
+ * crc32_core over its words in memory: little-endian hosts only, which the tests run on).
  *
  * usage: dds_peer [--domain N] [--ns NS] COMMAND ...
  *   states [--timeout S]      the next rt/joint_states: 'name POS VEL EFF' lines
@@ -21,6 +21,7 @@
  * Exit 0 on success, 1 when nothing came within the timeout (default 10 s), 2 on bad usage.
  */
 #include <math.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -179,88 +180,104 @@ static uint32_t crc32_core(const uint32_t *ptr, uint32_t len)
     return crc;
 }
 
+/* The message's bytes where unitree's C struct has them, padding zero. (Member stores into a
+ * struct may leave its padding bytes unspecified, and an optimising compiler does: so the
+ * struct gives the layout through offsetof, and the bytes go into a zeroed image.) */
+#define PUT(img, base, type, member, src) \
+    memcpy((img) + (base) + offsetof(type, member), &(src), sizeof(src))
+
+static uint32_t image_crc(const unsigned char *img, size_t size)
+{
+    uint32_t words[300];
+    memcpy(words, img, size); /* little-endian host: the words as unitree reads them */
+    return crc32_core(words, (uint32_t)(size / 4u - 1u));
+}
+
 static uint32_t lowcmd_crc(const unitree_go_msg_dds__LowCmd_ *m)
 {
-    raw_low_cmd raw;
+    unsigned char img[sizeof(raw_low_cmd)];
     unsigned i;
-    memset(&raw, 0, sizeof raw);
-    memcpy(raw.head, m->head, 2);
-    raw.level_flag = m->level_flag;
-    raw.frame_reserve = m->frame_reserve;
-    memcpy(raw.sn, m->sn, sizeof raw.sn);
-    memcpy(raw.version, m->version, sizeof raw.version);
-    raw.bandwidth = m->bandwidth;
+    memset(img, 0, sizeof img);
+    PUT(img, 0, raw_low_cmd, head, m->head);
+    PUT(img, 0, raw_low_cmd, level_flag, m->level_flag);
+    PUT(img, 0, raw_low_cmd, frame_reserve, m->frame_reserve);
+    PUT(img, 0, raw_low_cmd, sn, m->sn);
+    PUT(img, 0, raw_low_cmd, version, m->version);
+    PUT(img, 0, raw_low_cmd, bandwidth, m->bandwidth);
     for (i = 0; i < 20; i++) {
-        raw.motor[i].mode = m->motor_cmd[i].mode;
-        raw.motor[i].q = m->motor_cmd[i].q;
-        raw.motor[i].dq = m->motor_cmd[i].dq;
-        raw.motor[i].tau = m->motor_cmd[i].tau;
-        raw.motor[i].kp = m->motor_cmd[i].kp;
-        raw.motor[i].kd = m->motor_cmd[i].kd;
-        memcpy(raw.motor[i].reserve, m->motor_cmd[i].reserve, 12);
+        size_t base = offsetof(raw_low_cmd, motor) + i * sizeof(raw_motor_cmd);
+        const unitree_go_msg_dds__MotorCmd_ *c = &m->motor_cmd[i];
+        PUT(img, base, raw_motor_cmd, mode, c->mode);
+        PUT(img, base, raw_motor_cmd, q, c->q);
+        PUT(img, base, raw_motor_cmd, dq, c->dq);
+        PUT(img, base, raw_motor_cmd, tau, c->tau);
+        PUT(img, base, raw_motor_cmd, kp, c->kp);
+        PUT(img, base, raw_motor_cmd, kd, c->kd);
+        PUT(img, base, raw_motor_cmd, reserve, c->reserve);
     }
-    raw.bms_off = m->bms_cmd.off;
-    memcpy(raw.bms_reserve, m->bms_cmd.reserve, 3);
-    memcpy(raw.wireless_remote, m->wireless_remote, 40);
-    memcpy(raw.led, m->led, 12);
-    memcpy(raw.fan, m->fan, 2);
-    raw.gpio = m->gpio;
-    raw.reserve = m->reserve;
-    return crc32_core((const uint32_t *)(const void *)&raw, (uint32_t)(sizeof raw / 4u - 1u));
+    PUT(img, 0, raw_low_cmd, bms_off, m->bms_cmd.off);
+    PUT(img, 0, raw_low_cmd, bms_reserve, m->bms_cmd.reserve);
+    PUT(img, 0, raw_low_cmd, wireless_remote, m->wireless_remote);
+    PUT(img, 0, raw_low_cmd, led, m->led);
+    PUT(img, 0, raw_low_cmd, fan, m->fan);
+    PUT(img, 0, raw_low_cmd, gpio, m->gpio);
+    PUT(img, 0, raw_low_cmd, reserve, m->reserve);
+    return image_crc(img, sizeof img);
 }
 
 static uint32_t lowstate_crc(const unitree_go_msg_dds__LowState_ *m)
 {
-    raw_low_state raw;
+    unsigned char img[sizeof(raw_low_state)];
     unsigned i;
-    memset(&raw, 0, sizeof raw);
-    memcpy(raw.head, m->head, 2);
-    raw.level_flag = m->level_flag;
-    raw.frame_reserve = m->frame_reserve;
-    memcpy(raw.sn, m->sn, sizeof raw.sn);
-    memcpy(raw.version, m->version, sizeof raw.version);
-    raw.bandwidth = m->bandwidth;
-    memcpy(raw.quaternion, m->imu_state.quaternion, sizeof raw.quaternion);
-    memcpy(raw.gyroscope, m->imu_state.gyroscope, sizeof raw.gyroscope);
-    memcpy(raw.accelerometer, m->imu_state.accelerometer, sizeof raw.accelerometer);
-    memcpy(raw.rpy, m->imu_state.rpy, sizeof raw.rpy);
-    raw.imu_temperature = m->imu_state.temperature;
+    memset(img, 0, sizeof img);
+    PUT(img, 0, raw_low_state, head, m->head);
+    PUT(img, 0, raw_low_state, level_flag, m->level_flag);
+    PUT(img, 0, raw_low_state, frame_reserve, m->frame_reserve);
+    PUT(img, 0, raw_low_state, sn, m->sn);
+    PUT(img, 0, raw_low_state, version, m->version);
+    PUT(img, 0, raw_low_state, bandwidth, m->bandwidth);
+    PUT(img, 0, raw_low_state, quaternion, m->imu_state.quaternion);
+    PUT(img, 0, raw_low_state, gyroscope, m->imu_state.gyroscope);
+    PUT(img, 0, raw_low_state, accelerometer, m->imu_state.accelerometer);
+    PUT(img, 0, raw_low_state, rpy, m->imu_state.rpy);
+    PUT(img, 0, raw_low_state, imu_temperature, m->imu_state.temperature);
     for (i = 0; i < 20; i++) {
+        size_t base = offsetof(raw_low_state, motor) + i * sizeof(raw_motor_state);
         const unitree_go_msg_dds__MotorState_ *s = &m->motor_state[i];
-        raw.motor[i].mode = s->mode;
-        raw.motor[i].q = s->q;
-        raw.motor[i].dq = s->dq;
-        raw.motor[i].ddq = s->ddq;
-        raw.motor[i].tau_est = s->tau_est;
-        raw.motor[i].q_raw = s->q_raw;
-        raw.motor[i].dq_raw = s->dq_raw;
-        raw.motor[i].ddq_raw = s->ddq_raw;
-        raw.motor[i].temperature = s->temperature;
-        raw.motor[i].lost = s->lost;
-        memcpy(raw.motor[i].reserve, s->reserve, 8);
+        PUT(img, base, raw_motor_state, mode, s->mode);
+        PUT(img, base, raw_motor_state, q, s->q);
+        PUT(img, base, raw_motor_state, dq, s->dq);
+        PUT(img, base, raw_motor_state, ddq, s->ddq);
+        PUT(img, base, raw_motor_state, tau_est, s->tau_est);
+        PUT(img, base, raw_motor_state, q_raw, s->q_raw);
+        PUT(img, base, raw_motor_state, dq_raw, s->dq_raw);
+        PUT(img, base, raw_motor_state, ddq_raw, s->ddq_raw);
+        PUT(img, base, raw_motor_state, temperature, s->temperature);
+        PUT(img, base, raw_motor_state, lost, s->lost);
+        PUT(img, base, raw_motor_state, reserve, s->reserve);
     }
-    raw.version_high = m->bms_state.version_high;
-    raw.version_low = m->bms_state.version_low;
-    raw.status = m->bms_state.status;
-    raw.soc = m->bms_state.soc;
-    raw.current = m->bms_state.current;
-    raw.cycle = m->bms_state.cycle;
-    memcpy(raw.bq_ntc, m->bms_state.bq_ntc, 2);
-    memcpy(raw.mcu_ntc, m->bms_state.mcu_ntc, 2);
-    memcpy(raw.cell_vol, m->bms_state.cell_vol, sizeof raw.cell_vol);
-    memcpy(raw.foot_force, m->foot_force, sizeof raw.foot_force);
-    memcpy(raw.foot_force_est, m->foot_force_est, sizeof raw.foot_force_est);
-    raw.tick = m->tick;
-    memcpy(raw.wireless_remote, m->wireless_remote, 40);
-    raw.bit_flag = m->bit_flag;
-    raw.adc_reel = m->adc_reel;
-    raw.temperature_ntc1 = m->temperature_ntc1;
-    raw.temperature_ntc2 = m->temperature_ntc2;
-    raw.power_v = m->power_v;
-    raw.power_a = m->power_a;
-    memcpy(raw.fan_frequency, m->fan_frequency, sizeof raw.fan_frequency);
-    raw.reserve = m->reserve;
-    return crc32_core((const uint32_t *)(const void *)&raw, (uint32_t)(sizeof raw / 4u - 1u));
+    PUT(img, 0, raw_low_state, version_high, m->bms_state.version_high);
+    PUT(img, 0, raw_low_state, version_low, m->bms_state.version_low);
+    PUT(img, 0, raw_low_state, status, m->bms_state.status);
+    PUT(img, 0, raw_low_state, soc, m->bms_state.soc);
+    PUT(img, 0, raw_low_state, current, m->bms_state.current);
+    PUT(img, 0, raw_low_state, cycle, m->bms_state.cycle);
+    PUT(img, 0, raw_low_state, bq_ntc, m->bms_state.bq_ntc);
+    PUT(img, 0, raw_low_state, mcu_ntc, m->bms_state.mcu_ntc);
+    PUT(img, 0, raw_low_state, cell_vol, m->bms_state.cell_vol);
+    PUT(img, 0, raw_low_state, foot_force, m->foot_force);
+    PUT(img, 0, raw_low_state, foot_force_est, m->foot_force_est);
+    PUT(img, 0, raw_low_state, tick, m->tick);
+    PUT(img, 0, raw_low_state, wireless_remote, m->wireless_remote);
+    PUT(img, 0, raw_low_state, bit_flag, m->bit_flag);
+    PUT(img, 0, raw_low_state, adc_reel, m->adc_reel);
+    PUT(img, 0, raw_low_state, temperature_ntc1, m->temperature_ntc1);
+    PUT(img, 0, raw_low_state, temperature_ntc2, m->temperature_ntc2);
+    PUT(img, 0, raw_low_state, power_v, m->power_v);
+    PUT(img, 0, raw_low_state, power_a, m->power_a);
+    PUT(img, 0, raw_low_state, fan_frequency, m->fan_frequency);
+    PUT(img, 0, raw_low_state, reserve, m->reserve);
+    return image_crc(img, sizeof img);
 }
 
 static int cmd_lowstate(double timeout_s)
@@ -273,7 +290,7 @@ static int cmd_lowstate(double timeout_s)
         printf("motor %u %.6f %.6f %.6f %d %u\n", i, (double)m.motor_state[i].q,
                (double)m.motor_state[i].dq, (double)m.motor_state[i].tau_est,
                (int)m.motor_state[i].temperature, (unsigned)m.motor_state[i].mode);
-    printf("power_v %.2f\ncrc %s\n", (double)m.power_v, lowstate_crc(&m) == m.crc ? "ok" : "bad");
+    printf("power_v %.2f\ncrc %s %08lx %08lx\n", (double)m.power_v, lowstate_crc(&m) == m.crc ? "ok" : "bad", (unsigned long)m.crc, (unsigned long)lowstate_crc(&m));
     return 0;
 }
 
