@@ -67,7 +67,7 @@ install-dds: $(DDS_BIN)
 	install -d $(DESTDIR)$(BINDIR)
 	install -m 755 $(DDS_BIN) $(DESTDIR)$(BINDIR)/
 
-bench-dds: $(DDS_BIN) $(DDS_TEST_PEER) $(SIM_BIN) $(J288_BIN)
+bench-dds: $(DDS_BIN) $(DDS_TEST_PEER) $(SIM_BIN) $(J288_BIN) $(BUILD)/bench/write_stamp.so
 	BUILD=$(BUILD) bash scripts/bench-dds.sh
 else
 dds dds-missing bench-dds:
@@ -79,3 +79,8 @@ ALL_TARGETS += dds-missing
 TEST_DEPS += dds-missing
 endif
 install: install-dds
+
+# The benchmark's write() stamper (test/bench/write_stamp.c), preloaded into the bridge.
+$(BUILD)/bench/write_stamp.so: test/bench/write_stamp.c
+	@mkdir -p $(@D)
+	$(CC) -O2 -shared -fPIC $< -o $@ -ldl

@@ -15,6 +15,7 @@
  *                             motors, then 'crc ok' or 'crc bad'
  *   lowcmd [--for S] [--hz H] [--bad-crc] MOTOR MODE Q DQ TAU KP KD
  *                             rt/lowcmd for one motor (the others mode 0), crc set (or wrong)
+ *   listen [--for S]          read rt/joint_states for S seconds: 'samples N'
  *   latency [--count N] [--hz H] NAME A B
  *                             commands for joint NAME alternating between positions A and B,
  *                             printing 'sent T_NS POS' for each (CLOCK_MONOTONIC at dds_write)
@@ -96,6 +97,33 @@ static int cmd_states(double timeout_s)
                i < m.position._length ? m.position._buffer[i] : NAN,
                i < m.velocity._length ? m.velocity._buffer[i] : NAN,
                i < m.effort._length ? m.effort._buffer[i] : NAN);
+    return 0;
+}
+
+static int cmd_listen(double seconds)
+{
+    dds_entity_t pp = dds_create_participant(domain, NULL, NULL);
+    dds_entity_t tp = make_topic(pp, &sensor_msgs_msg_dds__JointState__desc, "joint_states");
+    dds_qos_t *q = dds_create_qos();
+    dds_entity_t r;
+    void *ptrs[16] = {NULL};
+    dds_sample_info_t si[16];
+    double end = mono_s() + seconds;
+    long n = 0;
+    dds_qset_reliability(q, DDS_RELIABILITY_RELIABLE, DDS_SECS(1));
+    dds_qset_history(q, DDS_HISTORY_KEEP_LAST, 16);
+    r = dds_create_reader(pp, tp, q, NULL);
+    dds_delete_qos(q);
+    while (mono_s() < end) {
+        int k = dds_take(r, ptrs, si, 16, 16);
+        if (k > 0) {
+            n += k;
+            dds_return_loan(r, ptrs, k);
+        } else {
+            dds_sleepfor(DDS_USECS(500));
+        }
+    }
+    printf("samples %ld\n", n);
     return 0;
 }
 
@@ -488,6 +516,8 @@ int main(int argc, char **argv)
     setvbuf(stdout, NULL, _IOLBF, 0);
     if (strcmp(cmd, "states") == 0)
         return cmd_states(timeout_s);
+    if (strcmp(cmd, "listen") == 0)
+        return cmd_listen(seconds);
     if (strcmp(cmd, "diag") == 0)
         return cmd_diag(timeout_s);
     if (strcmp(cmd, "lowstate") == 0)

@@ -6,6 +6,7 @@
  */
 #include <errno.h>
 #include <signal.h>
+#include <sys/resource.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -314,6 +315,21 @@ static void wait_period(struct timespec *next, long period_ns)
     (void)clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, next, NULL);
 }
 
+/* One line at exit: cycles, their rate, and the process's CPU time (DDS's threads included). */
+static void print_summary(const j288_robot_t *r, uint32_t start_us)
+{
+    j288_robot_stats_t rs;
+    struct rusage ru;
+    double secs = (double)(uint32_t)(j288_linux_now_us() - start_us) * 1e-6, cpu;
+    (void)j288_robot_stats(r, &rs);
+    (void)getrusage(RUSAGE_SELF, &ru);
+    cpu = (double)ru.ru_utime.tv_sec + (double)ru.ru_stime.tv_sec +
+          1e-6 * (double)(ru.ru_utime.tv_usec + ru.ru_stime.tv_usec);
+    fprintf(stderr, "j288-dds: %lu cycles (%lu complete) in %.2f s, %.0f cycles/s, cpu %.3f s\n",
+            (unsigned long)rs.cycles, (unsigned long)rs.complete_cycles, secs,
+            secs > 0 ? (double)rs.cycles / secs : 0.0, cpu);
+}
+
 static int run(const options_t *o)
 {
     static j288_robot_config_t cfg;
@@ -391,6 +407,7 @@ static int run(const options_t *o)
                 rc == J288_OK ? "broadcast lock sent" : j288_strerror(rc));
         publish_diagnostics(&b, &io);
     }
+    print_summary(&robot, start_us);
     j288_robot_close(&robot);
     (void)dds_delete(io.participant);
     return status;

@@ -1,0 +1,98 @@
+#!/usr/bin/env bash
+# usage: [BUILD=build] [DURATION=5] scripts/bench-dds.sh      (make bench-dds)
+# j288-dds's cost, in a private network namespace (test/dds/lib_dds.sh), against four j288-sim
+# buses of three servos (pseudo-terminals), everything back to back:
+# - cycles/s and CPU per cycle of the runner alone (`j288 --config F log --rate 0`), of the
+#   bridge publishing with nobody listening, and of the bridge publishing to a subscriber
+#   (test/dds/dds_peer listen); the difference in CPU per cycle is what DDS costs;
+# - command-to-wire latency at --rate 1000: the peer's dds_write of a joint_command (its
+#   CLOCK_MONOTONIC) to the write() of the first frame carrying that target (stamped by
+#   test/bench/write_stamp.so preloaded into the bridge), p50 / p99 / max over COUNT commands.
+# Wall-clock figures on a shared machine: compare the rows of one run. Needs make dds, j288.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+. test/dds/lib_dds.sh
+dds_netns "$0" "$@"
+BUILD=${BUILD:-build}
+BIN=$BUILD/bin
+DURATION=${DURATION:-5}
+COUNT=${COUNT:-300}
+tmp=$(mktemp -d)
+SIM_DIR=$tmp
+. test/e2e/lib_sim.sh
+. test/dds/lib_dds.sh
+trap 'sim_cleanup TERM' EXIT
+SHIM=$BUILD/bench/write_stamp.so
+for f in "$BIN/j288" "$DDS" "$PEER" "$SIM" "$SHIM"; do
+    [ -x "$f" ] || [ -f "$f" ] || { echo "bench-dds: $f missing (make dds all, then make bench-dds)" >&2; exit 1; }
+done
+
+start_sims 4 --exit-after 600 --log "$tmp/log.{k}"
+robot_config 4 "$tmp/robot.yaml" 5000 20 1
+
+# the runner alone: cycles/s from its JSON, CPU from time(1)
+/usr/bin/time -f 'cpu %U %S' -o "$tmp/time" "$BIN/j288" --config "$tmp/robot.yaml" log --rate 0 \
+    --duration "$DURATION" --json >"$tmp/log.json"
+log_rate=$(sed -n 's/.*"cycles_per_s": *\([0-9.]*\).*/\1/p' "$tmp/log.json")
+log_cycles=$(sed -n 's/.*"cycles": *\([0-9]*\).*/\1/p' "$tmp/log.json" | head -n1)
+log_cpu=$(awk '{ print $2 + $3 }' "$tmp/time")
+
+# the bridge for DURATION s: "cycles rate cpu" from its summary line
+bridge_run() {
+    "$DDS" --config "$tmp/robot.yaml" --domain "$DDS_DOMAIN" "$@" 2>"$tmp/bridge.err" &
+    local p=$!
+    sleep "$DURATION"
+    kill -INT $p; wait $p || true
+    sed -n 's/^j288-dds: \([0-9]*\) cycles .* s, \([0-9]*\) cycles\/s, cpu \([0-9.]*\) s$/\1 \2 \3/p' "$tmp/bridge.err"
+}
+read -r quiet_cycles quiet_rate quiet_cpu < <(bridge_run --rate 0)
+"$PEER" listen --for $((DURATION + 3)) >"$tmp/listen" &
+lp=$!
+sleep 1
+read -r pub_cycles pub_rate pub_cpu < <(bridge_run --rate 0)
+wait $lp
+samples=$(sed -n 's/^samples //p' "$tmp/listen")
+
+# latency at 1 kHz
+: >"$tmp/log.0"
+J288_WRITE_STAMP=$tmp/stamps LD_PRELOAD=$PWD/$SHIM "$DDS" --config "$tmp/robot.yaml" \
+    --domain "$DDS_DOMAIN" --rate 1000 --timeout 1000 2>"$tmp/bridge.err" &
+bp=$!
+for _ in $(seq 1 30); do "$PEER" states --timeout 1 >"$tmp/first" 2>/dev/null && ! grep -q nan "$tmp/first" && break; done
+"$PEER" latency --count "$COUNT" --hz 50 leg0_1 0.30 0.35 >"$tmp/sent"
+sleep 0.5
+kill -INT $bp; wait $bp || true
+
+echo "j288-dds benchmark: 4 buses x 3 servos on j288-sim, ${DURATION} s each, $(nproc) cores"
+printf '%-44s %9s %14s\n' "setup (back to back)" "cycles/s" "CPU us/cycle"
+awk -v c="$log_cycles" -v r="$log_rate" -v u="$log_cpu" 'BEGIN { printf "%-44s %9.0f %14.1f\n", "runner alone (j288 log --rate 0)", r, u * 1e6 / c }'
+awk -v c="$quiet_cycles" -v r="$quiet_rate" -v u="$quiet_cpu" 'BEGIN { printf "%-44s %9.0f %14.1f\n", "j288-dds, nobody subscribed", r, u * 1e6 / c }'
+awk -v c="$pub_cycles" -v r="$pub_rate" -v u="$pub_cpu" -v s="$samples" 'BEGIN { printf "%-44s %9.0f %14.1f\n", "j288-dds, a subscriber (" s " samples)", r, u * 1e6 / c }'
+python3 - "$tmp/sent" "$tmp/stamps" "$tmp/log.0" <<'PY'
+import sys
+sent = [(int(t), float(p)) for _, t, p in (l.split() for l in open(sys.argv[1]) if l.startswith('sent '))]
+frames = [(int(t), h) for t, _, h in (l.split() for l in open(sys.argv[2]))]
+# the simulator of bus leg0 decodes every frame it got: hex -> (id, status, pos)
+dec = {}
+for l in open(sys.argv[3]):
+    f = l.split()
+    if len(f) >= 8 and f[2] == 'id=1' and f[3] == 'status=1':
+        dec[f[1]] = int(f[7].split('=')[1])
+raws = sorted(set(dec.values()))
+if len(raws) != 2:
+    sys.exit('bench-dds: expected two target positions on the wire, saw %d' % len(raws))
+raw_of = {0.30: raws[0], 0.35: raws[1]}   # direction 1: the larger angle, the larger count
+lat, j = [], 0
+for t, p in sent:
+    while j < len(frames) and frames[j][0] < t:
+        j += 1
+    k = j
+    while k < len(frames) and dec.get(frames[k][1]) != raw_of[round(p, 2)]:
+        k += 1
+    if k < len(frames):
+        lat.append((frames[k][0] - t) / 1000.0)
+lat.sort()
+q = lambda f: lat[min(len(lat) - 1, int(f * len(lat)))]
+print('command to wire at --rate 1000 (%d of %d commands): p50 %.0f us, p99 %.0f us, max %.0f us'
+      % (len(lat), len(sent), q(0.5), q(0.99), lat[-1]))
+PY
