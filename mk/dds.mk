@@ -3,11 +3,12 @@
 #   make dds           $(DDS_BIN): build/bin/j288-dds (also built by `make` when found)
 #   test/dds/*.sh      golden XCDR1 bytes and the unitree crc, and the bridge end to end, each
 #                      in a private network namespace (TEST_SCRIPTS)
+#   make test-dds      those tests alone (CI's test-dds step)
 #   make bench-dds     cycles/s with and without DDS, command-to-wire latency, DDS's CPU share
 # Without Cyclone DDS: a one-line notice and nothing else (CI=true: an error).
 # The IDL in tools/j288-dds/idl is compiled by idlc into $(DDS_GEN) (-t: no XTypes type
 # information, so that peers match on the type name as ROS 2's rmw_cyclonedds does).
-.PHONY: dds dds-missing bench-dds install-dds
+.PHONY: dds dds-missing test-dds bench-dds install-dds
 DDS_FOUND := $(shell pkg-config --exists CycloneDDS 2>/dev/null && command -v idlc >/dev/null 2>&1 && echo yes)
 DDS_BIN := $(BIN)/j288-dds
 DDS_GEN := $(BUILD)/dds/gen
@@ -21,6 +22,7 @@ DDS_LIBS := $(shell pkg-config --libs CycloneDDS 2>/dev/null)
 DDS_TOOL_OBJ := $(addprefix $(OBJ)/tools/j288-dds/,bridge.o diag.o unitree_crc.o)
 DDS_TEST_PEER := $(BUILD)/test/dds_peer
 DDS_GOLDEN := $(BUILD)/test/dds_golden
+DDS_TESTS := test/dds/golden.sh test/dds/bridge_e2e.sh test/dds/unitree_e2e.sh
 
 ifeq ($(DDS_FOUND),yes)
 # idlc writes NAME.c and NAME.h; the .c stands for both.
@@ -61,7 +63,10 @@ $(DDS_GOLDEN): $(OBJ)/test/dds/dds_golden.o $(OBJ)/tools/j288-dds/unitree_crc.o 
 dds: $(DDS_BIN)
 ALL_TARGETS += $(DDS_BIN) $(DDS_TEST_PEER) $(DDS_GOLDEN)
 TEST_DEPS += $(DDS_BIN) $(DDS_TEST_PEER) $(DDS_GOLDEN) $(SIM_BIN)
-TEST_SCRIPTS += test/dds/golden.sh test/dds/bridge_e2e.sh test/dds/unitree_e2e.sh
+TEST_SCRIPTS += $(DDS_TESTS)
+
+test-dds: $(DDS_BIN) $(DDS_TEST_PEER) $(DDS_GOLDEN) $(SIM_BIN)
+	$(call RUN_TESTS,$(DDS_TESTS))
 
 install-dds: $(DDS_BIN)
 	install -d $(DESTDIR)$(BINDIR)
@@ -70,7 +75,7 @@ install-dds: $(DDS_BIN)
 bench-dds: $(DDS_BIN) $(DDS_TEST_PEER) $(SIM_BIN) $(J288_BIN) $(BUILD)/bench/write_stamp.so
 	BUILD=$(BUILD) bash scripts/bench-dds.sh
 else
-dds dds-missing bench-dds:
+dds dds-missing test-dds bench-dds:
 	@if [ "$${CI:-}" = true ]; then \
 	    echo "error: Cyclone DDS not found (CI=true: a failure); install: cyclonedds-dev cyclonedds-tools" >&2; exit 1; fi
 	@echo "notice: skipping j288-dds and its tests, Cyclone DDS not found; install with: apt-get install -y --no-install-recommends cyclonedds-dev cyclonedds-tools" >&2
