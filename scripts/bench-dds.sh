@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# usage: [BUILD=build] [DURATION=5] scripts/bench-dds.sh      (make bench-dds)
+# usage: [BUILD=build] [DURATION=5] [ROUNDS=3] [COUNT=300] scripts/bench-dds.sh  (make bench-dds)
 # j288-dds's cost, in a private network namespace (test/dds/lib_dds.sh), against four j288-sim
 # buses of three servos (pseudo-terminals), everything back to back:
 # - cycles/s and CPU per cycle of the runner alone (`j288 --config F log --rate 0`), of the
@@ -17,6 +17,7 @@ BUILD=${BUILD:-build}
 BIN=$BUILD/bin
 DURATION=${DURATION:-5}
 COUNT=${COUNT:-300}
+ROUNDS=${ROUNDS:-3}
 tmp=$(mktemp -d)
 SIM_DIR=$tmp
 . test/e2e/lib_sim.sh
@@ -30,14 +31,15 @@ done
 start_sims 4 --exit-after 600 --log "$tmp/log.{k}"
 robot_config 4 "$tmp/robot.yaml" 5000 20 1
 
-# the runner alone: cycles/s from its JSON, CPU from time(1)
-/usr/bin/time -f 'cpu %U %S' -o "$tmp/time" "$BIN/j288" --config "$tmp/robot.yaml" log --rate 0 \
-    --duration "$DURATION" --json >"$tmp/log.json"
-log_rate=$(sed -n 's/.*"cycles_per_s": *\([0-9.]*\).*/\1/p' "$tmp/log.json")
-log_cycles=$(sed -n 's/.*"cycles": *\([0-9]*\).*/\1/p' "$tmp/log.json" | head -n1)
-log_cpu=$(awk '{ print $2 + $3 }' "$tmp/time")
-
-# the bridge for DURATION s: "cycles rate cpu" from its summary line
+# runner_run: "cycles rate cpu" of the runner alone (its JSON; CPU from time(1))
+runner_run() {
+    /usr/bin/time -f 'cpu %U %S' -o "$tmp/time" "$BIN/j288" --config "$tmp/robot.yaml" log \
+        --rate 0 --duration "$DURATION" --json >"$tmp/log.json"
+    echo "$(sed -n 's/.*"cycles": *\([0-9]*\).*/\1/p' "$tmp/log.json" | head -n1)" \
+         "$(sed -n 's/.*"cycles_per_s": *\([0-9.]*\).*/\1/p' "$tmp/log.json")" \
+         "$(awk '{ print $2 + $3 }' "$tmp/time")"
+}
+# bridge_run OPTIONS: the same of the bridge for DURATION s (its summary line at exit)
 bridge_run() {
     "$DDS" --config "$tmp/robot.yaml" --domain "$DDS_DOMAIN" "$@" 2>"$tmp/bridge.err" &
     local p=$!
@@ -45,13 +47,17 @@ bridge_run() {
     kill -INT $p; wait $p || true
     sed -n 's/^j288-dds: \([0-9]*\) cycles .* s, \([0-9]*\) cycles\/s, cpu \([0-9.]*\) s$/\1 \2 \3/p' "$tmp/bridge.err"
 }
-read -r quiet_cycles quiet_rate quiet_cpu < <(bridge_run --rate 0)
-"$PEER" listen --for $((DURATION + 3)) >"$tmp/listen" &
-lp=$!
-sleep 1
-read -r pub_cycles pub_rate pub_cpu < <(bridge_run --rate 0)
-wait $lp
-samples=$(sed -n 's/^samples //p' "$tmp/listen")
+# ROUNDS rounds of the three setups in turn (the machine's load drifts: medians of rounds)
+: >"$tmp/rows"
+for r in $(seq 1 "$ROUNDS"); do
+    echo "runner $(runner_run)" >>"$tmp/rows"
+    echo "quiet $(bridge_run --rate 0)" >>"$tmp/rows"
+    "$PEER" listen --for $((DURATION + 3)) >"$tmp/listen" &
+    lp=$!
+    sleep 1
+    echo "subscribed $(bridge_run --rate 0)" >>"$tmp/rows"
+    wait $lp
+done
 
 # latency at 1 kHz
 : >"$tmp/log.0"
@@ -64,10 +70,21 @@ sleep 0.5
 kill -INT $bp; wait $bp || true
 
 echo "j288-dds benchmark: 4 buses x 3 servos on j288-sim, ${DURATION} s each, $(nproc) cores"
-printf '%-44s %9s %14s\n' "setup (back to back)" "cycles/s" "CPU us/cycle"
-awk -v c="$log_cycles" -v r="$log_rate" -v u="$log_cpu" 'BEGIN { printf "%-44s %9.0f %14.1f\n", "runner alone (j288 log --rate 0)", r, u * 1e6 / c }'
-awk -v c="$quiet_cycles" -v r="$quiet_rate" -v u="$quiet_cpu" 'BEGIN { printf "%-44s %9.0f %14.1f\n", "j288-dds, nobody subscribed", r, u * 1e6 / c }'
-awk -v c="$pub_cycles" -v r="$pub_rate" -v u="$pub_cpu" -v s="$samples" 'BEGIN { printf "%-44s %9.0f %14.1f\n", "j288-dds, a subscriber (" s " samples)", r, u * 1e6 / c }'
+python3 - "$tmp/rows" <<'PY'
+import sys, statistics as st
+rows = {}
+for l in open(sys.argv[1]):
+    name, cycles, rate, cpu = l.split()
+    rows.setdefault(name, []).append((float(rate), float(cpu) * 1e6 / float(cycles)))
+label = {'runner': 'runner alone (j288 log --rate 0)', 'quiet': 'j288-dds, nobody subscribed',
+         'subscribed': 'j288-dds, publishing to a subscriber'}
+base = st.median(r for r, _ in rows['runner'])
+print('%-40s %16s %8s %14s' % ('setup (back to back), median of rounds', 'cycles/s', 'vs alone', 'CPU us/cycle'))
+for k in ('runner', 'quiet', 'subscribed'):
+    rate = st.median(r for r, _ in rows[k]); cpu = st.median(c for _, c in rows[k])
+    spread = '%.0f-%.0f' % (min(r for r, _ in rows[k]), max(r for r, _ in rows[k]))
+    print('%-40s %6.0f (%s) %7.0f%% %14.1f' % (label[k], rate, spread, 100 * rate / base, cpu))
+PY
 python3 - "$tmp/sent" "$tmp/stamps" "$tmp/log.0" <<'PY'
 import sys
 sent = [(int(t), float(p)) for _, t, p in (l.split() for l in open(sys.argv[1]) if l.startswith('sent '))]
