@@ -245,6 +245,7 @@ void bridge_check_timeouts(bridge_t *b, uint32_t now_us)
 
 void bridge_bus_lost(bridge_t *b, unsigned bus, const char *what)
 {
+    unsigned j;
     int rc;
     if (bus < J288_ROBOT_MAX_BUSES)
         b->bus_lost[bus]++;
@@ -255,6 +256,8 @@ void bridge_bus_lost(bridge_t *b, unsigned bus, const char *what)
     snprintf(b->stop_reason, sizeof b->stop_reason, "bus '%s' %s", j288_robot_bus_name(b->robot, bus),
              what);
     rc = j288_robot_stop(b->robot);
+    for (j = 0; j < J288_ROBOT_MAX_JOINTS; j++) /* at lock now: no timeout may hold them again */
+        b->joint[j].mode = JOINT_IDLE;
     fprintf(stderr, "j288-dds: --stop-on-bus-loss: every bus locked (%s); commands refused "
                     "until restart\n", rc == J288_OK ? "stop sent" : j288_strerror(rc));
 }
