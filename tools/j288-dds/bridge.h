@@ -84,6 +84,7 @@ typedef struct {
     bridge_joint_t joint[J288_ROBOT_MAX_JOINTS];
     uint32_t refused[BRIDGE_NCAUSES];
     uint32_t messages;          /* command messages taken */
+    uint32_t refused_reported;  /* refusals counted at the previous diagnostics */
     uint32_t bus_lost[J288_ROBOT_MAX_BUSES];
     /* what the samples point at (names are the runner's own strings) */
     char *names[J288_ROBOT_MAX_JOINTS];

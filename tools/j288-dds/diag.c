@@ -68,20 +68,24 @@ static void kv(diagnostic_msgs_msg_dds__DiagnosticStatus_ *s, const char *key, c
 static void bridge_status(bridge_t *b, diagnostic_msgs_msg_dds__DiagnosticArray_ *m)
 {
     unsigned c, timed_out = 0, j;
-    uint32_t refused = 0;
+    uint32_t total = 0, refused;
     diagnostic_msgs_msg_dds__DiagnosticStatus_ *s;
     for (c = 0; c < BRIDGE_NCAUSES; c++)
-        refused += b->refused[c];
+        total += b->refused[c];
+    refused = total - b->refused_reported; /* a warning while refusals go on, not forever */
+    b->refused_reported = total;
     for (j = 0; j < j288_robot_njoints(b->robot); j++)
         timed_out += b->joint[j].mode == JOINT_TIMED_OUT;
     s = status(m, b->stopped ? LEVEL_ERROR : (timed_out != 0u || refused != 0u) ? LEVEL_WARN : LEVEL_OK,
                str("j288-dds: bridge"), str("j288-dds"));
     s->message = b->stopped ? str("stopped: %s", b->stop_reason)
                  : timed_out != 0u ? str("%u joint(s) timed out", timed_out)
-                 : refused != 0u ? str("%lu command(s) refused", (unsigned long)refused)
+                 : refused != 0u ? str("%lu command(s) refused since the last report",
+                                       (unsigned long)refused)
                                 : str("ok");
     kv(s, "messages", str("%lu", (unsigned long)b->messages));
     kv(s, "timeout_ms", str("%lu", (unsigned long)(b->timeout_us / 1000u)));
+    kv(s, "refused", str("%lu", (unsigned long)total));
     kv(s, "timeout_policy", str("%s", b->policy == TIMEOUT_HOLD ? "hold" : "lock"));
     for (c = 0; c < BRIDGE_NCAUSES; c++)
         if (b->refused[c] != 0u)
