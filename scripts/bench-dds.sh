@@ -21,7 +21,8 @@ ROUNDS=${ROUNDS:-3}
 tmp=$(mktemp -d)
 SIM_DIR=$tmp
 . test/e2e/lib_sim.sh
-. test/dds/lib_dds.sh
+PEER=$BUILD/test/dds_peer
+DDS=$BIN/j288-dds
 trap 'sim_cleanup TERM' EXIT
 SHIM=$BUILD/bench/write_stamp.so
 for f in "$BIN/j288" "$DDS" "$PEER" "$SIM" "$SHIM"; do

@@ -12,15 +12,7 @@ set -u
 cd "$(dirname "$0")/../.."
 . test/dds/lib_dds.sh
 dds_netns "$0" "$@"
-BUILD=${BUILD:-build}
-BIN=${BIN:-$BUILD/bin}
-. test/e2e/lib_e2e.sh
-SIM_DIR=$E2E_TMP
-. test/e2e/lib_sim.sh
-. test/dds/lib_dds.sh
-trap 'kill -CONT "${SIM_PID_1:-}" 2>/dev/null; sim_cleanup TERM' EXIT
-trap 'exit 130' INT TERM
-need_built "$DDS" "$PEER" "$SIM"
+dds_e2e_setup
 
 start_sims 2 --exit-after 300 --truth "$SIM_DIR/truth.{k}" --log "$SIM_DIR/log.{k}"
 robot_config 2 "$SIM_DIR/robot.yaml" 5000 20 1
@@ -41,7 +33,11 @@ t_command_moves_a_joint() {
     "$PEER" command --for 30 --hz 50 leg0_2 0.5 - - & local p=$!
     wait_truth 0 2 0.5 20 || { kill $p; return 1; }
     kill $p; wait $p 2>/dev/null
-    "$PEER" states >"$SIM_DIR/states" && near "$(awk '$1 == "leg0_2" { print $2 }' "$SIM_DIR/states")" 0.5 0.02
+    wait_err 'joint leg0_2: no command for 100 ms' || return 1
+    sleep 0.3 # held: at rest
+    "$PEER" states >"$SIM_DIR/states" || return 1
+    near "$(awk '$1 == "leg0_2" { print $2 }' "$SIM_DIR/states")" "$(truth 0 2)" 0.002 ||
+        { echo "leg0_2 published $(awk '$1 == "leg0_2" { print $2 }' "$SIM_DIR/states"), true $(truth 0 2)"; return 1; }
 }
 t_silence_holds() {
     local a b
@@ -60,7 +56,7 @@ t_silence_holds() {
 bad() {
     local before after
     before=$(truth 0 3)
-    "$PEER" command --for 0.1 --hz 100 "$1" "$3" "$4" "$5" || return 1
+    "$PEER" command --count 10 --hz 100 "$1" "$3" "$4" "$5" || return 1
     wait_err "command refused: $2" || return 1
     sleep 0.2
     reported_once "$2" || return 1
@@ -73,8 +69,8 @@ t_named_twice() { bad leg0_3,leg0_3 'joint named twice' 1,1 - -; }
 t_no_values() { bad leg0_3 'no joint or no values' - - -; }
 t_nan() { bad leg0_3 'NaN or infinite value' nan - -; }
 t_infinity() {
-    "$PEER" command --for 0.1 --hz 100 leg0_3 - inf - || return 1
-    "$PEER" command --for 0.1 --hz 100 leg0_3 - - -inf || return 1
+    "$PEER" command --count 10 --hz 100 leg0_3 - inf - || return 1
+    "$PEER" command --count 10 --hz 100 leg0_3 - - -inf || return 1
     sleep 0.2
     reported_once 'NaN or infinite value'
 }

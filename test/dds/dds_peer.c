@@ -8,12 +8,13 @@
  *   states [--timeout S]      the next rt/joint_states: 'name POS VEL EFF' lines
  *   diag [--timeout S]        the next rt/diagnostics: 'status NAME|LEVEL|MESSAGE' then
  *                             'NAME|KEY=VALUE' lines
- *   command [--for S] [--hz H] NAMES POS VEL EFF
+ *   command [--for S | --count N] [--hz H] NAMES POS VEL EFF
  *                             rt/joint_command; each a comma list, '-' for an empty array;
- *                             values may be nan, inf; one message when --for is 0 (default)
+ *                             values may be nan, inf; for S seconds, or exactly N messages
+ *                             (one by default), at H per second (100)
  *   lowstate [--timeout S]    the next rt/lowstate: 'motor I Q DQ TAU TEMP MODE' lines for the
  *                             motors, then 'crc ok' or 'crc bad'
- *   lowcmd [--for S] [--hz H] [--bad-crc] MOTOR MODE Q DQ TAU KP KD
+ *   lowcmd [--for S | --count N] [--hz H] [--bad-crc] MOTOR MODE Q DQ TAU KP KD
  *                             rt/lowcmd for one motor (the others mode 0), crc set (or wrong)
  *   listen [--for S]          read rt/joint_states for S seconds: 'samples N'
  *   latency [--count N] [--hz H] NAME A B
@@ -214,6 +215,17 @@ static uint32_t crc32_core(const uint32_t *ptr, uint32_t len)
 #define PUT(img, base, type, member, src) \
     memcpy((img) + (base) + offsetof(type, member), &(src), sizeof(src))
 
+/* The members both messages start with. */
+#define PUT_HEAD(img, type, m)                               \
+    do {                                                     \
+        PUT(img, 0, type, head, (m)->head);                  \
+        PUT(img, 0, type, level_flag, (m)->level_flag);      \
+        PUT(img, 0, type, frame_reserve, (m)->frame_reserve); \
+        PUT(img, 0, type, sn, (m)->sn);                      \
+        PUT(img, 0, type, version, (m)->version);            \
+        PUT(img, 0, type, bandwidth, (m)->bandwidth);        \
+    } while (0)
+
 static uint32_t image_crc(const unsigned char *img, size_t size)
 {
     uint32_t words[300];
@@ -226,12 +238,7 @@ static uint32_t lowcmd_crc(const unitree_go_msg_dds__LowCmd_ *m)
     unsigned char img[sizeof(raw_low_cmd)];
     unsigned i;
     memset(img, 0, sizeof img);
-    PUT(img, 0, raw_low_cmd, head, m->head);
-    PUT(img, 0, raw_low_cmd, level_flag, m->level_flag);
-    PUT(img, 0, raw_low_cmd, frame_reserve, m->frame_reserve);
-    PUT(img, 0, raw_low_cmd, sn, m->sn);
-    PUT(img, 0, raw_low_cmd, version, m->version);
-    PUT(img, 0, raw_low_cmd, bandwidth, m->bandwidth);
+    PUT_HEAD(img, raw_low_cmd, m);
     for (i = 0; i < 20; i++) {
         size_t base = offsetof(raw_low_cmd, motor) + i * sizeof(raw_motor_cmd);
         const unitree_go_msg_dds__MotorCmd_ *c = &m->motor_cmd[i];
@@ -258,12 +265,7 @@ static uint32_t lowstate_crc(const unitree_go_msg_dds__LowState_ *m)
     unsigned char img[sizeof(raw_low_state)];
     unsigned i;
     memset(img, 0, sizeof img);
-    PUT(img, 0, raw_low_state, head, m->head);
-    PUT(img, 0, raw_low_state, level_flag, m->level_flag);
-    PUT(img, 0, raw_low_state, frame_reserve, m->frame_reserve);
-    PUT(img, 0, raw_low_state, sn, m->sn);
-    PUT(img, 0, raw_low_state, version, m->version);
-    PUT(img, 0, raw_low_state, bandwidth, m->bandwidth);
+    PUT_HEAD(img, raw_low_state, m);
     PUT(img, 0, raw_low_state, quaternion, m->imu_state.quaternion);
     PUT(img, 0, raw_low_state, gyroscope, m->imu_state.gyroscope);
     PUT(img, 0, raw_low_state, accelerometer, m->imu_state.accelerometer);
@@ -345,16 +347,18 @@ static dds_entity_t writer_for(const dds_topic_descriptor_t *d, const char *name
     return -1;
 }
 
-/* Publish write(i) at hz for seconds (once when seconds is 0). */
-static void pace(double seconds, double hz, void (*write)(void *ctx), void *ctx)
+/* Publish write() at hz: count times when count > 0, else for seconds (once when 0). */
+static void pace(int count, double seconds, double hz, void (*write)(void *ctx), void *ctx)
 {
     double end = mono_s() + seconds, next = mono_s();
+    int sent = 0;
     do {
         write(ctx);
+        sent++;
         next += 1.0 / hz;
         while (mono_s() < next)
             dds_sleepfor(DDS_USECS(200));
-    } while (mono_s() < end);
+    } while (count > 0 ? sent < count : mono_s() < end);
 }
 
 /* "a,b,c" -> values; "-" -> none. */
@@ -380,7 +384,7 @@ static void write_js(void *p)
     dds_write(c->w, &c->m);
 }
 
-static int cmd_command(double seconds, double hz, char **argv)
+static int cmd_command(int count, double seconds, double hz, char **argv)
 {
     static char *names[MAXN];
     static double pos[MAXN], vel[MAXN], eff[MAXN];
@@ -401,7 +405,7 @@ static int cmd_command(double seconds, double hz, char **argv)
     c.w = writer_for(&sensor_msgs_msg_dds__JointState__desc, "joint_command");
     if (c.w < 0)
         return 1;
-    pace(seconds, hz, write_js, &c);
+    pace(count, seconds, hz, write_js, &c);
     dds_wait_for_acks(c.w, DDS_SECS(2));
     return 0;
 }
@@ -417,7 +421,7 @@ static void write_lc(void *p)
     dds_write(c->w, &c->m);
 }
 
-static int cmd_lowcmd(double seconds, double hz, int bad_crc, char **argv)
+static int cmd_lowcmd(int count, double seconds, double hz, int bad_crc, char **argv)
 {
     static lc_ctx c;
     unitree_go_msg_dds__MotorCmd_ *mc;
@@ -438,7 +442,7 @@ static int cmd_lowcmd(double seconds, double hz, int bad_crc, char **argv)
     c.w = writer_for(&unitree_go_msg_dds__LowCmd__desc, "lowcmd");
     if (c.w < 0)
         return 1;
-    pace(seconds, hz, write_lc, &c);
+    pace(count, seconds, hz, write_lc, &c);
     dds_wait_for_acks(c.w, DDS_SECS(2));
     return 0;
 }
@@ -476,7 +480,7 @@ static int cmd_latency(int count, double hz, char **argv)
 int main(int argc, char **argv)
 {
     double timeout_s = 10.0, seconds = 0.0, hz = 100.0;
-    int i = 1, bad_crc = 0, count = 100;
+    int i = 1, bad_crc = 0, count = 0; /* latency: 100 when not given */
     const char *cmd;
     const char *env = getenv("DDS_DOMAIN");
     if (env != NULL)
@@ -523,11 +527,11 @@ int main(int argc, char **argv)
     if (strcmp(cmd, "lowstate") == 0)
         return cmd_lowstate(timeout_s);
     if (strcmp(cmd, "command") == 0 && argc - i == 4)
-        return cmd_command(seconds, hz, argv + i);
+        return cmd_command(count, seconds, hz, argv + i);
     if (strcmp(cmd, "lowcmd") == 0 && argc - i == 7)
-        return cmd_lowcmd(seconds, hz, bad_crc, argv + i);
+        return cmd_lowcmd(count, seconds, hz, bad_crc, argv + i);
     if (strcmp(cmd, "latency") == 0 && argc - i == 3)
-        return cmd_latency(count, hz, argv + i);
+        return cmd_latency(count > 0 ? count : 100, hz, argv + i);
     fprintf(stderr, "dds_peer: bad usage (see the top of test/dds/dds_peer.c)\n");
     return 2;
 }

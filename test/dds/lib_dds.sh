@@ -27,10 +27,24 @@ dds_netns() {
     export DDS_DOMAIN
 }
 
-# ---- the bridge against simulators (after test/e2e/lib_e2e.sh and lib_sim.sh) ----
-PEER=${BUILD:-build}/test/dds_peer
-PEER_ARGS=()
-DDS=${BIN:-build/bin}/j288-dds
+# ---- the bridge against simulators ----
+
+# dds_e2e_setup: after dds_netns, for the end-to-end scripts: BUILD, BIN, the e2e and
+# simulator helpers (test/e2e/lib_e2e.sh, lib_sim.sh; SIM_DIR is E2E_TMP), PEER and DDS, and
+# the traps (every process stopped, a frozen simulator resumed first, at exit).
+dds_e2e_setup() {
+    BUILD=${BUILD:-build}
+    BIN=${BIN:-$BUILD/bin}
+    . test/e2e/lib_e2e.sh
+    SIM_DIR=$E2E_TMP
+    . test/e2e/lib_sim.sh
+    PEER=$BUILD/test/dds_peer
+    PEER_ARGS=()
+    DDS=$BIN/j288-dds
+    trap 'kill -CONT "${SIM_PID_1:-}" 2>/dev/null; sim_cleanup TERM' EXIT
+    trap 'exit 130' INT TERM
+    need_built "$DDS" "$PEER" "$SIM"
+}
 
 # near A B TOL: |A - B| <= TOL, angles compared modulo 2 pi.
 near() {
@@ -97,12 +111,18 @@ reported_once() {
     [ "$n" -eq 1 ] || { echo "'$1' reported $n times"; return 1; }
 }
 
-# wait_truth K ID TARGET [SECONDS]: servo ID of simulator K reaches TARGET (0.01 rad).
+# wait_truth K ID TARGET [SECONDS]: servo ID of simulator K reaches TARGET (0.01 rad) and
+# stays there (two readings 0.2 s apart).
 wait_truth() {
-    local i t
+    local i t near_before=0
     for i in $(seq 1 $((${4:-20} * 5))); do
         t=$(truth "$1" "$2")
-        near "$t" "$3" 0.01 && return 0
+        if near "$t" "$3" 0.01; then
+            [ $near_before = 1 ] && return 0
+            near_before=1
+        else
+            near_before=0
+        fi
         sleep 0.2
     done
     echo "servo $2 on simulator $1 at $t, not $3"; return 1

@@ -9,15 +9,7 @@ set -u
 cd "$(dirname "$0")/../.."
 . test/dds/lib_dds.sh
 dds_netns "$0" "$@"
-BUILD=${BUILD:-build}
-BIN=${BIN:-$BUILD/bin}
-. test/e2e/lib_e2e.sh
-SIM_DIR=$E2E_TMP
-. test/e2e/lib_sim.sh
-. test/dds/lib_dds.sh
-trap 'sim_cleanup TERM' EXIT
-trap 'exit 130' INT TERM
-need_built "$DDS" "$PEER" "$SIM"
+dds_e2e_setup
 UNITREE=1
 
 start_sims 1 --exit-after 300 --truth "$SIM_DIR/truth.{k}" --log "$SIM_DIR/log.{k}"
@@ -52,7 +44,7 @@ t_silence_holds() {
 bad_lowcmd() {
     local cause=$1 before after; shift
     before=$(truth 0 3)
-    "$PEER" lowcmd --for 0.1 --hz 100 "$@" || return 1
+    "$PEER" lowcmd --count 10 --hz 100 "$@" || return 1
     wait_err "command refused: $cause" || return 1
     sleep 0.2
     reported_once "$cause" || return 1
