@@ -67,7 +67,7 @@ truth() {
 }
 
 # start_bridge OPTIONS...: j288-dds on $SIM_DIR/robot.yaml (stderr in $SIM_DIR/bridge.err), once
-# it publishes known angles (up to 30 s; the peer reads with PEER_ARGS, e.g. --ns NS); sets
+# it publishes known angles (diagnostics in unitree mode: LowState_ cannot say) (up to 30 s; the peer reads with PEER_ARGS, e.g. --ns NS); sets
 # BRIDGE_PID. A bridge still running from a failed check is stopped first.
 start_bridge() {
     [ -n "${BRIDGE_PID:-}" ] && kill -0 "$BRIDGE_PID" 2>/dev/null && stop_bridge
@@ -77,7 +77,9 @@ start_bridge() {
     local i
     for i in $(seq 1 30); do
         if [ "${UNITREE:-0}" = 1 ]; then
-            "$PEER" "${PEER_ARGS[@]}" lowstate --timeout 1 >"$SIM_DIR/first" 2>/dev/null && return 0
+            "$PEER" "${PEER_ARGS[@]}" diag --timeout 2 >"$SIM_DIR/first" 2>/dev/null &&
+                grep -q 'angle_known=true' "$SIM_DIR/first" &&
+                ! grep -q 'angle_known=false' "$SIM_DIR/first" && return 0
         else
             "$PEER" "${PEER_ARGS[@]}" states --timeout 1 >"$SIM_DIR/first" 2>/dev/null &&
                 ! grep -q nan "$SIM_DIR/first" && return 0

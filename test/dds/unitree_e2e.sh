@@ -13,7 +13,7 @@ dds_e2e_setup
 UNITREE=1
 
 start_sims 1 --exit-after 300 --truth "$SIM_DIR/truth.{k}" --log "$SIM_DIR/log.{k}"
-robot_config 1 "$SIM_DIR/robot.yaml" 5000 20 1
+robot_config 1 "$SIM_DIR/robot.yaml" 250000 20 1
 
 t_lowstate_is_the_truth() {
     "$PEER" lowstate >"$SIM_DIR/ls" || { echo "no lowstate"; return 1; }
