@@ -6,7 +6,8 @@
 # diagnostics), or locks it (--on-timeout lock); each bad input (unknown name, arrays of
 # different lengths, a joint named twice, no values, NaN, infinity, outside the limits) is
 # refused with nothing sent, reported once however often it comes; a namespace moves the
-# topics; Ctrl-C locks every bus; with --stop-on-bus-loss a frozen bus locks all.
+# topics; Ctrl-C locks every bus; with --stop-on-bus-loss a frozen bus locks all; bad options
+# and a config too big for unitree mode are refused before anything is opened.
 # Every wait polls and is bounded; no check depends on the machine's speed (replies get a
 # 250 ms margin: the simulators may run under valgrind, make test-valgrind).
 set -u
@@ -121,7 +122,28 @@ t_bus_loss_locks_all() {
     stop_bridge
 }
 
+t_bad_options() {
+    local rc
+    "$DDS" --config "$SIM_DIR/robot.yaml" --rate -1 2>"$SIM_DIR/err"; rc=$?
+    [ $rc -eq 2 ] && grep -q -- '--rate takes' "$SIM_DIR/err" || { echo "--rate -1: exit $rc"; return 1; }
+    "$DDS" --config "$SIM_DIR/robot.yaml" --namespace /a//b 2>/dev/null; [ $? -eq 2 ] || return 1
+    "$DDS" --config "$SIM_DIR/robot.yaml" --on-timeout drift 2>/dev/null; [ $? -eq 2 ] || return 1
+    "$DDS" --config "$SIM_DIR/robot.yaml" --domain 233 2>/dev/null; [ $? -eq 2 ] || return 1
+    "$DDS" --rate 100 2>/dev/null; [ $? -eq 2 ] || return 1
+    "$DDS" --config "$SIM_DIR/no-such.yaml" 2>"$SIM_DIR/err"; [ $? -eq 1 ] || return 1
+    grep -q 'no-such.yaml' "$SIM_DIR/err" || return 1
+    # unitree mode has 20 motor slots: 21 joints are refused before any bus is opened
+    { echo "buses:"; echo "  - {name: a, port: /dev/j288-none-a}"; echo "  - {name: b, port: /dev/j288-none-b}"
+      echo "joints:"
+      for i in $(seq 0 14); do echo "  - {name: a$i, bus: a, id: $i}"; done
+      for i in $(seq 0 5); do echo "  - {name: b$i, bus: b, id: $i}"; done; } >"$SIM_DIR/big.yaml"
+    "$DDS" --config "$SIM_DIR/big.yaml" --unitree 2>"$SIM_DIR/err"; [ $? -eq 1 ] || return 1
+    grep -q -- '--unitree: 21 joints, LowCmd_ has 20 motors' "$SIM_DIR/err" || return 1
+    "$DDS" --help | grep -q 'rt/\[NS/\]joint_command'
+}
+
 start_bridge || exit 1
+e2e_check bad_options t_bad_options
 e2e_check states_are_the_truth t_states_are_the_truth
 e2e_check command_moves_a_joint t_command_moves_a_joint
 e2e_check silence_holds t_silence_holds
