@@ -95,11 +95,9 @@ static void bridge_status(bridge_t *b, diagnostic_msgs_msg_dds__DiagnosticArray_
 static void bus_status(bridge_t *b, unsigned bus, diagnostic_msgs_msg_dds__DiagnosticArray_ *m)
 {
     j288_robot_bus_stats_t bs;
-    const j288_bus_stats_t *ws = j288_robot_bus_wire_stats(b->robot, bus);
     const char *name = j288_robot_bus_name(b->robot, bus);
     diagnostic_msgs_msg_dds__DiagnosticStatus_ *s;
     (void)j288_robot_bus_stats(b->robot, bus, &bs);
-    (void)ws;
     s = status(m, bs.gone ? LEVEL_ERROR : bs.up ? LEVEL_OK : LEVEL_ERROR,
                str("j288-dds: bus %s", name), str("bus:%s", name));
     s->message = str("%s", bs.gone ? "gone (device vanished)" : bs.up ? "up" : "down (no reply)");

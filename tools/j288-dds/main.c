@@ -277,11 +277,19 @@ static void take_commands(bridge_t *b, const dds_io_t *io, bool unitree)
         (void)dds_return_loan(io->cmd_r, samples, n);
 }
 
-static void publish_state(bridge_t *b, const dds_io_t *io, bool unitree, uint32_t start_us)
+/* CLOCK_MONOTONIC in seconds (the runner's microsecond clock wraps after 71 minutes). */
+static double mono_s(void)
+{
+    struct timespec ts;
+    (void)clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static void publish_state(bridge_t *b, const dds_io_t *io, bool unitree, double start_s)
 {
     if (unitree) {
         static unitree_go_msg_dds__LowState_ ls;
-        bridge_fill_lowstate(b, &ls, (j288_linux_now_us() - start_us) / 1000u);
+        bridge_fill_lowstate(b, &ls, (uint32_t)(uint64_t)((mono_s() - start_s) * 1000.0));
         (void)dds_write(io->state_w, &ls);
     } else {
         sensor_msgs_msg_dds__JointState_ js;
@@ -316,11 +324,11 @@ static void wait_period(struct timespec *next, long period_ns)
 }
 
 /* One line at exit: cycles, their rate, and the process's CPU time (DDS's threads included). */
-static void print_summary(const j288_robot_t *r, uint32_t start_us)
+static void print_summary(const j288_robot_t *r, double start_s)
 {
     j288_robot_stats_t rs;
     struct rusage ru;
-    double secs = (double)(uint32_t)(j288_linux_now_us() - start_us) * 1e-6, cpu;
+    double secs = mono_s() - start_s, cpu;
     (void)j288_robot_stats(r, &rs);
     (void)getrusage(RUSAGE_SELF, &ru);
     cpu = (double)ru.ru_utime.tv_sec + (double)ru.ru_stime.tv_sec +
@@ -341,7 +349,8 @@ static int run(const options_t *o)
     dds_io_t io;
     struct timespec next;
     long period_ns = o->rate_hz > 0 ? (long)(1e9 / o->rate_hz) : 0;
-    uint32_t start_us, last_diag;
+    uint32_t last_diag;
+    double start_s;
     int rc, status = 0;
 
     if (j288_robot_config_load(o->config, &cfg, err, sizeof err) != 0) {
@@ -376,7 +385,8 @@ static int run(const options_t *o)
             o->unitree ? "rt/lowstate + rt/lowcmd" : "rt/joint_states + rt/joint_command",
             o->ns != NULL ? " in namespace " : "", o->ns != NULL ? o->ns : "",
             o->rate_hz > 0 ? "paced" : "back to back");
-    start_us = last_diag = j288_linux_now_us();
+    start_s = mono_s();
+    last_diag = j288_linux_now_us();
     (void)clock_gettime(CLOCK_MONOTONIC, &next);
     publish_diagnostics(&b, &io);
     while (stop_signal == 0) {
@@ -391,7 +401,7 @@ static int run(const options_t *o)
             status = 1;
             break;
         }
-        publish_state(&b, &io, o->unitree, start_us);
+        publish_state(&b, &io, o->unitree, start_s);
         if ((uint32_t)(j288_linux_now_us() - last_diag) >= DIAG_PERIOD_US) {
             last_diag = j288_linux_now_us();
             publish_diagnostics(&b, &io);
@@ -407,7 +417,7 @@ static int run(const options_t *o)
                 rc == J288_OK ? "broadcast lock sent" : j288_strerror(rc));
         publish_diagnostics(&b, &io);
     }
-    print_summary(&robot, start_us);
+    print_summary(&robot, start_s);
     j288_robot_close(&robot);
     (void)dds_delete(io.participant);
     return status;
