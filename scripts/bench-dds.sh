@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# usage: [BUILD=build] [DURATION=5] [ROUNDS=3] [COUNT=300] scripts/bench-dds.sh  (make bench-dds)
+# usage: [BUILD=build] [DURATION=5] [ROUNDS=3] [COUNT=300] [CALLGRIND=1] scripts/bench-dds.sh
+#        (make bench-dds)
 # j288-dds's cost, in a private network namespace (test/dds/lib_dds.sh), against four j288-sim
 # buses of three servos (pseudo-terminals), everything back to back:
 # - cycles/s and CPU per cycle of the runner alone (`j288 --config F log --rate 0`), of the
@@ -7,7 +8,9 @@
 #   (test/dds/dds_peer listen); the difference in CPU per cycle is what DDS costs;
 # - command-to-wire latency at --rate 1000: the peer's dds_write of a joint_command (its
 #   CLOCK_MONOTONIC) to the write() of the first frame carrying that target (stamped by
-#   test/bench/write_stamp.so preloaded into the bridge), p50 / p99 / max over COUNT commands.
+#   test/bench/write_stamp.so preloaded into the bridge), p50 / p99 / max over COUNT commands;
+# - with CALLGRIND=1, instructions per cycle (valgrind --tool=callgrind, every thread): the
+#   runner alone, and the bridge publishing to a subscriber, split into its parts.
 # Wall-clock figures on a shared machine: compare the rows of one run. Needs make dds, j288.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -70,6 +73,22 @@ for _ in $(seq 1 30); do "$PEER" states --timeout 1 >"$tmp/first" 2>/dev/null &&
 sleep 0.5
 kill -INT $bp; wait $bp || true
 
+# instructions per cycle, counted by callgrind (repeatable, unlike the seconds above)
+if [ "${CALLGRIND:-0}" = 1 ]; then
+    valgrind --tool=callgrind --callgrind-out-file="$tmp/runner.cg" "$BIN/j288" \
+        --config "$tmp/robot.yaml" log --rate 0 --duration 4 --json >"$tmp/log.json" 2>/dev/null
+    cg_runner_cycles=$(sed -n 's/.*"cycles": *\([0-9]*\).*/\1/p' "$tmp/log.json" | head -n1)
+    "$PEER" listen --for 12 >/dev/null &
+    lp=$!
+    valgrind --tool=callgrind --callgrind-out-file="$tmp/dds.cg" "$DDS" --config "$tmp/robot.yaml" \
+        --domain "$DDS_DOMAIN" --rate 0 2>"$tmp/dds.err" &
+    vp=$!
+    sleep 8
+    kill -INT $vp; wait $vp || true
+    wait $lp
+    cg_dds_cycles=$(sed -n 's/^j288-dds: \([0-9]*\) cycles .*/\1/p' "$tmp/dds.err")
+fi
+
 echo "j288-dds benchmark: 4 buses x 3 servos on j288-sim, ${DURATION} s each, $(nproc) cores"
 python3 - "$tmp/rows" <<'PY'
 import sys, statistics as st
@@ -114,3 +133,20 @@ q = lambda f: lat[min(len(lat) - 1, int(f * len(lat)))]
 print('command to wire at --rate 1000 (%d of %d commands): p50 %.0f us, p99 %.0f us, max %.0f us'
       % (len(lat), len(sent), q(0.5), q(0.99), lat[-1]))
 PY
+if [ "${CALLGRIND:-0}" = 1 ]; then
+    echo "instructions per cycle (callgrind, all threads; start-up included in the totals):"
+    # inclusive cost of a function: the first number on its line of callgrind_annotate
+    incl() { callgrind_annotate --inclusive=yes "$1" 2>/dev/null | awk -v f="$2" '$0 ~ f { gsub(",", "", $1); print $1; exit }'; }
+    total() { callgrind_annotate "$1" 2>/dev/null | awk '/PROGRAM TOTALS/ { gsub(",", "", $1); print $1; exit }'; }
+    per() { awk -v a="${1:-0}" -v c="$2" 'BEGIN { printf "%8.0f", a / c }'; }
+    printf '  runner alone: total %s, j288_robot_cycle %s  (%s cycles)\n' \
+        "$(per "$(total "$tmp/runner.cg")" "$cg_runner_cycles")" \
+        "$(per "$(incl "$tmp/runner.cg" ':j288_robot_cycle ')" "$cg_runner_cycles")" "$cg_runner_cycles"
+    printf '  j288-dds:     total %s, j288_robot_cycle %s, dds_write %s, dds_take %s, fill %s, diagnostics %s  (%s cycles)\n' \
+        "$(per "$(total "$tmp/dds.cg")" "$cg_dds_cycles")" \
+        "$(per "$(incl "$tmp/dds.cg" ':j288_robot_cycle ')" "$cg_dds_cycles")" \
+        "$(per "$(incl "$tmp/dds.cg" ':dds_write ')" "$cg_dds_cycles")" \
+        "$(per "$(incl "$tmp/dds.cg" ':dds_take ')" "$cg_dds_cycles")" \
+        "$(per "$(incl "$tmp/dds.cg" 'bridge_fill_joint_state ')" "$cg_dds_cycles")" \
+        "$(per "$(incl "$tmp/dds.cg" 'publish_diagnostics')" "$cg_dds_cycles")" "$cg_dds_cycles"
+fi
