@@ -122,12 +122,73 @@ static void low_cmd(unitree_go_msg_dds__LowCmd_ *m)
     m->crc = j288_dds_lowcmd_crc(m);
 }
 
+/* The LowState sample for the crc alone (the same in golden.py). */
+static void low_state(unitree_go_msg_dds__LowState_ *m)
+{
+    static const float imu[13] = {1.0f, 0, 0, 0, 0.5f, -0.5f, 0.25f, 0, 0, 9.75f, 0.125f, -0.125f, 3.0f};
+    unsigned i;
+    memset(m, 0, sizeof *m);
+    m->head[0] = 0xFE;
+    m->head[1] = 0xEF;
+    m->level_flag = 0xFF;
+    m->sn[0] = 5;
+    m->sn[1] = 6;
+    m->version[0] = 7;
+    m->version[1] = 8;
+    m->bandwidth = 0x4321;
+    memcpy(m->imu_state.quaternion, imu, 4 * sizeof(float));
+    memcpy(m->imu_state.gyroscope, imu + 4, 3 * sizeof(float));
+    memcpy(m->imu_state.accelerometer, imu + 7, 3 * sizeof(float));
+    memcpy(m->imu_state.rpy, imu + 10, 3 * sizeof(float));
+    m->imu_state.temperature = -7;
+    for (i = 0; i < 20u; i++) {
+        unitree_go_msg_dds__MotorState_ *s = &m->motor_state[i];
+        s->mode = (uint8_t)(i % 2u);
+        s->q = 0.5f * (float)i;
+        s->dq = -0.25f * (float)i;
+        s->tau_est = 1.5f;
+        s->temperature = (int8_t)(30 + i);
+        s->lost = 3u * i;
+    }
+    m->bms_state.version_high = 1;
+    m->bms_state.version_low = 2;
+    m->bms_state.status = 3;
+    m->bms_state.soc = 80;
+    m->bms_state.current = -1500;
+    m->bms_state.cycle = 42;
+    m->bms_state.bq_ntc[0] = -3;
+    m->bms_state.bq_ntc[1] = 4;
+    m->bms_state.mcu_ntc[0] = 5;
+    m->bms_state.mcu_ntc[1] = -6;
+    for (i = 0; i < 15u; i++)
+        m->bms_state.cell_vol[i] = (uint16_t)(3700u + i);
+    m->foot_force[0] = 10;
+    m->foot_force[1] = -20;
+    m->foot_force[2] = 30;
+    m->foot_force[3] = -40;
+    for (i = 0; i < 4u; i++)
+        m->foot_force_est[i] = (int16_t)(i + 1u);
+    m->tick = 123456;
+    for (i = 0; i < 40u; i++)
+        m->wireless_remote[i] = (uint8_t)i;
+    m->bit_flag = 0x5A;
+    m->adc_reel = 0.75f;
+    m->temperature_ntc1 = 33;
+    m->temperature_ntc2 = 34;
+    m->power_v = 24.5f;
+    m->power_a = -1.25f;
+    for (i = 0; i < 4u; i++)
+        m->fan_frequency[i] = (uint16_t)(100u * (i + 1u));
+    m->reserve = 0xCAFEF00Du;
+}
+
 int main(int argc, char **argv)
 {
     dds_domainid_t domain = argc > 1 ? (dds_domainid_t)atoi(argv[1]) : 0;
     dds_entity_t pp = dds_create_participant(domain, NULL, NULL);
     static sensor_msgs_msg_dds__JointState_ js;
     static unitree_go_msg_dds__LowCmd_ lc;
+    static unitree_go_msg_dds__LowState_ ls;
     static char ab[] = "ab";
     std_msgs_msg_dds__Header_ hd = {{-2, 7u}, ab}; /* the same in golden.py */
     int rc = 0;
@@ -138,6 +199,8 @@ int main(int argc, char **argv)
     joint_state(&js);
     low_cmd(&lc);
     printf("lowcmd_crc %08lx\n", (unsigned long)lc.crc);
+    low_state(&ls);
+    printf("lowstate_crc %08lx\n", (unsigned long)j288_dds_lowstate_crc(&ls));
     if (print_cdr(pp, &sensor_msgs_msg_dds__JointState__desc, "joint_state", &js) != 0 ||
         print_cdr(pp, &unitree_go_msg_dds__LowCmd__desc, "lowcmd", &lc) != 0 ||
         print_cdr(pp, &std_msgs_msg_dds__Header__desc, "header", &hd) != 0)

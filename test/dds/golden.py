@@ -15,7 +15,8 @@ The unitree crc (unitree_sdk2): the message copied into a C struct (natural alig
 padding), crc32_core over its 32-bit little-endian words but the last: polynomial 0x04C11DB7,
 initial 0xFFFFFFFF, each word shifted in most significant bit first, no final XOR.
 
-Prints `name hex` lines in dds_golden's order. The samples must match dds_golden.c's."""
+Prints `name hex` lines in dds_golden's order (and the crc of a LowState sample, which only
+the crc test uses). The samples must match dds_golden.c's."""
 import struct
 
 
@@ -102,6 +103,28 @@ def lowcmd_crc():
     return crc32_core(words)
 
 
+# The LowState sample (the same in dds_golden.c): unitree's C struct LowState, 1180 bytes.
+LOWSTATE_FMT = ('<4B4IH2x' + '13fb3x' + 'B3x7fb3x3I' * 20 + '4BiH4b15H'
+                + '8hI40BB3xfBB2x2f4H2I')
+
+
+def lowstate_values():
+    v = [0xFE, 0xEF, 0xFF, 0, 5, 6, 7, 8, 0x4321]
+    v += [1.0, 0.0, 0.0, 0.0, 0.5, -0.5, 0.25, 0.0, 0.0, 9.75, 0.125, -0.125, 3.0, -7]
+    for i in range(20):
+        v += [i % 2, 0.5 * i, -0.25 * i, 0.0, 1.5, 0.0, 0.0, 0.0, 30 + i, i * 3, 0, 0]
+    v += [1, 2, 3, 80, -1500, 42, -3, 4, 5, -6] + [3700 + k for k in range(15)]
+    v += [10, -20, 30, -40, 1, 2, 3, 4, 123456] + [k for k in range(40)]
+    v += [0x5A, 0.75, 33, 34, 24.5, -1.25, 100, 200, 300, 400, 0xCAFEF00D, 0]
+    return v
+
+
+def lowstate_crc():
+    raw = struct.pack(LOWSTATE_FMT, *lowstate_values())
+    assert len(raw) == 1180
+    return crc32_core(struct.unpack('<295I', raw)[:-1])
+
+
 def lowcmd(crc):
     c = Cdr()
     for fmt, v in lowcmd_fields(crc):
@@ -118,6 +141,7 @@ def header_only():
 if __name__ == '__main__':
     crc = lowcmd_crc()
     print('lowcmd_crc %08x' % crc)
+    print('lowstate_crc %08x' % lowstate_crc())
     print('joint_state ' + joint_state().hex())
     print('lowcmd ' + lowcmd(crc).hex())
     print('header ' + header_only().hex())
