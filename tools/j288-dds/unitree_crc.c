@@ -43,6 +43,27 @@ static void put_f32(packer_t *p, float f)
     put_u32(p, v);
 }
 
+static void put_f32s(packer_t *p, const float *f, size_t n)
+{
+    size_t k;
+    for (k = 0; k < n; k++)
+        put_f32(p, f[k]);
+}
+
+static void put_u16s(packer_t *p, const uint16_t *v, size_t n)
+{
+    size_t k;
+    for (k = 0; k < n; k++)
+        put_u16(p, v[k]);
+}
+
+static void put_i16s(packer_t *p, const int16_t *v, size_t n)
+{
+    size_t k;
+    for (k = 0; k < n; k++)
+        put_u16(p, (uint16_t)v[k]);
+}
+
 static void put_bytes(packer_t *p, const uint8_t *b, size_t n)
 {
     memcpy(p->buf + p->pos, b, n);
@@ -97,17 +118,13 @@ void j288_dds_pack_lowstate(const unitree_go_msg_dds__LowState_ *m,
     packer_t p = {out, 0u};
     const unitree_go_msg_dds__IMUState_ *imu = &m->imu_state;
     const unitree_go_msg_dds__BmsState_ *bms = &m->bms_state;
-    unsigned i, k;
+    unsigned i;
     put_head(&p, m->head, m->level_flag, m->frame_reserve, m->sn, m->version, m->bandwidth);
     align(&p, 4u);
-    for (k = 0; k < 4u; k++)
-        put_f32(&p, imu->quaternion[k]);
-    for (k = 0; k < 3u; k++)
-        put_f32(&p, imu->gyroscope[k]);
-    for (k = 0; k < 3u; k++)
-        put_f32(&p, imu->accelerometer[k]);
-    for (k = 0; k < 3u; k++)
-        put_f32(&p, imu->rpy[k]);
+    put_f32s(&p, imu->quaternion, 4u);
+    put_f32s(&p, imu->gyroscope, 3u);
+    put_f32s(&p, imu->accelerometer, 3u);
+    put_f32s(&p, imu->rpy, 3u);
     put_u8(&p, (uint8_t)imu->temperature);
     for (i = 0; i < 20u; i++) {
         const unitree_go_msg_dds__MotorState_ *s = &m->motor_state[i];
@@ -132,17 +149,14 @@ void j288_dds_pack_lowstate(const unitree_go_msg_dds__LowState_ *m,
     put_u8(&p, bms->soc);
     put_u32(&p, (uint32_t)bms->current);
     put_u16(&p, bms->cycle);
-    for (k = 0; k < 2u; k++)
-        put_u8(&p, (uint8_t)bms->bq_ntc[k]);
-    for (k = 0; k < 2u; k++)
-        put_u8(&p, (uint8_t)bms->mcu_ntc[k]);
-    for (k = 0; k < 15u; k++)
-        put_u16(&p, bms->cell_vol[k]);
+    put_u8(&p, (uint8_t)bms->bq_ntc[0]);
+    put_u8(&p, (uint8_t)bms->bq_ntc[1]);
+    put_u8(&p, (uint8_t)bms->mcu_ntc[0]);
+    put_u8(&p, (uint8_t)bms->mcu_ntc[1]);
+    put_u16s(&p, bms->cell_vol, 15u);
     align(&p, 4u); /* end of BmsState (size 44) */
-    for (k = 0; k < 4u; k++)
-        put_u16(&p, (uint16_t)m->foot_force[k]);
-    for (k = 0; k < 4u; k++)
-        put_u16(&p, (uint16_t)m->foot_force_est[k]);
+    put_i16s(&p, m->foot_force, 4u);
+    put_i16s(&p, m->foot_force_est, 4u);
     put_u32(&p, m->tick);
     put_bytes(&p, m->wireless_remote, 40u);
     put_u8(&p, m->bit_flag);
@@ -151,8 +165,7 @@ void j288_dds_pack_lowstate(const unitree_go_msg_dds__LowState_ *m,
     put_u8(&p, m->temperature_ntc2);
     put_f32(&p, m->power_v);
     put_f32(&p, m->power_a);
-    for (k = 0; k < 4u; k++)
-        put_u16(&p, m->fan_frequency[k]);
+    put_u16s(&p, m->fan_frequency, 4u);
     put_u32(&p, m->reserve);
     put_u32(&p, 0u); /* crc */
     align(&p, 4u);
