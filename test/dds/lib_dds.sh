@@ -137,10 +137,11 @@ still() {
     near "$a" "$b" 0.005 || { echo "servo $2 on simulator $1 moved: $a -> $b"; return 1; }
 }
 
-# locked_all: every simulator's log got the broadcast lock (id 15, status 0).
+# locked_all K...: simulator K's log got the broadcast lock (id 15, status 0) with the
+# watchdog bit 0 (a locked servo needs no watchdog; the runner's policy).
 locked_all() {
     local k
     for k in "$@"; do
-        grep -q ' id=15 status=0' "$SIM_DIR/log.$k" || { echo "no broadcast lock on bus $k"; return 1; }
+        grep -q ' id=15 status=0 wd=0' "$SIM_DIR/log.$k" || { echo "no broadcast lock on bus $k"; return 1; }
     done
 }

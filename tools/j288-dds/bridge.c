@@ -24,23 +24,8 @@ const char *bridge_cause_name(bridge_cause_t c)
     return (unsigned)c < BRIDGE_NCAUSES ? cause_names[c] : "?";
 }
 
-void bridge_default_gains(j288_robot_config_t *cfg)
-{
-    size_t j;
-    for (j = 0; j < cfg->njoints; j++) {
-        if (!cfg->joint[j].has_kp) {
-            cfg->joint[j].has_kp = true;
-            cfg->joint[j].kp = J288_DDS_DEFAULT_KP;
-        }
-        if (!cfg->joint[j].has_kd) {
-            cfg->joint[j].has_kd = true;
-            cfg->joint[j].kd = J288_DDS_DEFAULT_KD;
-        }
-    }
-}
-
 void bridge_init(bridge_t *b, j288_robot_t *robot, const j288_robot_config_t *cfg,
-                 uint32_t timeout_us, bridge_timeout_policy_t policy, bool stop_on_bus_loss)
+                 uint32_t timeout_us, bridge_timeout_policy_t policy)
 {
     unsigned j;
     memset(b, 0, sizeof *b);
@@ -48,7 +33,6 @@ void bridge_init(bridge_t *b, j288_robot_t *robot, const j288_robot_config_t *cf
     b->cfg = cfg;
     b->timeout_us = timeout_us;
     b->policy = policy;
-    b->stop_on_bus_loss = stop_on_bus_loss;
     for (j = 0; j < j288_robot_njoints(robot); j++)
         b->names[j] = (char *)(uintptr_t)j288_robot_joint_name(robot, j); /* DDS wants char * */
 }
@@ -140,14 +124,16 @@ static bool check_command(bridge_t *b, const sensor_msgs_msg_dds__JointState_ *m
     return true;
 }
 
-/* The joint's angle now, and its configured gains. */
+/* The joint's angle now, and its gains: the config's, else the runner's defaults (the ones
+ * its hold uses too). */
 static void current(const bridge_t *b, unsigned j, double *pos, double *kp, double *kd)
 {
+    const j288_robot_config_joint_t *cj = &b->cfg->joint[j];
     j288_robot_state_t st;
     (void)j288_robot_read(b->robot, j, &st);
     *pos = st.pos;
-    *kp = b->cfg->joint[j].kp;
-    *kd = b->cfg->joint[j].kd;
+    *kp = cj->has_kp ? cj->kp : J288_ROBOT_DEFAULT_KP;
+    *kd = cj->has_kd ? cj->kd : J288_ROBOT_DEFAULT_KD;
 }
 
 void bridge_take_command(bridge_t *b, const sensor_msgs_msg_dds__JointState_ *m, uint32_t now_us)
@@ -245,21 +231,30 @@ void bridge_check_timeouts(bridge_t *b, uint32_t now_us)
 
 void bridge_bus_lost(bridge_t *b, unsigned bus, const char *what)
 {
-    unsigned j;
-    int rc;
     if (bus < J288_ROBOT_MAX_BUSES)
         b->bus_lost[bus]++;
     fprintf(stderr, "j288-dds: bus '%s' %s\n", j288_robot_bus_name(b->robot, bus), what);
-    if (!b->stop_on_bus_loss || b->stopped)
+}
+
+void bridge_stopped(bridge_t *b, const char *why)
+{
+    unsigned j;
+    if (b->stopped)
         return;
     b->stopped = true;
-    snprintf(b->stop_reason, sizeof b->stop_reason, "bus '%s' %s", j288_robot_bus_name(b->robot, bus),
-             what);
-    rc = j288_robot_stop(b->robot);
+    snprintf(b->stop_reason, sizeof b->stop_reason, "%s", why);
     for (j = 0; j < J288_ROBOT_MAX_JOINTS; j++) /* at lock now: no timeout may hold them again */
         b->joint[j].mode = JOINT_IDLE;
-    fprintf(stderr, "j288-dds: --stop-on-bus-loss: every bus locked (%s); commands refused "
-                    "until restart\n", rc == J288_OK ? "stop sent" : j288_strerror(rc));
+    fprintf(stderr, "j288-dds: --stop-on-bus-loss: %s; commands refused until restart\n", why);
+}
+
+void bridge_watchdog(bridge_t *b, unsigned joint)
+{
+    if (joint >= J288_ROBOT_MAX_JOINTS)
+        return;
+    b->joint[joint].watchdog++;
+    fprintf(stderr, "j288-dds: joint %s: the servo's watchdog had tripped (cleared)\n",
+            j288_robot_joint_name(b->robot, joint));
 }
 
 void bridge_stamp_now(builtin_interfaces_msg_dds__Time_ *t)

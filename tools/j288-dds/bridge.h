@@ -12,7 +12,7 @@
  * joint: position given -> target at that angle with the joint's kp (and kd); else kp 0 and
  * the target angle is where the joint is; velocity given -> that speed with kd; effort given
  * -> feed-forward torque; neither position nor velocity -> kd 0 (pure torque). Gains are the
- * config's, or J288_DDS_DEFAULT_KP / _KD for a joint that gives none.
+ * config's, or the runner's J288_ROBOT_DEFAULT_KP / _KD for a joint that gives none.
  *
  * Refused (nothing sent for the joints concerned; counted; the first of each cause written on
  * stderr): a whole message whose arrays differ in length from name, that names no joint or
@@ -37,8 +37,6 @@
 #include "sensor_msgs.h"
 #include "unitree_go.h"
 
-#define J288_DDS_DEFAULT_KP 5.0             /* N*m/rad, a joint whose config gives no kp */
-#define J288_DDS_DEFAULT_KD 0.1             /* N*m*s/rad */
 #define J288_DDS_DEFAULT_TIMEOUT_US 100000u /* 100 ms */
 #define J288_DDS_UNITREE_MOTORS 20u         /* LowCmd_/LowState_ motor slots */
 
@@ -52,7 +50,7 @@ typedef enum {
     BRIDGE_CAUSE_UNKNOWN_ANGLE, /* the joint's angle is not known yet */
     BRIDGE_CAUSE_BAD_CRC,     /* unitree mode: LowCmd_ crc mismatch */
     BRIDGE_CAUSE_BAD_MODE,    /* unitree mode: motor mode other than 0 or 1 */
-    BRIDGE_CAUSE_STOPPED,     /* a command while the robot is stopped (bus lost) */
+    BRIDGE_CAUSE_STOPPED,     /* a command while the robot is stopped (a bus lost) */
     BRIDGE_CAUSE_OTHER,       /* any other refusal of the joint layer */
     BRIDGE_NCAUSES
 } bridge_cause_t;
@@ -71,6 +69,7 @@ typedef struct {
     uint32_t last_cmd_us;  /* j288_linux_now_us() when its latest command was accepted */
     uint32_t accepted;     /* commands accepted for this joint */
     uint32_t timeouts;
+    uint32_t watchdog;     /* servo watchdog trips the runner found and cleared */
 } bridge_joint_t;
 
 typedef struct {
@@ -78,7 +77,6 @@ typedef struct {
     const j288_robot_config_t *cfg;
     uint32_t timeout_us;
     bridge_timeout_policy_t policy;
-    bool stop_on_bus_loss;
     bool stopped;               /* every bus locked after a bus loss: commands refused */
     char stop_reason[128];
     bridge_joint_t joint[J288_ROBOT_MAX_JOINTS];
@@ -93,10 +91,7 @@ typedef struct {
 
 /* Ready a bridge over an open robot (its joints in cfg's order). */
 void bridge_init(bridge_t *b, j288_robot_t *robot, const j288_robot_config_t *cfg,
-                 uint32_t timeout_us, bridge_timeout_policy_t policy, bool stop_on_bus_loss);
-
-/* A config's joints without kp / kd get the bridge's defaults (before j288_robot_open). */
-void bridge_default_gains(j288_robot_config_t *cfg);
+                 uint32_t timeout_us, bridge_timeout_policy_t policy);
 
 /* The name of a cause, for messages and diagnostics. */
 const char *bridge_cause_name(bridge_cause_t c);
@@ -113,9 +108,15 @@ void bridge_take_lowcmd(bridge_t *b, const unitree_go_msg_dds__LowCmd_ *m, uint3
 /* After each cycle: the timeout policy for joints whose command is too old. */
 void bridge_check_timeouts(bridge_t *b, uint32_t now_us);
 
-/* A bus went down or vanished (a runner event): reported; with stop_on_bus_loss, every bus is
- * locked (j288_robot_stop) and commands are refused from then on. Call between cycles. */
+/* A bus went down or vanished (a runner event): reported and counted. */
 void bridge_bus_lost(bridge_t *b, unsigned bus, const char *what);
+
+/* The runner stopped every bus on a bus loss (its stop_on_bus_loss): commands are refused
+ * from then on, no joint is driven again (no timeout hold either); why says which bus. */
+void bridge_stopped(bridge_t *b, const char *why);
+
+/* A servo's watchdog had tripped (a runner event, cleared by the runner): reported. */
+void bridge_watchdog(bridge_t *b, unsigned joint);
 
 /* The robot's state after the latest cycle into a JointState sample (stamp: CLOCK_REALTIME).
  * The sample points into b: valid until the next call. */

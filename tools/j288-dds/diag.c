@@ -140,6 +140,7 @@ static void joint_status(bridge_t *b, unsigned j, diagnostic_msgs_msg_dds__Diagn
     kv(s, "command", str("%s", mode_name(b->joint[j].mode)));
     kv(s, "commands_accepted", str("%lu", (unsigned long)b->joint[j].accepted));
     kv(s, "timeouts", str("%lu", (unsigned long)b->joint[j].timeouts));
+    kv(s, "watchdog_trips", str("%lu", (unsigned long)b->joint[j].watchdog));
     kv(s, "faults", str("0x%06lx", (unsigned long)st.faults));
     kv(s, "warnings", str("0x%02x", (unsigned)st.warnings));
     kv(s, "case_temp_c", str("%.1f", st.case_temp_c));

@@ -41,7 +41,7 @@ static const char usage[] =
     "  --stop-on-bus-loss  a bus that stops answering or vanishes locks every bus, and\n"
     "                      commands are refused until restart\n"
     "  --help, --version\n"
-    "Gains: each joint's kp and kd from the config, else kp 5 N*m/rad, kd 0.1 N*m*s/rad.\n"
+    "Gains: each joint's kp and kd from the config, else kp 20 N*m/rad, kd 2.5 N*m*s/rad.\n"
     "SIGINT / SIGTERM: every bus locked (broadcast lock, watchdog bit 0), then exit 0.\n";
 
 typedef struct {
@@ -171,19 +171,20 @@ static int parse(int argc, char **argv, options_t *o, bool *done)
 typedef struct {
     unsigned n;
     struct {
-        unsigned bus;
+        unsigned index; /* bus, or joint (watchdog) */
         j288_robot_event_kind_t kind;
-    } ev[2u * J288_ROBOT_MAX_BUSES];
+    } ev[2u * J288_ROBOT_MAX_BUSES + J288_ROBOT_MAX_JOINTS];
 } pending_t;
 
 static void on_event(void *user, const j288_robot_event_t *ev)
 {
     pending_t *p = user;
-    if (ev->kind != J288_ROBOT_EV_BUS_DOWN && ev->kind != J288_ROBOT_EV_BUS_GONE &&
-        ev->kind != J288_ROBOT_EV_BUS_UP)
+    bool bus = ev->kind == J288_ROBOT_EV_BUS_DOWN || ev->kind == J288_ROBOT_EV_BUS_GONE ||
+               ev->kind == J288_ROBOT_EV_BUS_UP;
+    if (!bus && !(ev->kind == J288_ROBOT_EV_WATCHDOG && ev->joint >= 0))
         return;
     if (p->n < sizeof p->ev / sizeof p->ev[0]) {
-        p->ev[p->n].bus = ev->bus;
+        p->ev[p->n].index = bus ? ev->bus : (unsigned)ev->joint;
         p->ev[p->n].kind = ev->kind;
         p->n++;
     }
@@ -193,14 +194,35 @@ static void handle_events(bridge_t *b, pending_t *p)
 {
     unsigned i;
     for (i = 0; i < p->n; i++) {
-        if (p->ev[i].kind == J288_ROBOT_EV_BUS_UP)
-            fprintf(stderr, "j288-dds: bus '%s' answers again\n", j288_robot_bus_name(b->robot, p->ev[i].bus));
-        else
-            bridge_bus_lost(b, p->ev[i].bus, p->ev[i].kind == J288_ROBOT_EV_BUS_GONE
-                                                 ? "vanished (device gone)"
-                                                 : "stopped answering");
+        unsigned k = p->ev[i].index;
+        switch (p->ev[i].kind) {
+        case J288_ROBOT_EV_BUS_UP:
+            fprintf(stderr, "j288-dds: bus '%s' answers again\n", j288_robot_bus_name(b->robot, k));
+            break;
+        case J288_ROBOT_EV_BUS_GONE:
+            bridge_bus_lost(b, k, "vanished (device gone)");
+            break;
+        case J288_ROBOT_EV_BUS_DOWN:
+            bridge_bus_lost(b, k, "stopped answering");
+            break;
+        default:
+            bridge_watchdog(b, k);
+            break;
+        }
     }
     p->n = 0;
+}
+
+/* Whether every bus's device is gone (nothing left to run). */
+static bool every_bus_gone(const j288_robot_t *r)
+{
+    unsigned i;
+    for (i = 0; i < j288_robot_nbuses(r); i++) {
+        j288_robot_bus_stats_t bs;
+        if (j288_robot_bus_stats(r, i, &bs) == J288_OK && !bs.gone)
+            return false;
+    }
+    return true;
 }
 
 /* ---- DDS entities ---- */
@@ -362,10 +384,10 @@ static int run(const options_t *o)
                 (unsigned)cfg.njoints, J288_DDS_UNITREE_MOTORS);
         return 1;
     }
-    bridge_default_gains(&cfg);
     memset(&ro, 0, sizeof ro);
     ro.on_event = on_event;
     ro.user = &pending;
+    ro.stop_on_bus_loss = o->stop_on_bus_loss; /* the runner stops every bus itself */
     rc = j288_robot_open(&robot, &cfg, &ro);
     if (rc != J288_OK) {
         fprintf(stderr, "j288-dds: %s\n", j288_robot_error(&robot));
@@ -379,7 +401,7 @@ static int run(const options_t *o)
             (void)dds_delete(io.participant);
         return 1;
     }
-    bridge_init(&b, &robot, &cfg, o->timeout_us, o->policy, o->stop_on_bus_loss);
+    bridge_init(&b, &robot, &cfg, o->timeout_us, o->policy);
     fprintf(stderr, "j288-dds: %u joints on %u buses, domain %ld, %s%s%s, %s\n",
             j288_robot_njoints(&robot), j288_robot_nbuses(&robot), o->domain,
             o->unitree ? "rt/lowstate + rt/lowcmd" : "rt/joint_states + rt/joint_command",
@@ -396,11 +418,13 @@ static int run(const options_t *o)
         handle_events(&b, &pending);
         if (rc == J288_ERR_ABORTED)
             break;
-        if (rc == J288_ERR_OFFLINE) {
+        if (rc == J288_ERR_OFFLINE && every_bus_gone(&robot)) {
             fprintf(stderr, "j288-dds: every bus is gone: %s\n", j288_robot_error(&robot));
             status = 1;
             break;
         }
+        if (rc == J288_ERR_OFFLINE) /* stop on bus loss: the runner locked every bus */
+            bridge_stopped(&b, j288_robot_error(&robot));
         publish_state(&b, &io, o->unitree, start_s);
         if ((uint32_t)(j288_linux_now_us() - last_diag) >= DIAG_PERIOD_US) {
             last_diag = j288_linux_now_us();
