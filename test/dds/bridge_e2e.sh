@@ -6,7 +6,7 @@
 # diagnostics), or locks it (--on-timeout lock); each bad input (unknown name, arrays of
 # different lengths, a joint named twice, no values, NaN, infinity, outside the limits) is
 # refused with nothing sent, reported once however often it comes; a namespace moves the
-# topics; Ctrl-C locks every bus; with --stop-on-bus-loss a frozen bus locks all; bad options
+# topics; a servo watchdog trip is reported; Ctrl-C locks every bus; with --stop-on-bus-loss a frozen bus locks all; bad options
 # and a config too big for unitree mode are refused before anything is opened.
 # Every wait polls and is bounded; no check depends on the machine's speed (replies get a
 # 250 ms margin: the simulators may run under valgrind, make test-valgrind).
@@ -84,6 +84,16 @@ t_refusals_in_diagnostics() {
         grep -q '^j288-dds: bus leg1|sweeps=' "$SIM_DIR/diag" &&
         grep -q '^j288-dds: joint leg0_1|winding_temp_c=' "$SIM_DIR/diag"
 }
+t_watchdog_trip_reported() {
+    # the bridge frozen for 1.5 s while leg1_2 follows commands (watchdog bit 1): the servo's
+    # watchdog trips; once the bridge runs again the runner clears it and the bridge says so
+    "$PEER" command --for 6 --hz 50 leg1_2 0.3 - - & local p=$!
+    sleep 1
+    kill -STOP "$BRIDGE_PID"; sleep 1.5; kill -CONT "$BRIDGE_PID"
+    wait_err "joint leg1_2: the servo's watchdog had tripped \\(cleared\\)" || { kill $p; return 1; }
+    wait $p
+    "$PEER" diag >"$SIM_DIR/diag" && grep -Eq '^j288-dds: joint leg1_2\|watchdog_trips=[1-9]' "$SIM_DIR/diag"
+}
 t_ctrl_c_locks_every_bus() {
     : >"$SIM_DIR/log.0"; : >"$SIM_DIR/log.1"
     stop_bridge || { echo "exit $?"; return 1; }
@@ -155,6 +165,7 @@ e2e_check nan t_nan
 e2e_check infinity t_infinity
 e2e_check outside_limits t_outside_limits
 e2e_check refusals_in_diagnostics t_refusals_in_diagnostics
+e2e_check watchdog_trip_reported t_watchdog_trip_reported
 e2e_check ctrl_c_locks_every_bus t_ctrl_c_locks_every_bus
 e2e_check timeout_locks t_timeout_locks
 e2e_check bus_loss_locks_all t_bus_loss_locks_all
