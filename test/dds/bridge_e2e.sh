@@ -6,8 +6,9 @@
 # diagnostics), or locks it (--on-timeout lock); each bad input (unknown name, arrays of
 # different lengths, a joint named twice, no values, NaN, infinity, outside the limits) is
 # refused with nothing sent, reported once however often it comes; a namespace moves the
-# topics; a servo watchdog trip is reported; Ctrl-C locks every bus; with --stop-on-bus-loss a frozen bus locks all; bad options
-# and a config too big for unitree mode are refused before anything is opened.
+# topics; a servo watchdog trip is reported; Ctrl-C locks every bus; with --stop-on-bus-loss
+# a frozen bus locks all; bad options and a config too big for unitree mode are refused
+# before anything is opened.
 # Every wait polls and is bounded; no check depends on the machine's speed (replies get a
 # 250 ms margin: the simulators may run under valgrind, make test-valgrind).
 set -u
