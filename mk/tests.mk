@@ -113,11 +113,11 @@ $(SIM_MODEL_TEST): $(OBJ)/test/sim/test_sim_model.o $(SIM_MODEL_OBJ) $(UNITY_OBJ
 	@mkdir -p $(@D)
 	$(CC) $(CFLAGS_COMMON) $^ -o $@ $(LDFLAGS_COMMON) -lm
 
-# Built with the D-cache maintenance on and a 32-byte receive buffer (a transaction's echo and
+# Built with the D-cache maintenance on and a 64-byte receive buffer (a transaction's echo and
 # reply then cross the half, complete and wrap points), so that every path is exercised, and
 # with the bytes handed to the bus watched (test_rx_sink); the target tests use the same.
 # Twice: against the F4's USART and DMA registers, and the G4's (test_stm32_port_g4).
-STM32_TEST_DEFS := -DJ288_STM32_DCACHE=1 -DJ288_STM32_RX_BUF_SIZE=32u -DJ288_STM32_RX_SINK=test_rx_sink
+STM32_TEST_DEFS := -DJ288_STM32_DCACHE=1 -DJ288_STM32_RX_BUF_SIZE=64u -DJ288_STM32_RX_SINK=test_rx_sink
 STM32_HDRS := $(wildcard port/stm32_hal/*.h test/stm32/*.h test/stm32/stub/*.h) $(TEST_HDR)
 STM32_TEST := $(BUILD)/test/test_stm32_port
 STM32_TEST_SRC := port/stm32_hal/j288_stm32.c test/stm32/fake_hal.c test/stm32/test_stm32_port.c

@@ -20,6 +20,8 @@
 
 /* Compile-time checks (C99: a negative array size fails the build). */
 typedef char j288_stm32_rx_holds_reply[(J288_STM32_RX_BUF_SIZE > J288_REPLY_LEN) ? 1 : -1];
+/* The echo plus half a buffer (the most that waits for a transmit's end) stays under a buffer. */
+typedef char j288_stm32_rx_holds_echo[(J288_STM32_RX_BUF_SIZE > 2u * J288_CMD_LEN) ? 1 : -1];
 typedef char j288_stm32_rx_whole_lines[(J288_STM32_RX_BUF_SIZE % J288_STM32_DCACHE_LINE) == 0u ? 1 : -1];
 typedef char j288_stm32_rx_fits_hal[(J288_STM32_RX_BUF_SIZE <= 0xFFFFu) ? 1 : -1];
 
@@ -237,29 +239,18 @@ static void rx_take(j288_stm32_t *p, uint32_t head)
     }
 }
 
-/* Bytes that belong to nobody (before a transmit) or our own echo: not handed over. At most
- * max: a late interrupt may find reply bytes behind the echo. */
-static void rx_skip(j288_stm32_t *p, uint32_t max)
+/* Bytes up to position to that are not handed over: heard before a transmit (nobody's) or
+ * our own echo. */
+static void rx_skip(j288_stm32_t *p, uint32_t to)
 {
-    uint32_t head = rx_head(p);
-    uint32_t n = rx_pending(p, head);
-    if (n > max) {
-        n = max;
-        head = (p->rx_pos + n) % J288_STM32_RX_BUF_SIZE;
-    }
-    p->rx_pos = (uint16_t)head;
-    p->stats.rx_skipped += n;
+    p->stats.rx_skipped += rx_pending(p, to);
+    p->rx_pos = (uint16_t)to;
 }
 
-/* The line is driven only through DE (the receiver never goes off). Going to transmit, what
- * was heard so far is nobody's: skipped, so that the echo starts clean. */
+/* The line is driven only through DE: the receiver never goes off. */
 static void op_set_dir(void *ctx, j288_dir_t dir)
 {
-    j288_stm32_t *p = ctx;
-    if (dir == J288_DIR_TX) {
-        rx_skip(p, J288_STM32_RX_BUF_SIZE);
-    }
-    de_write(p, dir == J288_DIR_TX);
+    de_write(ctx, dir == J288_DIR_TX);
 }
 
 /* A transmit still running (its complete interrupt lost) is stopped first. A stream stops
@@ -267,7 +258,10 @@ static void op_set_dir(void *ctx, j288_dir_t dir)
  * says it is still running. */
 static bool tx_stream_ready(j288_stm32_t *p, dma_regs_t *s)
 {
-    if (((DMA_CTRL(s) & DMA_EN) != 0u) && (DMA_COUNT(s) != 0u)) {
+    if ((DMA_CTRL(s) & DMA_EN) == 0u) {
+        return true;
+    }
+    if (DMA_COUNT(s) != 0u) {
         p->stats.dma_resets++;
     }
     return dma_stop(s);
@@ -279,7 +273,7 @@ static int op_start_tx(void *ctx, const uint8_t *data, size_t len)
     dma_regs_t *s = p->tx_stream;
     USART_TypeDef *u = p->uart;
 
-    if ((data == NULL) || (len == 0u) || (len > J288_STM32_TX_BUF_SIZE)) {
+    if ((data == NULL) || (len == 0u) || (len > J288_CMD_LEN)) {
         return J288_ERR_BAD_ARG;
     }
     if (!tx_stream_ready(p, s)) {
@@ -293,13 +287,17 @@ static int op_start_tx(void *ctx, const uint8_t *data, size_t len)
         memcpy(p->cfg.dma->tx, data, len);
     }
     cache_clean(p->cfg.dma->tx, J288_STM32_TX_BUF_SIZE);
+    /* The echo starts here; what was heard before is nobody's (skipped at the end). */
+    p->tx_start = (uint16_t)rx_head(p);
     p->tx_len = (uint16_t)len;
     p->tx_on = true;
     p->stats.tx_frames++;
     *p->tx_ifcr = (uint32_t)DMA_F_ALL << p->tx_shift;
     DMA_COUNT(s) = (uint32_t)len;
-    uart_clear_tc(u);
-    u->CR1 |= USART_CR1_TCIE;
+    if (p->cfg.deaf_while_transmitting) { /* no echo to tell the end: transmit complete */
+        uart_clear_tc(u);
+        u->CR1 |= USART_CR1_TCIE;
+    }
     DMA_CTRL(s) |= DMA_EN;
     return J288_OK;
 }
@@ -441,8 +439,9 @@ static void op_unlock(void *ctx)
 }
 
 /* The one operations table. Each bus gets a copy (j288_stm32_t.ops) without the optional
- * operations its configuration lacks: no timer, no arm_timeout (the application polls); no
- * CRC unit, no crc32 (the library's compile-time backend). */
+ * operations its configuration lacks: no timer, or a bus that does not advance in its
+ * interrupts, no arm_timeout (the application polls, and a poll looks at the clock); no CRC
+ * unit, no crc32 (the library's compile-time backend). */
 static const j288_port_t port_ops = {
     .start_tx = op_start_tx,
     .now_us = op_now_us,
@@ -455,11 +454,11 @@ static const j288_port_t port_ops = {
     .unlock = op_unlock,
 };
 
-static void pick_ops(j288_stm32_t *p)
+static void pick_ops(j288_stm32_t *p, bool advance_in_isr)
 {
     p->ops = port_ops;
-    if (p->cfg.htim == NULL) {
-        p->ops.arm_timeout = NULL;
+    if ((p->cfg.htim == NULL) || !advance_in_isr) {
+        p->ops.arm_timeout = NULL; /* polled, the bus reads the clock itself (bus.h) */
     }
 #if J288_STM32_HW_CRC
     if (p->cfg.hcrc == NULL) {
@@ -630,7 +629,7 @@ int j288_stm32_init(j288_stm32_t *p, const j288_stm32_config_t *cfg,
     memset(p, 0, sizeof *p);
     p->cfg = *cfg;
     p->echo = (bus_cfg != NULL) && bus_cfg->echo;
-    pick_ops(p);
+    pick_ops(p, (bus_cfg != NULL) && bus_cfg->advance_in_isr);
     take_registers(p);
     rc = j288_bus_init(&p->bus, &p->ops, p, bus_cfg);
     if (rc != J288_OK) {
@@ -645,6 +644,7 @@ int j288_stm32_init(j288_stm32_t *p, const j288_stm32_config_t *cfg,
         return J288_ERR_PORT;
     }
     registry[free_slot] = p;
+    p->live = true;
     return J288_OK;
 }
 
@@ -652,6 +652,7 @@ void j288_stm32_deinit(j288_stm32_t *p)
 {
     for (size_t i = 0; i < J288_STM32_MAX_BUSES; i++) {
         if ((p != NULL) && (registry[i] == p)) {
+            p->live = false;
             registry[i] = NULL;
             if (p->cfg.htim != NULL) {
                 __HAL_TIM_DISABLE_IT(p->cfg.htim, channel_it(p->cfg.tim_channel));
@@ -685,14 +686,11 @@ const j288_stm32_stats_t *j288_stm32_stats(const j288_stm32_t *p)
 
 /* ---- interrupts ------------------------------------------------------------------------- */
 
+/* Registered: init sets it last, deinit clears it first (the IRQ entries look at nothing
+ * else, so that they need no search). */
 static bool registered(const j288_stm32_t *p)
 {
-    for (size_t i = 0; i < J288_STM32_MAX_BUSES; i++) {
-        if ((p != NULL) && (registry[i] == p)) {
-            return true;
-        }
-    }
-    return false;
+    return (p != NULL) && p->live;
 }
 
 /* Error flags seen: counted one by one and reported to the bus as one line error; the bytes
@@ -719,18 +717,33 @@ PORT_NOINLINE static void line_errors(j288_stm32_t *p, uint32_t sr)
     j288_bus_on_error(&p->bus, f);
 }
 
-/* Transmit complete (the last stop bit is out): the echo, whole by now, is handed to the bus
- * to check or skipped; then the bus turns the line (DE) and waits for the reply. */
+/* The end of a transmit: the whole echo is in (the line hears us), or transmit complete (a
+ * deaf line). The echo is handed to the bus to check, or skipped; then the bus turns the line
+ * (DE) and waits for the reply, whose bytes may already follow the echo. */
 static void tx_complete(j288_stm32_t *p)
 {
-    p->uart->CR1 &= ~(uint32_t)USART_CR1_TCIE;
+    uint32_t echo_end = p->tx_start;
     p->tx_on = false;
-    if (p->echo) {
-        rx_take(p, rx_head(p));
-    } else if (!p->cfg.deaf_while_transmitting) {
-        rx_skip(p, p->tx_len);
+    if (p->cfg.deaf_while_transmitting) {
+        p->uart->CR1 &= ~(uint32_t)USART_CR1_TCIE;
+    } else if (p->echo) {
+        rx_skip(p, p->tx_start);
+        echo_end = (echo_end + p->tx_len) % J288_STM32_RX_BUF_SIZE;
+        rx_take(p, echo_end);
+    } else {
+        echo_end = (echo_end + p->tx_len) % J288_STM32_RX_BUF_SIZE;
     }
+    rx_skip(p, echo_end);
     j288_bus_on_tx_done(&p->bus);
+}
+
+/* Our transmit has come back whole: the receiver hears the line, so the end of the echo is
+ * the end of the transmit (its last stop bit sampled). Seen at the idle line that follows it,
+ * or at a half/complete event when the reply follows without a pause. */
+static bool echo_heard(const j288_stm32_t *p, uint32_t head)
+{
+    uint32_t since = (head + J288_STM32_RX_BUF_SIZE - p->tx_start) % J288_STM32_RX_BUF_SIZE;
+    return !p->cfg.deaf_while_transmitting && (since >= p->tx_len);
 }
 
 void j288_stm32_on_uart_irq(j288_stm32_t *p)
@@ -743,15 +756,19 @@ void j288_stm32_on_uart_irq(j288_stm32_t *p)
     }
     u = p->uart;
     sr = UART_STATUS(u);
-    /* Transmit complete first: an idle line seen with it follows the echo, whose bytes must
-     * be skipped before anything is handed over. */
-    if (((sr & UART_TC) != 0u) && ((u->CR1 & USART_CR1_TCIE) != 0u)) {
-        tx_complete(p);
+    if (p->cfg.deaf_while_transmitting && ((sr & UART_TC) != 0u) && ((u->CR1 & USART_CR1_TCIE) != 0u)) {
+        tx_complete(p); /* a deaf line's transmit */
     }
     if ((sr & (UART_IDLE | UART_ERRORS)) != 0u) {
+        uint32_t head = rx_head(p);
         uart_clear(u, sr);
         p->stats.rx_events++;
-        rx_take(p, rx_head(p));
+        if (p->tx_on && echo_heard(p, head)) {
+            tx_complete(p);
+        }
+        if (!p->tx_on && (head != p->rx_pos)) {
+            rx_take(p, head);
+        }
         if ((sr & UART_ERRORS) != 0u) {
             line_errors(p, sr);
         }
@@ -760,9 +777,10 @@ void j288_stm32_on_uart_irq(j288_stm32_t *p)
 
 /* Half and complete: handed over only once a quarter of the buffer waits, so that a reply is
  * usually handed over whole at its idle line; the next half event comes at most half a buffer
- * later, so less than three quarters ever wait. During a transmit they are our echo: left for
- * transmit complete to skip (or hand over, with the echo option). A transfer error stops the
- * stream: it is restarted at the start of the buffer. */
+ * later, so less than three quarters ever wait. During a transmit they find our echo: left
+ * until it is whole (at most the 20 bytes and half a buffer wait: the buffer holds more than
+ * twice a command), then the transmit ends here. A transfer error stops the stream: it is
+ * restarted at the start of the buffer. */
 void j288_stm32_on_dma_rx_irq(j288_stm32_t *p)
 {
     uint32_t flags, head;
@@ -786,10 +804,15 @@ void j288_stm32_on_dma_rx_irq(j288_stm32_t *p)
         return;
     }
     head = rx_head(p);
-    if ((p->tx_on && !p->echo) || (rx_pending(p, head) < J288_STM32_RX_BUF_SIZE / 4u)) {
-        return; /* our own echo, skipped at transmit complete; or too little to bother */
+    if (p->tx_on) {
+        if (!echo_heard(p, head)) {
+            return; /* our own echo, not whole yet */
+        }
+        tx_complete(p);
     }
-    rx_take(p, head);
+    if (rx_pending(p, head) >= J288_STM32_RX_BUF_SIZE / 4u) {
+        rx_take(p, head);
+    }
 }
 
 bool j288_stm32_on_timer(TIM_HandleTypeDef *htim)

@@ -248,10 +248,11 @@ typedef struct j288_stm32 {
     uint8_t rx_shift;
     bool echo;                 /* the bus checks the echo: hand it over */
     volatile uint16_t rx_pos;  /* position in the circular buffer handed out so far */
-    volatile uint16_t tx_len;  /* bytes of the last transmit (the echo to skip) */
+    volatile uint16_t tx_len;  /* bytes of the last transmit (its echo) */
+    volatile uint16_t tx_start; /* where its echo starts in the receive buffer */
     volatile bool tx_on;       /* a transmit is in flight */
     uint32_t lock_saved;
-    bool lock_basepri;
+    volatile bool live;        /* registered: the IRQ entries serve it */
     uint8_t bounce[J288_STM32_BOUNCE_SIZE]; /* a wrapped run, handed over in one piece */
     volatile uint32_t tim_deadline; /* last arm_timeout deadline (now_us clock) */
     j288_stm32_stats_t stats;

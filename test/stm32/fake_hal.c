@@ -414,7 +414,9 @@ bool fake_hal_tx_busy(const UART_HandleTypeDef *huart)
            ((f->usart.CR3 & USART_CR3_DMAT) != 0u);
 }
 
-bool fake_hal_tx_complete(UART_HandleTypeDef *huart)
+bool fake_hal_tx_complete(UART_HandleTypeDef *huart) { return fake_hal_tx_complete_ex(huart, true); }
+
+bool fake_hal_tx_complete_ex(UART_HandleTypeDef *huart, bool then_idle)
 {
     fake_uart_t *f = uart_of(huart);
     J288_STUB_DMA_INSTANCE *s = &f->tx_stream;
@@ -441,6 +443,9 @@ bool fake_hal_tx_complete(UART_HandleTypeDef *huart)
     *flag_reg(f, false) |= (uint32_t)D_TC << flag_shift(f, false);
     U_STATUS(&f->usart) |= U_TC;
     dispatch(f);
+    if (then_idle) {
+        (void)fake_hal_line_idle(huart);
+    }
     return true;
 }
 

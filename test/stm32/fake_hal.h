@@ -71,8 +71,11 @@ void fake_hal_line_deaf(UART_HandleTypeDef *huart, bool deaf);
 /* The last frame transmitted on huart, and whether a transmit is loaded and not finished. */
 const uint8_t *fake_hal_tx_data(const UART_HandleTypeDef *huart, size_t *len);
 bool fake_hal_tx_busy(const UART_HandleTypeDef *huart);
-/* The TX stream sends what it was loaded with; TC rises. false if nothing was loaded. */
+/* The TX stream sends what it was loaded with (the line hears it back unless deaf); TC rises;
+ * then the line idles (then_idle), or the reply follows at once (false). false if nothing was
+ * loaded. fake_hal_tx_complete: then_idle. */
 bool fake_hal_tx_complete(UART_HandleTypeDef *huart);
+bool fake_hal_tx_complete_ex(UART_HandleTypeDef *huart, bool then_idle);
 
 /* Bytes on the line; returns how many the receiver took into the data register. */
 size_t fake_hal_rx_bytes(UART_HandleTypeDef *huart, const uint8_t *data, size_t len);

@@ -224,73 +224,72 @@ static int port_setup(void)
     return j288_stm32_init(&port, &pc, NULL);
 }
 
-/* The NVIC: the RX stream's interrupt when its half or complete flag is up, the UART's when
- * its idle or (enabled) transmit complete flag is. The flags the hardware clears on the
- * port's register accesses (IFCR, the SR-then-DR sequence) are cleared here afterwards. */
-static void nvic_dma_rx(void)
+/* The simulation runs paused (its time excluded); the port's entries run counted. */
+static void port_uart_irq(void)
 {
-    if (((DMA2_LISR >> RX_SHIFT) & (DMA_LISR_HTIF0 | DMA_LISR_TCIF0)) != 0u) {
-        j288_stm32_on_dma_rx_irq(&port);
-        DMA2_LISR &= ~DMA2_LIFCR;
-        DMA2_LIFCR = 0u;
-    }
-}
-static void nvic_uart(void)
-{
+    pause_end();
     j288_stm32_on_uart_irq(&port);
-    usart1_regs.SR &= ~(uint32_t)USART_SR_IDLE;
+    pause_begin();
 }
 
 /* n bytes arrive on the line and go to the RX stream's buffer; the stream counts down and
- * raises its half and complete flags, whose interrupt is taken at once. Copied up to the next
- * flag at a time, so that the simulation's own time (excluded) is measured in few pieces. */
+ * raises its half and complete flags, whose interrupt is taken at once (and the flags the
+ * port cleared through LIFCR go, as the silicon clears them). Called paused. */
 static void line_receive(const uint8_t *src, uint32_t n)
 {
     DMA_Stream_TypeDef *s = DMA2_STREAM(2u);
     while (n > 0u) {
-        uint32_t pos, chunk, to_flag;
-        pause_begin();
-        pos = J288_STM32_RX_BUF_SIZE - s->NDTR;
-        to_flag = ((pos < J288_STM32_RX_BUF_SIZE / 2u) ? J288_STM32_RX_BUF_SIZE / 2u : J288_STM32_RX_BUF_SIZE) - pos;
-        chunk = (n < to_flag) ? n : to_flag;
+        uint32_t pos = J288_STM32_RX_BUF_SIZE - s->NDTR;
+        uint32_t to_flag = ((pos < J288_STM32_RX_BUF_SIZE / 2u) ? J288_STM32_RX_BUF_SIZE / 2u : J288_STM32_RX_BUF_SIZE) - pos;
+        uint32_t chunk = (n < to_flag) ? n : to_flag;
         memcpy(&bus_dma.rx[pos], src, chunk);
         src += chunk;
         n -= chunk;
         s->NDTR -= chunk;
-        if (s->NDTR == J288_STM32_RX_BUF_SIZE / 2u) {
-            DMA2_LISR |= DMA_LISR_HTIF0 << RX_SHIFT;
-        }
-        if (s->NDTR == 0u) {
-            DMA2_LISR |= DMA_LISR_TCIF0 << RX_SHIFT;
-            s->NDTR = J288_STM32_RX_BUF_SIZE;
-        }
-        pause_end();
         if (chunk == to_flag) {
-            nvic_dma_rx();
+            DMA2_LISR |= ((s->NDTR == 0u) ? DMA_LISR_TCIF0 : DMA_LISR_HTIF0) << RX_SHIFT;
+            s->NDTR = (s->NDTR == 0u) ? J288_STM32_RX_BUF_SIZE : s->NDTR;
+            pause_end();
+            j288_stm32_on_dma_rx_irq(&port);
+            pause_begin();
+            DMA2_LISR &= ~DMA2_LIFCR;
+            DMA2_LIFCR = 0u;
         }
     }
 }
 
 /* The TX stream sends its 20 bytes, which the single wire echoes to the receiver, then the
- * last stop bit goes out (TC); the line idles before the servo answers. */
+ * last stop bit goes out (TC, an interrupt only when enabled); the line idles before the
+ * servo answers. */
 static void hw_transmit_done(void)
 {
     DMA_Stream_TypeDef *tx = DMA2_STREAM(7u);
+    pause_begin();
+    /* SR's bits are rc_w0: the port's clear of TC (a write of ~TC) left the others as they
+     * were, which RAM does not do: put them back (and TC cleared). */
+    usart1_regs.SR = 0u;
     line_receive(bus_dma.tx, tx->NDTR);
     tx->NDTR = 0u;
     tx->CR &= ~(uint32_t)DMA_SxCR_EN;
-    usart1_regs.SR |= USART_SR_TC;
-    nvic_uart();
-    usart1_regs.SR |= USART_SR_IDLE;
-    nvic_uart();
+    usart1_regs.SR = USART_SR_TC;
+    if ((usart1_regs.CR1 & USART_CR1_TCIE) != 0u) { /* a deaf line's end of transmit */
+        port_uart_irq();
+    }
+    usart1_regs.SR = USART_SR_TC | USART_SR_IDLE;
+    port_uart_irq();
+    usart1_regs.SR = USART_SR_TC; /* the port's SR-then-DR read cleared IDLE */
+    pause_end();
 }
 
 /* 26 bytes of reply, then the line idles. */
 static void hw_reply_then_idle(void)
 {
+    pause_begin();
     line_receive(k_reply3, J288_REPLY_LEN);
-    usart1_regs.SR |= USART_SR_IDLE;
-    nvic_uart();
+    usart1_regs.SR = USART_SR_TC | USART_SR_IDLE;
+    port_uart_irq();
+    usart1_regs.SR = USART_SR_TC;
+    pause_end();
 }
 
 static void port_transaction(void)

@@ -4,7 +4,7 @@
  * the G4 (test_stm32_port_g4, -DJ288_STUB_G4). The test plays the application (its IRQ
  * handlers call the port's entries) and the hardware (it completes transmits, puts bytes on
  * the line, idles it, raises line flags, fires the timer). Built with J288_STM32_DCACHE=1 and
- * J288_STM32_RX_BUF_SIZE=32 so that the cache maintenance is exercised and a transaction's 46
+ * J288_STM32_RX_BUF_SIZE=64 so that the cache maintenance is exercised and a transaction's 46
  * bytes (echo and reply) cross the half, complete and wrap points; received bytes are watched
  * on their way to the bus (J288_STM32_RX_SINK=test_rx_sink).
  */
@@ -131,6 +131,16 @@ static void init_port1(const j288_bus_config_t *bus_cfg, bool timer, bool de)
 }
 
 static void poll1(void) { j288_bus_poll(j288_stm32_bus(&port1), fake_now); }
+
+/* A bus that advances in its interrupts: the only kind the timer serves (a polled bus looks at
+ * the clock when polled). */
+static const j288_bus_config_t *isr_bus(void)
+{
+    static j288_bus_config_t bc;
+    memset(&bc, 0, sizeof bc);
+    bc.advance_in_isr = true;
+    return &bc;
+}
 
 /* Submit foc3 on port1 and let its transmit finish (the echo comes back on the line). */
 static void send_foc3(void)
@@ -368,7 +378,7 @@ static void test_full_transaction_registers_and_bytes(void)
     poll1();
     TEST_ASSERT_TRUE(fake_hal_tx_busy(&huart1));
     TEST_ASSERT_EQUAL_INT(1, fake_hal_gpio_level(&gpioa, DE_PIN));
-    TEST_ASSERT_TRUE((fake_hal_usart(&huart1)->CR1 & USART_CR1_TCIE) != 0u);
+    TEST_ASSERT_TRUE((fake_hal_usart(&huart1)->CR1 & USART_CR1_TCIE) == 0u); /* the echo tells */
     TEST_ASSERT_TRUE(fake_hal_log_find(FAKE_CACHE_CLEAN, dma1.tx, 0) >= 0);
 
     /* the worked frame, byte for byte, from the DMA buffer; the echo skipped */
@@ -470,8 +480,9 @@ static void test_reply_stopping_at_a_gap_is_truncated_at_the_deadline(void)
 }
 
 /* Fault 1: no turnaround window. The reply starts 0, 1, 2, 5 or 10 us after our last stop bit
- * (a byte takes 1.67 us at 6 Mbps), and the transmit-complete interrupt is taken before or
- * after its first bytes arrived: every byte reaches the bus. Bytes are timed in thirds of a
+ * (a byte takes 1.67 us at 6 Mbps), and the interrupt that ends the transmit (the idle line
+ * after the echo, or a later one) is taken before or after the reply's first bytes arrived,
+ * with the DMA prompt or lagging: every byte reaches the bus. Bytes are timed in thirds of a
  * microsecond (a byte: 5). */
 static void run_turnaround(unsigned delay_us, unsigned tc_latency_thirds, bool lag)
 {
@@ -484,17 +495,15 @@ static void run_turnaround(unsigned delay_us, unsigned tc_latency_thirds, bool l
     init_port1(NULL, false, false);
     TEST_ASSERT_EQUAL_INT(J288_OK, j288_bus_submit(j288_stm32_bus(&port1), &cmd, fake_now, on_done, NULL));
     poll1();
-    fake_hal_irq_hold(true); /* the TC interrupt waits its latency */
-    TEST_ASSERT_TRUE(fake_hal_tx_complete(&huart1));
+    fake_hal_irq_hold(true); /* the interrupt that ends the transmit waits its latency */
+    /* a frame of silence after the echo (2 us and more) raises IDLE */
+    TEST_ASSERT_TRUE(fake_hal_tx_complete_ex(&huart1, delay_us >= 2u));
     fake_hal_dma_lag(&huart1, lag); /* reply bytes wait in DR while a handler runs */
     if (tc_latency_thirds >= first_done) {
         before_tc = 1u + (tc_latency_thirds - first_done) / 5u;
     }
     if (before_tc > J288_REPLY_LEN) {
         before_tc = J288_REPLY_LEN;
-    }
-    if ((delay_us >= 2u) && (tc_latency_thirds >= 5u)) {
-        (void)fake_hal_line_idle(&huart1); /* a frame of silence after the echo */
     }
     (void)fake_hal_rx_bytes(&huart1, k_reply3, before_tc);
     while (fake_hal_irq_service(&huart1, true) || fake_hal_irq_service(&huart1, false)) {
@@ -503,7 +512,7 @@ static void run_turnaround(unsigned delay_us, unsigned tc_latency_thirds, bool l
     (void)fake_hal_rx_bytes(&huart1, &k_reply3[before_tc], J288_REPLY_LEN - before_tc);
     TEST_ASSERT_TRUE(fake_hal_line_idle(&huart1));
     finish();
-    snprintf(msg, sizeof msg, "reply %u us after the stop bit, TC taken %u/3 us late%s", delay_us,
+    snprintf(msg, sizeof msg, "reply %u us after the stop bit, transmit end taken %u/3 us late%s", delay_us,
              tc_latency_thirds, lag ? ", DMA lagging" : "");
     TEST_ASSERT_EQUAL_INT_MESSAGE(J288_OK, last_txn.result, msg);
     TEST_ASSERT_EQUAL_UINT32_MESSAGE(J288_REPLY_LEN, j288_stm32_stats(&port1)->rx_bytes, msg);
@@ -523,13 +532,13 @@ static void test_reply_at_any_delay_after_the_stop_bit_loses_no_byte(void)
 }
 
 /* Fault 2: the position comes from the stream's counter at every event, whatever the order
- * in which the half, complete and idle interrupts are taken and however late. A window of 45
- * bytes (more than the 32-byte buffer), an idle line after 10: each event is served 0 to 8
+ * in which the half, complete and idle interrupts are taken and however late. A window of 80
+ * bytes (more than the 64-byte buffer), an idle line after 10: each event is served 0 to 8
  * bytes after it was raised, the UART's or the stream's first when both wait; every byte
  * reaches the bus exactly once, in order. */
 static void test_every_event_order_delivers_each_byte_once(void)
 {
-    uint8_t window[45];
+    uint8_t window[80];
     for (size_t i = 0; i < sizeof window; i++) {
         window[i] = (uint8_t)(0x40u + i);
     }
@@ -554,7 +563,7 @@ static void test_every_event_order_delivers_each_byte_once(void)
             uart_wait = fake_hal_irq_pending(&huart1, true) ? uart_wait + 1u : 0u;
             dma_wait = fake_hal_irq_pending(&huart1, false) ? dma_wait + 1u : 0u;
             /* the late event of the window: served later still */
-            unsigned dma_lag = (i > 30u) ? lag_late : lag_dma;
+            unsigned dma_lag = (i > 60u) ? lag_late : lag_dma;
             for (int k = 0; k < 2; k++) {
                 bool uart = (k == 0) == uart_first;
                 if (uart && (uart_wait > lag_uart)) {
@@ -732,7 +741,7 @@ static void test_two_buses_route_by_port(void)
 static void test_timeout_from_timer_channel(void)
 {
     uint32_t budget;
-    init_port1(NULL, true, false);
+    init_port1(isr_bus(), true, false);
     tim2_regs.CNT = 5000u;
     send_foc3();
     budget = j288_bus_reply_budget_us(j288_stm32_bus(&port1));
@@ -744,14 +753,23 @@ static void test_timeout_from_timer_channel(void)
     fake_now += budget + 5u;
     TEST_ASSERT_TRUE(fake_hal_tim_fire(&htim2, TIM_CHANNEL_1));
     TEST_ASSERT_EQUAL_UINT32(1u, j288_stm32_stats(&port1)->timer_events);
-    poll1();
     TEST_ASSERT_EQUAL_INT(1, done_count);
+    TEST_ASSERT_EQUAL_INT(J288_ERR_TIMEOUT, last_txn.result);
+}
+
+/* Polled, the bus needs no timer: the compare is never armed. */
+static void test_polled_bus_leaves_the_timer_alone(void)
+{
+    init_port1(NULL, true, false);
+    send_foc3();
+    TEST_ASSERT_TRUE((tim2_regs.DIER & TIM_IT_CC1) == 0u);
+    finish();
     TEST_ASSERT_EQUAL_INT(J288_ERR_TIMEOUT, last_txn.result);
 }
 
 static void test_timer_on_16_bit_counter_wraps(void)
 {
-    init_port1(NULL, true, false);
+    init_port1(isr_bus(), true, false);
     tim2_regs.ARR = 0xFFFFu;
     tim2_regs.CNT = 0xFFF0u;
     send_foc3();
@@ -914,7 +932,7 @@ static uint32_t timeouts_delivered(void)
 static void test_timer_arm_races_the_counter_at_every_access(void)
 {
     const j288_port_t *ops;
-    init_port1_timer_tick(NULL);
+    init_port1_timer_tick(isr_bus());
     ops = j288_stm32_bus(&port1)->port;
     for (uint32_t delay = 1u; delay <= 3u; delay++) {
         for (uint32_t run = 1u; run <= 4u; run++) {
@@ -936,7 +954,7 @@ static void test_timer_arm_races_the_counter_at_every_access(void)
 
 static void test_timer_deadline_already_passed_fires_at_once(void)
 {
-    init_port1_timer_tick(NULL);
+    init_port1_timer_tick(isr_bus());
     tim2_regs.CNT = 5000u;
     j288_stm32_bus(&port1)->port->arm_timeout(&port1, 4990u);
     TEST_ASSERT_EQUAL_UINT(1u, fake_hal_tim_run(&htim2, 0u));
@@ -1015,6 +1033,7 @@ int main(void)
     RUN_TEST(test_deinit_during_a_transmit_stops_it_and_releases_the_line);
     RUN_TEST(test_two_buses_route_by_port);
     RUN_TEST(test_timeout_from_timer_channel);
+    RUN_TEST(test_polled_bus_leaves_the_timer_alone);
     RUN_TEST(test_timer_on_16_bit_counter_wraps);
     RUN_TEST(test_advance_in_isr_timeout_ends_in_timer_interrupt);
     RUN_TEST(test_16_bit_timer_long_budget_rearms_until_deadline);
