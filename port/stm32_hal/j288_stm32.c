@@ -294,7 +294,7 @@ static int op_start_tx(void *ctx, const uint8_t *data, size_t len)
     p->stats.tx_frames++;
     *p->tx_ifcr = (uint32_t)DMA_F_ALL << p->tx_shift;
     DMA_COUNT(s) = (uint32_t)len;
-    if (p->cfg.deaf_while_transmitting) { /* no echo to tell the end: transmit complete */
+    if (p->tc_ends_tx) {
         uart_clear_tc(u);
         u->CR1 |= USART_CR1_TCIE;
     }
@@ -629,6 +629,7 @@ int j288_stm32_init(j288_stm32_t *p, const j288_stm32_config_t *cfg,
     memset(p, 0, sizeof *p);
     p->cfg = *cfg;
     p->echo = (bus_cfg != NULL) && bus_cfg->echo;
+    p->tc_ends_tx = (cfg->de_port != NULL) || cfg->deaf_while_transmitting;
     pick_ops(p, (bus_cfg != NULL) && bus_cfg->advance_in_isr);
     take_registers(p);
     rc = j288_bus_init(&p->bus, &p->ops, p, bus_cfg);
@@ -717,26 +718,6 @@ PORT_NOINLINE static void line_errors(j288_stm32_t *p, uint32_t sr)
     j288_bus_on_error(&p->bus, f);
 }
 
-/* The end of a transmit: the whole echo is in (the line hears us), or transmit complete (a
- * deaf line). The echo is handed to the bus to check, or skipped; then the bus turns the line
- * (DE) and waits for the reply, whose bytes may already follow the echo. */
-static void tx_complete(j288_stm32_t *p)
-{
-    uint32_t echo_end = p->tx_start;
-    p->tx_on = false;
-    if (p->cfg.deaf_while_transmitting) {
-        p->uart->CR1 &= ~(uint32_t)USART_CR1_TCIE;
-    } else if (p->echo) {
-        rx_skip(p, p->tx_start);
-        echo_end = (echo_end + p->tx_len) % J288_STM32_RX_BUF_SIZE;
-        rx_take(p, echo_end);
-    } else {
-        echo_end = (echo_end + p->tx_len) % J288_STM32_RX_BUF_SIZE;
-    }
-    rx_skip(p, echo_end);
-    j288_bus_on_tx_done(&p->bus);
-}
-
 /* Our transmit has come back whole: the receiver hears the line, so the end of the echo is
  * the end of the transmit (its last stop bit sampled). Seen at the idle line that follows it,
  * or at a half/complete event when the reply follows without a pause. */
@@ -744,6 +725,43 @@ static bool echo_heard(const j288_stm32_t *p, uint32_t head)
 {
     uint32_t since = (head + J288_STM32_RX_BUF_SIZE - p->tx_start) % J288_STM32_RX_BUF_SIZE;
     return !p->cfg.deaf_while_transmitting && (since >= p->tx_len);
+}
+
+/* Where the echo ends. At transmit complete (a DE pin) the last echoed byte was sampled half a
+ * bit earlier and the DMA stores it within a few bus cycles: waited for, a bounded number of
+ * reads; an echo cut short (a collision) ends where the bytes end. */
+static uint32_t echo_end(const j288_stm32_t *p)
+{
+    return ((uint32_t)p->tx_start + p->tx_len) % J288_STM32_RX_BUF_SIZE;
+}
+
+PORT_NOINLINE static uint32_t echo_end_at_tc(const j288_stm32_t *p)
+{
+    uint32_t head = rx_head(p);
+    if (p->cfg.deaf_while_transmitting) {
+        return p->tx_start; /* no echo */
+    }
+    for (uint32_t i = 0; (i < J288_STM32_STOP_SPINS) && !echo_heard(p, head); i++) {
+        head = rx_head(p);
+    }
+    return echo_heard(p, head) ? echo_end(p) : head;
+}
+
+/* The end of a transmit: the whole echo is in (the line hears us), or transmit complete (a DE
+ * pin to drop at once, or a deaf line). The echo is handed to the bus to check, or skipped;
+ * then the bus turns the line (DE) and waits for the reply, whose bytes may already follow. */
+static void tx_complete(j288_stm32_t *p, uint32_t end)
+{
+    p->tx_on = false;
+    if (p->tc_ends_tx) {
+        p->uart->CR1 &= ~(uint32_t)USART_CR1_TCIE;
+    }
+    if (p->echo) {
+        rx_skip(p, p->tx_start);
+        rx_take(p, end);
+    }
+    rx_skip(p, end);
+    j288_bus_on_tx_done(&p->bus);
 }
 
 void j288_stm32_on_uart_irq(j288_stm32_t *p)
@@ -756,15 +774,15 @@ void j288_stm32_on_uart_irq(j288_stm32_t *p)
     }
     u = p->uart;
     sr = UART_STATUS(u);
-    if (p->cfg.deaf_while_transmitting && ((sr & UART_TC) != 0u) && ((u->CR1 & USART_CR1_TCIE) != 0u)) {
-        tx_complete(p); /* a deaf line's transmit */
+    if (p->tc_ends_tx && ((sr & UART_TC) != 0u) && ((u->CR1 & USART_CR1_TCIE) != 0u)) {
+        tx_complete(p, echo_end_at_tc(p)); /* DE to drop at once, or a deaf line */
     }
     if ((sr & (UART_IDLE | UART_ERRORS)) != 0u) {
         uint32_t head = rx_head(p);
         uart_clear(u, sr);
         p->stats.rx_events++;
-        if (p->tx_on && echo_heard(p, head)) {
-            tx_complete(p);
+        if (p->tx_on && !p->tc_ends_tx && echo_heard(p, head)) {
+            tx_complete(p, echo_end(p));
         }
         if (!p->tx_on && (head != p->rx_pos)) {
             rx_take(p, head);
@@ -805,10 +823,10 @@ void j288_stm32_on_dma_rx_irq(j288_stm32_t *p)
     }
     head = rx_head(p);
     if (p->tx_on) {
-        if (!echo_heard(p, head)) {
-            return; /* our own echo, not whole yet */
+        if (p->tc_ends_tx || !echo_heard(p, head)) {
+            return; /* our own echo, not whole yet, or transmit complete to come */
         }
-        tx_complete(p);
+        tx_complete(p, echo_end(p));
     }
     if (rx_pending(p, head) >= J288_STM32_RX_BUF_SIZE / 4u) {
         rx_take(p, head);

@@ -247,6 +247,8 @@ typedef struct j288_stm32 {
     uint8_t tx_shift;
     uint8_t rx_shift;
     bool echo;                 /* the bus checks the echo: hand it over */
+    bool tc_ends_tx;           /* transmit complete ends a transmit (DE pin, deaf line), not
+                                  the echo's idle line */
     volatile uint16_t rx_pos;  /* position in the circular buffer handed out so far */
     volatile uint16_t tx_len;  /* bytes of the last transmit (its echo) */
     volatile uint16_t tx_start; /* where its echo starts in the receive buffer */

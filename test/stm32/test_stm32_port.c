@@ -378,7 +378,8 @@ static void test_full_transaction_registers_and_bytes(void)
     poll1();
     TEST_ASSERT_TRUE(fake_hal_tx_busy(&huart1));
     TEST_ASSERT_EQUAL_INT(1, fake_hal_gpio_level(&gpioa, DE_PIN));
-    TEST_ASSERT_TRUE((fake_hal_usart(&huart1)->CR1 & USART_CR1_TCIE) == 0u); /* the echo tells */
+    /* with a DE pin to drop, transmit complete ends the transmit (not the echo's idle line) */
+    TEST_ASSERT_TRUE((fake_hal_usart(&huart1)->CR1 & USART_CR1_TCIE) != 0u);
     TEST_ASSERT_TRUE(fake_hal_log_find(FAKE_CACHE_CLEAN, dma1.tx, 0) >= 0);
 
     /* the worked frame, byte for byte, from the DMA buffer; the echo skipped */
@@ -403,10 +404,12 @@ static void test_full_transaction_registers_and_bytes(void)
     TEST_ASSERT_EQUAL_UINT32(0u, fake_hal_primask());
 }
 
-/* Many transactions: the circular buffer wraps again and again, every reply arrives whole. */
+/* Many transactions: the circular buffer wraps again and again, every reply arrives whole;
+ * without a DE pin the echo's idle line ends each transmit (no transmit-complete interrupt). */
 static void test_many_transactions_across_the_wraps(void)
 {
     init_port1(NULL, false, false);
+    TEST_ASSERT_TRUE((fake_hal_usart(&huart1)->CR1 & USART_CR1_TCIE) == 0u);
     for (int i = 0; i < 20; i++) {
         done_count = 0;
         sink_len = 0u;
