@@ -258,13 +258,19 @@ static void op_set_dir(void *ctx, j288_dir_t dir)
  * says it is still running. */
 static bool tx_stream_ready(j288_stm32_t *p, dma_regs_t *s)
 {
-    if ((DMA_CTRL(s) & DMA_EN) == 0u) {
+    uint32_t ctrl = DMA_CTRL(s);
+    if ((ctrl & DMA_EN) == 0u) {
         return true;
     }
     if (DMA_COUNT(s) != 0u) {
         p->stats.dma_resets++;
     }
+#if defined(DMA_SxCR_EN)
     return dma_stop(s);
+#else
+    DMA_CTRL(s) = ctrl & ~(uint32_t)DMA_EN; /* a channel stops at once */
+    return true;
+#endif
 }
 
 static int op_start_tx(void *ctx, const uint8_t *data, size_t len)

@@ -149,13 +149,41 @@ static void plain_transaction(void)
 
 /* ---- the STM32 port on the real HAL, peripherals in RAM --------------------------------- */
 
+#if defined(STM32G4)
+/* DMA1 channels 1 (TX) and 2 (RX), their flags in one ISR/IFCR pair. HAL_DMA_Init would find
+ * the flags from the channel's fixed address and program the DMAMUX at its own: the fields it
+ * fills in are set here instead. */
+static DMA_Channel_TypeDef tx_ch, rx_ch;
+static DMA_TypeDef dma1_regs;
+#define RX_COUNT (rx_ch.CNDTR)
+#define TX_COUNT (tx_ch.CNDTR)
+#define DMA_FLAGS (dma1_regs.ISR)
+#define DMA_FLAGS_CLEARED (dma1_regs.IFCR)
+#define F_HT DMA_ISR_HTIF1
+#define F_TC DMA_ISR_TCIF1
+#define RX_SHIFT 4u /* channel 2 */
+#define UART_STATUS (usart1_regs.ISR)
+#define S_TC USART_ISR_TC
+#define S_IDLE USART_ISR_IDLE
+#define FAMILY "G4"
+#else
 /* DMA2 as the HAL addresses it: LISR, HISR, LIFCR, HIFCR, then 8 streams of 0x18 bytes from
  * offset 0x10; the HAL finds a stream's flags from the stream's address. */
 static uint32_t dma2_block[0x100u / 4u] __attribute__((aligned(1024)));
 #define DMA2_STREAM(n) ((DMA_Stream_TypeDef *)(void *)((uint8_t *)dma2_block + 0x10u + 0x18u * (n)))
-#define DMA2_LISR (dma2_block[0])
-#define DMA2_LIFCR (dma2_block[2])
+#define TX_STREAM DMA2_STREAM(7u)
+#define RX_COUNT (DMA2_STREAM(2u)->NDTR)
+#define TX_COUNT (TX_STREAM->NDTR)
+#define DMA_FLAGS (dma2_block[0])         /* LISR */
+#define DMA_FLAGS_CLEARED (dma2_block[2]) /* LIFCR */
+#define F_HT DMA_LISR_HTIF0
+#define F_TC DMA_LISR_TCIF0
 #define RX_SHIFT 16u /* stream 2's flags in LISR */
+#define UART_STATUS (usart1_regs.SR)
+#define S_TC USART_SR_TC
+#define S_IDLE USART_SR_IDLE
+#define FAMILY "F4"
+#endif
 
 static USART_TypeDef usart1_regs;
 static TIM_TypeDef tim2_regs;
@@ -176,12 +204,20 @@ static int port_setup(void)
     j288_stm32_config_t pc;
     static const DMA_HandleTypeDef zero_dma;
 
-    memset(dma2_block, 0, sizeof dma2_block);
     memset(&usart1_regs, 0, sizeof usart1_regs);
     memset(&huart1, 0, sizeof huart1);
     hdma_tx = zero_dma;
     hdma_rx = zero_dma;
-
+#if defined(STM32G4)
+    memset(&dma1_regs, 0, sizeof dma1_regs);
+    hdma_tx.Instance = &tx_ch;
+    hdma_tx.DmaBaseAddress = &dma1_regs;
+    hdma_tx.ChannelIndex = 0u;
+    hdma_rx.Instance = &rx_ch;
+    hdma_rx.DmaBaseAddress = &dma1_regs;
+    hdma_rx.ChannelIndex = RX_SHIFT;
+#else
+    memset(dma2_block, 0, sizeof dma2_block);
     hdma_tx.Instance = DMA2_STREAM(7u);
     hdma_tx.Init.Channel = DMA_CHANNEL_4;
     hdma_tx.Init.Direction = DMA_MEMORY_TO_PERIPH;
@@ -195,6 +231,7 @@ static int port_setup(void)
     if ((HAL_DMA_Init(&hdma_tx) != HAL_OK) || (HAL_DMA_Init(&hdma_rx) != HAL_OK)) {
         return -1;
     }
+#endif
     /* What HAL_HalfDuplex_Init leaves (its clock and baud setup needs the RCC, which is not
      * here): the handle ready, the UART on in half-duplex mode, the streams linked. */
     huart1.Instance = &usart1_regs;
@@ -224,12 +261,17 @@ static int port_setup(void)
     return j288_stm32_init(&port, &pc, NULL);
 }
 
-/* The simulation runs paused (its time excluded); the port's entries run counted. */
+/* The simulation runs paused (its time excluded); the port's entries run counted. The G4's
+ * flags the port clears through ICR go afterwards, as the silicon clears them. */
 static void port_uart_irq(void)
 {
     pause_end();
     j288_stm32_on_uart_irq(&port);
     pause_begin();
+#if defined(STM32G4)
+    usart1_regs.ISR &= ~usart1_regs.ICR;
+    usart1_regs.ICR = 0u;
+#endif
 }
 
 /* n bytes arrive on the line and go to the RX stream's buffer; the stream counts down and
@@ -237,23 +279,22 @@ static void port_uart_irq(void)
  * port cleared through LIFCR go, as the silicon clears them). Called paused. */
 static void line_receive(const uint8_t *src, uint32_t n)
 {
-    DMA_Stream_TypeDef *s = DMA2_STREAM(2u);
     while (n > 0u) {
-        uint32_t pos = J288_STM32_RX_BUF_SIZE - s->NDTR;
+        uint32_t pos = J288_STM32_RX_BUF_SIZE - RX_COUNT;
         uint32_t to_flag = ((pos < J288_STM32_RX_BUF_SIZE / 2u) ? J288_STM32_RX_BUF_SIZE / 2u : J288_STM32_RX_BUF_SIZE) - pos;
         uint32_t chunk = (n < to_flag) ? n : to_flag;
         memcpy(&bus_dma.rx[pos], src, chunk);
         src += chunk;
         n -= chunk;
-        s->NDTR -= chunk;
+        RX_COUNT -= chunk;
         if (chunk == to_flag) {
-            DMA2_LISR |= ((s->NDTR == 0u) ? DMA_LISR_TCIF0 : DMA_LISR_HTIF0) << RX_SHIFT;
-            s->NDTR = (s->NDTR == 0u) ? J288_STM32_RX_BUF_SIZE : s->NDTR;
+            DMA_FLAGS |= ((RX_COUNT == 0u) ? F_TC : F_HT) << RX_SHIFT;
+            RX_COUNT = (RX_COUNT == 0u) ? J288_STM32_RX_BUF_SIZE : RX_COUNT;
             pause_end();
             j288_stm32_on_dma_rx_irq(&port);
             pause_begin();
-            DMA2_LISR &= ~DMA2_LIFCR;
-            DMA2_LIFCR = 0u;
+            DMA_FLAGS &= ~DMA_FLAGS_CLEARED;
+            DMA_FLAGS_CLEARED = 0u;
         }
     }
 }
@@ -263,21 +304,22 @@ static void line_receive(const uint8_t *src, uint32_t n)
  * servo answers. */
 static void hw_transmit_done(void)
 {
-    DMA_Stream_TypeDef *tx = DMA2_STREAM(7u);
     pause_begin();
     /* SR's bits are rc_w0: the port's clear of TC (a write of ~TC) left the others as they
      * were, which RAM does not do: put them back (and TC cleared). */
-    usart1_regs.SR = 0u;
-    line_receive(bus_dma.tx, tx->NDTR);
-    tx->NDTR = 0u;
-    tx->CR &= ~(uint32_t)DMA_SxCR_EN;
-    usart1_regs.SR = USART_SR_TC;
-    if ((usart1_regs.CR1 & USART_CR1_TCIE) != 0u) { /* a deaf line's end of transmit */
+    UART_STATUS = 0u;
+    line_receive(bus_dma.tx, TX_COUNT);
+    TX_COUNT = 0u;
+#if !defined(STM32G4)
+    TX_STREAM->CR &= ~(uint32_t)DMA_SxCR_EN; /* a stream stops; a channel stays enabled */
+#endif
+    UART_STATUS = S_TC;
+    if ((usart1_regs.CR1 & USART_CR1_TCIE) != 0u) { /* a DE pin's end of transmit */
         port_uart_irq();
     }
-    usart1_regs.SR = USART_SR_TC | USART_SR_IDLE;
+    UART_STATUS = S_TC | S_IDLE;
     port_uart_irq();
-    usart1_regs.SR = USART_SR_TC; /* the port's SR-then-DR read cleared IDLE */
+    UART_STATUS = S_TC; /* the F4's SR-then-DR read, the G4's ICR cleared IDLE */
     pause_end();
 }
 
@@ -286,9 +328,9 @@ static void hw_reply_then_idle(void)
 {
     pause_begin();
     line_receive(k_reply3, J288_REPLY_LEN);
-    usart1_regs.SR = USART_SR_TC | USART_SR_IDLE;
+    UART_STATUS = S_TC | S_IDLE;
     port_uart_irq();
-    usart1_regs.SR = USART_SR_TC;
+    UART_STATUS = S_TC;
     pause_end();
 }
 
@@ -379,7 +421,7 @@ int main(void)
            "reply + idle | polls to the end |\n");
     printf("|---|---:|---:|---:|---:|---:|---:|\n");
     print_row("lib/ alone (port operations empty)", &plain, NULL);
-    print_row("STM32 port on F4 registers (HAL init)", &regs, &plain);
+    print_row("STM32 port on " FAMILY " registers (HAL init)", &regs, &plain);
     printf("interrupt time per transaction (the port's entries and what the bus does in them): "
            "%u instructions\n", (unsigned)(regs.phase[1] + regs.phase[2]));
     return 0;
