@@ -93,7 +93,13 @@ typedef struct {
 #define USART_CR3_OVRDIS 0x00001000u
 #define USART_CR3_DDRE 0x00002000u
 #else
+/* -DJ288_STUB_H7: the same registers under the H7's name (its DMA1/2 are streams as the F4's),
+ * for what the port decides by family rather than by register model (reachable RAM). */
+#if defined(J288_STUB_H7)
+#define STM32H7
+#else
 #define STM32F4
+#endif
 typedef struct {
     volatile uint32_t CR;
     volatile uint32_t NDTR;
