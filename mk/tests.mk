@@ -120,38 +120,27 @@ $(SIM_MODEL_TEST): $(OBJ)/test/sim/test_sim_model.o $(SIM_MODEL_OBJ) $(UNITY_OBJ
 # the H7's name (test_stm32_port_h7).
 STM32_TEST_DEFS := -DJ288_STM32_DCACHE=1 -DJ288_STM32_RX_BUF_SIZE=64u -DJ288_STM32_RX_SINK=test_rx_sink
 STM32_HDRS := $(wildcard port/stm32_hal/*.h test/stm32/*.h test/stm32/stub/*.h) $(TEST_HDR)
-STM32_TEST := $(BUILD)/test/test_stm32_port
 STM32_TEST_SRC := port/stm32_hal/j288_stm32.c test/stm32/fake_hal.c test/stm32/test_stm32_port.c
-$(OBJ)/stm32host/%.o: %.c $(STM32_HDRS) $(UNITY)/unity.c
-	@mkdir -p $(@D)
-	$(CC) $(TEST_CPPFLAGS) -Iport/stm32_hal -Itest/stm32/stub -Itest/stm32 $(STM32_TEST_DEFS) \
-	    $(CFLAGS_COMMON) -c $< -o $@
 
-$(STM32_TEST): $(STM32_TEST_SRC:%.c=$(OBJ)/stm32host/%.o) $(UNITY_OBJ) $(LIB_A)
-	@mkdir -p $(@D)
-	$(CC) $(CFLAGS_COMMON) $^ -o $@ $(LDFLAGS_COMMON) -lm
+# $(call STM32_HOST_TEST,name,objdir,defs): test_stm32_port built with the stub's defs.
+define STM32_HOST_TEST
+$$(OBJ)/$(2)/%.o: %.c $$(STM32_HDRS) $$(UNITY)/unity.c
+	@mkdir -p $$(@D)
+	$$(CC) $$(TEST_CPPFLAGS) -Iport/stm32_hal -Itest/stm32/stub -Itest/stm32 $$(STM32_TEST_DEFS) $(3) \
+	    $$(CFLAGS_COMMON) -c $$< -o $$@
 
+$$(BUILD)/test/$(1): $$(STM32_TEST_SRC:%.c=$$(OBJ)/$(2)/%.o) $$(UNITY_OBJ) $$(LIB_A)
+	@mkdir -p $$(@D)
+	$$(CC) $$(CFLAGS_COMMON) $$^ -o $$@ $$(LDFLAGS_COMMON) -lm
+endef
+STM32_TEST := $(BUILD)/test/test_stm32_port
 STM32_G4_TEST := $(BUILD)/test/test_stm32_port_g4
-$(OBJ)/stm32host-g4/%.o: %.c $(STM32_HDRS) $(UNITY)/unity.c
-	@mkdir -p $(@D)
-	$(CC) $(TEST_CPPFLAGS) -Iport/stm32_hal -Itest/stm32/stub -Itest/stm32 $(STM32_TEST_DEFS) -DJ288_STUB_G4 \
-	    $(CFLAGS_COMMON) -c $< -o $@
-
-$(STM32_G4_TEST): $(STM32_TEST_SRC:%.c=$(OBJ)/stm32host-g4/%.o) $(UNITY_OBJ) $(LIB_A)
-	@mkdir -p $(@D)
-	$(CC) $(CFLAGS_COMMON) $^ -o $@ $(LDFLAGS_COMMON) -lm
-
 # The F4's register model under the H7's name: what the port decides by family (the RAM its
 # DMA reaches).
 STM32_H7_TEST := $(BUILD)/test/test_stm32_port_h7
-$(OBJ)/stm32host-h7/%.o: %.c $(STM32_HDRS) $(UNITY)/unity.c
-	@mkdir -p $(@D)
-	$(CC) $(TEST_CPPFLAGS) -Iport/stm32_hal -Itest/stm32/stub -Itest/stm32 $(STM32_TEST_DEFS) -DJ288_STUB_H7 \
-	    $(CFLAGS_COMMON) -c $< -o $@
-
-$(STM32_H7_TEST): $(STM32_TEST_SRC:%.c=$(OBJ)/stm32host-h7/%.o) $(UNITY_OBJ) $(LIB_A)
-	@mkdir -p $(@D)
-	$(CC) $(CFLAGS_COMMON) $^ -o $@ $(LDFLAGS_COMMON) -lm
+$(eval $(call STM32_HOST_TEST,test_stm32_port,stm32host,))
+$(eval $(call STM32_HOST_TEST,test_stm32_port_g4,stm32host-g4,-DJ288_STUB_G4))
+$(eval $(call STM32_HOST_TEST,test_stm32_port_h7,stm32host-h7,-DJ288_STUB_H7))
 
 # ---- the lists -------------------------------------------------------------------------------
 HOST_TESTS += $(CLI_TEST) $(foreach v,$(CODEC_CRC_VARIANTS),$(CODEC_CRC_TEST_NAMES:%=$(BUILD)/crc-$(v)/test/%)) \

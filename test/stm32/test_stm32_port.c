@@ -176,6 +176,18 @@ static void assert_reply_ok(void)
     TEST_ASSERT_EQUAL_INT32(5215, last_txn.reply.pos);
 }
 
+/* After a failed transaction: past its guard, the next one is heard whole. */
+static void next_transaction_is_heard_whole(void)
+{
+    fake_now += 3u * j288_bus_reply_budget_us(j288_stm32_bus(&port1)) + 10u;
+    poll1();
+    done_count = 0;
+    send_foc3();
+    reply_whole();
+    finish();
+    assert_reply_ok();
+}
+
 /* ---- init ----------------------------------------------------------------------------- */
 
 static void test_init_rejects_bad_config(void)
@@ -649,14 +661,7 @@ static void test_framing_or_overrun_at_any_byte_loses_nothing_after(void)
                 TEST_ASSERT_EQUAL_HEX8_ARRAY_MESSAGE(&k_reply3[at + 1u], &sink[sink_len - (J288_REPLY_LEN - at - 1u)],
                                                      J288_REPLY_LEN - at - 1u, msg);
             }
-            /* and the next transaction is heard whole */
-            fake_now += 3u * j288_bus_reply_budget_us(j288_stm32_bus(&port1));
-            poll1();
-            done_count = 0;
-            send_foc3();
-            reply_whole();
-            finish();
-            TEST_ASSERT_EQUAL_INT_MESSAGE(J288_OK, last_txn.result, msg);
+            next_transaction_is_heard_whole();
             tearDown();
         }
     }
@@ -672,13 +677,7 @@ static void test_rx_stream_error_restarts_the_stream(void)
     TEST_ASSERT_EQUAL_UINT32(1u, j288_stm32_stats(&port1)->dma_errors);
     finish();
     TEST_ASSERT_EQUAL_INT(J288_ERR_LINE, last_txn.result);
-    fake_now += 3u * j288_bus_reply_budget_us(j288_stm32_bus(&port1));
-    poll1();
-    done_count = 0;
-    send_foc3();
-    reply_whole();
-    finish();
-    assert_reply_ok();
+    next_transaction_is_heard_whole();
 }
 
 /* A transmit whose completion never came (the stream left running): the next transmit stops
@@ -694,14 +693,8 @@ static void test_stalled_transmit_is_stopped_and_the_next_transaction_works(void
     poll1();
     TEST_ASSERT_EQUAL_INT(1, done_count);
     TEST_ASSERT_EQUAL_INT(J288_ERR_TX_TIMEOUT, last_txn.result);
-    fake_now += 3u * j288_bus_reply_budget_us(j288_stm32_bus(&port1)) + 10u;
-    poll1();
-    done_count = 0;
-    send_foc3();
+    next_transaction_is_heard_whole();
     TEST_ASSERT_EQUAL_UINT32(1u, j288_stm32_stats(&port1)->dma_resets);
-    reply_whole();
-    finish();
-    assert_reply_ok();
 }
 
 static void test_deinit_during_a_transmit_stops_it_and_releases_the_line(void)
