@@ -11,8 +11,9 @@
  * How the line runs (docs/stm32.md says why):
  *  - The receiver is never switched off and the receive stream runs circular from init on,
  *    so there is no moment at the turnaround where a reply byte can be lost. The line hears
- *    our own 20 bytes: with the bus's echo option they are handed to the bus, which checks
- *    them (collisions); without it, the port skips them at transmit complete.
+ *    our own 20 bytes, and their end is the end of the transmit (seen at the idle line after
+ *    them; with a DE pin, transmit complete drops DE at once instead): with the bus's echo
+ *    option they are handed to the bus, which checks them (collisions); without, skipped.
  *  - The receive position is read from the stream's counter (NDTR/CNDTR) at every event: idle
  *    line, half and whole buffer. The events may come in any order, late or twice: every byte
  *    is handed to the bus once, in order, as long as less than a buffer passes between two
@@ -194,9 +195,10 @@ typedef struct {
      * deadline's distance from now_us, so both must count microseconds. */
     uint32_t (*now_us)(void);
 
-    /* Optional response timeout: a timer counting at 1 MHz, started by the application
-     * (HAL_TIM_Base_Start), whose capture/compare channel tim_channel (TIM_CHANNEL_1..4) is
-     * free and in its reset (frozen output compare) mode. The port writes the compare value,
+    /* Optional response timeout, used by a bus that advances in its interrupts
+     * (advance_in_isr; a polled bus reads the clock when polled): a timer counting at 1 MHz,
+     * started by the application (HAL_TIM_Base_Start), whose capture/compare channel
+     * tim_channel (TIM_CHANNEL_1..4) is free and in its reset (frozen output compare) mode. The port writes the compare value,
      * enables that channel's interrupt and, for a deadline already due, raises the channel's
      * event through the timer's EGR; forward HAL_TIM_OC_DelayElapsedCallback to
      * j288_stm32_on_timer(). Several buses may share one timer on different channels. NULL:
