@@ -531,6 +531,9 @@ static int check_config(const j288_stm32_config_t *cfg, const j288_bus_config_t 
         (J288_STM32_CACHE_OPS && (((uintptr_t)cfg->dma % J288_STM32_DCACHE_LINE) != 0u))) {
         return J288_ERR_BAD_CONFIG;
     }
+    if (cfg->irq_priority >= (1u << __NVIC_PRIO_BITS)) {
+        return J288_ERR_BAD_CONFIG; /* shifted into BASEPRI it would mask the wrong level, or none */
+    }
     if ((bus_cfg != NULL) && bus_cfg->echo && cfg->deaf_while_transmitting) {
         return J288_ERR_BAD_CONFIG; /* the line cannot hear the echo the bus would wait for */
     }

@@ -371,6 +371,20 @@ static void test_bus_lock_masks_only_the_bus_interrupts(void)
     __set_BASEPRI(0u);
 }
 
+/* A priority the NVIC cannot hold (its top __NVIC_PRIO_BITS bits) is refused at init: shifted
+ * into BASEPRI it would keep only its low bits, and 1 << __NVIC_PRIO_BITS would write 0, a
+ * lock that masks nothing. */
+static void test_init_rejects_a_priority_the_nvic_cannot_hold(void)
+{
+    j288_stm32_config_t c = base_config(&huart1, &dma1);
+    c.irq_priority = (uint8_t)(1u << __NVIC_PRIO_BITS);
+    TEST_ASSERT_EQUAL_INT(J288_ERR_BAD_CONFIG, j288_stm32_init(&port1, &c, NULL));
+    c.irq_priority = 0xFFu;
+    TEST_ASSERT_EQUAL_INT(J288_ERR_BAD_CONFIG, j288_stm32_init(&port1, &c, NULL));
+    c.irq_priority = (uint8_t)((1u << __NVIC_PRIO_BITS) - 1u); /* the least urgent: fine */
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_stm32_init(&port1, &c, NULL));
+}
+
 static void test_bus_lock_without_priority_masks_all(void)
 {
     const j288_port_t *ops;
@@ -1022,6 +1036,7 @@ int main(void)
     RUN_TEST(test_tx_pin_drive_option);
     RUN_TEST(test_bus_lock_masks_only_the_bus_interrupts);
     RUN_TEST(test_bus_lock_without_priority_masks_all);
+    RUN_TEST(test_init_rejects_a_priority_the_nvic_cannot_hold);
     RUN_TEST(test_full_transaction_registers_and_bytes);
     RUN_TEST(test_many_transactions_across_the_wraps);
     RUN_TEST(test_echo_option_checks_the_echo);
