@@ -256,6 +256,20 @@ static void test_init_takes_the_line(void)
     TEST_ASSERT_EQUAL_INT(0, fake_hal_gpio_level(&gpioa, DE_PIN));
 }
 
+/* A stream in FIFO mode (CubeMX offers it) counts a byte in NDTR when it leaves the UART,
+ * but writes it to memory only at the FIFO's threshold: the port, reading positions from the
+ * counter, would hand the bus stale bytes. Init puts the RX stream in direct mode. */
+static void test_init_puts_the_rx_stream_in_direct_mode(void)
+{
+#if defined(J288_STUB_G4)
+    TEST_IGNORE_MESSAGE("DMA channels have no FIFO");
+#else
+    fake_hal_rx_stream(&huart1)->FCR = DMA_SxFCR_DMDIS | 0x1u; /* FIFO mode, threshold 1/2 */
+    init_port1(NULL, false, true);
+    TEST_ASSERT_EQUAL_HEX32(0u, fake_hal_rx_stream(&huart1)->FCR & DMA_SxFCR_DMDIS);
+#endif
+}
+
 static void test_registry_is_bounded(void)
 {
     static j288_stm32_t extra[J288_STM32_MAX_BUSES + 1u];
@@ -1031,6 +1045,7 @@ int main(void)
     RUN_TEST(test_init_rejects_echo_on_a_deaf_line);
     RUN_TEST(test_init_takes_the_line);
     RUN_TEST(test_registry_is_bounded);
+    RUN_TEST(test_init_puts_the_rx_stream_in_direct_mode);
     RUN_TEST(test_init_refuses_buffers_the_dma_cannot_reach);
     RUN_TEST(test_init_rejects_uart_without_dma_streams);
     RUN_TEST(test_tx_pin_drive_option);
