@@ -19,6 +19,7 @@
 #include <mmsystem.h>
 
 #include <stdarg.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -550,6 +551,49 @@ HANDLE j288_windows_read_event(j288_windows_t *wp)
     if (!wp->rx_pending) /* ended empty at once (Wine): look again next round */
         (void)SetEvent(wp->rx_event);
     return wp->rx_event;
+}
+
+int j288_windows_service(j288_windows_t *wp)
+{
+    if (wp == NULL)
+        return J288_ERR_NULL;
+    return port_wait(wp, j288_windows_now_us());
+}
+
+unsigned j288_windows_wait_any(j288_windows_t *const ports[], unsigned n, uint32_t timeout_us,
+                               bool ready[])
+{
+    HANDLE ev[J288_WINDOWS_WAIT_MAX];
+    unsigned who[J288_WINDOWS_WAIT_MAX];
+    DWORD count = 0, i;
+    unsigned k, got = 0;
+    if (n > J288_WINDOWS_WAIT_MAX)
+        n = J288_WINDOWS_WAIT_MAX;
+    for (k = 0; k < n; k++) {
+        HANDLE h = j288_windows_read_event(ports[k]);
+        ready[k] = false;
+        if (h == NULL)
+            continue;
+        ev[count] = h;
+        who[count] = k;
+        count++;
+    }
+    if (count == 0u) {
+        Sleep(wait_ms((int32_t)(timeout_us > INT32_MAX ? INT32_MAX : timeout_us)));
+        return 0;
+    }
+    if (WaitForMultipleObjects(count, ev, FALSE,
+                               wait_ms((int32_t)(timeout_us > INT32_MAX ? INT32_MAX : timeout_us))) ==
+        WAIT_TIMEOUT)
+        return 0;
+    /* It names only the first signalled event: look at each. */
+    for (i = 0; i < count; i++) {
+        if (WaitForSingleObject(ev[i], 0) == WAIT_OBJECT_0) {
+            ready[who[i]] = true;
+            got++;
+        }
+    }
+    return got;
 }
 
 /* No start_rx (a read is always in flight), no set_dir (the adapter switches direction

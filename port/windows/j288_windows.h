@@ -190,6 +190,22 @@ int j288_windows_sweep(j288_windows_t *wp, j288_sched_t *s, uint32_t timeout_us)
  */
 HANDLE j288_windows_read_event(j288_windows_t *wp);
 
+/* Read what has come and deliver the events that are due, without sleeping: the port's
+ * wait() with a deadline of now. J288_OK, J288_ERR_OFFLINE (the device vanished: reported to
+ * the bus, j288_windows_error() says why), J288_ERR_NULL. Thread only. */
+int j288_windows_service(j288_windows_t *wp);
+
+/* The multi-bus wait (a host's one OS-specific call; Linux: one ppoll() over descriptors):
+ * sleep until one of ports[0..n-1] (open, not gone) has input or has failed, or timeout_us
+ * has passed (rounded up to whole milliseconds). ready[i] is set for each port to service
+ * (then call j288_windows_service() on it), cleared for the others; closed or gone ports are
+ * never ready. Returns how many are ready (0: timeout). n may be 0 (a plain bounded sleep).
+ * At most J288_WINDOWS_WAIT_MAX ports. One WaitForMultipleObjects() over the ports' read
+ * events. Thread only. */
+#define J288_WINDOWS_WAIT_MAX 16u
+unsigned j288_windows_wait_any(j288_windows_t *const ports[], unsigned n, uint32_t timeout_us,
+                               bool ready[]);
+
 /* The earliest time the port must be called again for its own timers (reply deadline armed
  * by the bus, line idle after bytes): sets *at_us and returns true, or false when none is due.
  * Thread only. */

@@ -241,8 +241,8 @@ static void test_stop_flag_aborts_run(void)
                                                     J288_WINDOWS_RUN_IGNORE_STOP));
 }
 
-/* Two ports, one WaitForMultipleObjects over their read events: the way a host waits for
- * several buses. Both transactions complete. */
+/* Two ports, one j288_windows_wait_any() (WaitForMultipleObjects over their read events):
+ * the way a host waits for several buses. Both transactions complete, woken by their replies. */
 static void test_two_ports_one_wait(void)
 {
     j288_windows_t other;
@@ -260,22 +260,33 @@ static void test_two_ports_one_wait(void)
     t0 = j288_windows_now_us();
     TEST_ASSERT_EQUAL_INT(J288_OK, j288_bus_submit(&g_bus, &c, t0, NULL, NULL));
     TEST_ASSERT_EQUAL_INT(J288_OK, j288_bus_submit(&other_bus, &c, t0, NULL, NULL));
+    j288_windows_t *ports[2];
+    bool ready[2];
+    unsigned woken = 0;
+    ports[0] = &g_wp;
+    ports[1] = &other;
     while (!(j288_bus_is_idle(&g_bus) && j288_bus_is_idle(&other_bus)) && rounds < 10000) {
-        HANDLE ev[2];
-        ev[0] = j288_windows_read_event(&g_wp);
-        ev[1] = j288_windows_read_event(&other);
-        TEST_ASSERT_NOT_NULL(ev[0]);
-        TEST_ASSERT_NOT_NULL(ev[1]);
-        (void)WaitForMultipleObjects(2, ev, FALSE, 1);
-        (void)j288_windows_port.wait(&g_wp, j288_windows_now_us());
-        (void)j288_windows_port.wait(&other, j288_windows_now_us());
+        unsigned k, got = j288_windows_wait_any(ports, 2, 1000u, ready);
+        for (k = 0; k < 2; k++) {
+            if (ready[k]) {
+                TEST_ASSERT_EQUAL_INT(J288_OK, j288_windows_service(ports[k]));
+                woken++;
+            }
+        }
+        TEST_ASSERT_TRUE(got <= 2u);
+        /* (the bus's poll sees its reply deadline itself) */
         j288_bus_poll(&g_bus, j288_windows_now_us());
         j288_bus_poll(&other_bus, j288_windows_now_us());
         rounds++;
     }
     TEST_ASSERT_EQUAL_UINT32(1u, j288_bus_stats(&g_bus)->ok);
     TEST_ASSERT_EQUAL_UINT32(1u, j288_bus_stats(&other_bus)->ok);
+    TEST_ASSERT_TRUE(woken >= 2u); /* both replies woke the wait */
+    /* A closed port is never ready, and the wait is then a bounded sleep. */
     j288_windows_close(&other);
+    TEST_ASSERT_EQUAL_UINT(0u, j288_windows_wait_any(&ports[1], 1, 1000u, ready));
+    TEST_ASSERT_FALSE(ready[0]);
+    TEST_ASSERT_EQUAL_UINT(0u, j288_windows_wait_any(ports, 0, 1000u, ready));
 }
 
 /* The simulator exits: the port says the device vanished, once, and then fails fast. */
