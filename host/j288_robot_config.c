@@ -12,14 +12,24 @@
 #include <string.h>
 #include <sys/stat.h>
 #include <unistd.h>
+#ifdef _WIN32
+#include <io.h>      /* _commit */
+#include <windows.h> /* MoveFileExA */
+#endif
 
 #ifdef J288_HAVE_LIBYAML
 #include <yaml.h>
 #endif
 
+/* Formats checked as C99's (%zu); mingw-w64's "printf" would check Microsoft's. */
+#ifdef __MINGW_PRINTF_FORMAT
+#define PRINTF_LIKE(f, a) __attribute__((format(__MINGW_PRINTF_FORMAT, f, a)))
+#else
+#define PRINTF_LIKE(f, a) __attribute__((format(printf, f, a)))
+#endif
+
 /* One line of error text: "prefix" then the formatted message. */
-static int set_error(char *err, size_t errlen, const char *fmt, ...)
-    __attribute__((format(printf, 3, 4)));
+static int set_error(char *err, size_t errlen, const char *fmt, ...) PRINTF_LIKE(3, 4);
 
 static int set_error(char *err, size_t errlen, const char *fmt, ...)
 {
@@ -204,7 +214,7 @@ typedef struct {
     size_t errlen;
 } ctx_t;
 
-static int fail(ctx_t *x, size_t line, const char *fmt, ...) __attribute__((format(printf, 3, 4)));
+static int fail(ctx_t *x, size_t line, const char *fmt, ...) PRINTF_LIKE(3, 4);
 
 /* "FILE:LINE: <label>message"; LINE counts from 1. */
 static int fail(ctx_t *x, size_t line, const char *fmt, ...)
@@ -1075,6 +1085,34 @@ int j288_robot_config_edit(const char *text, size_t len, const char *name, const
     return rc;
 }
 
+#ifdef _WIN32
+/* Windows: the same steps with its calls (no mkstemp/fchmod/fsync; rename() does not replace):
+ * a new file beside real, flushed to disk, then moved over real in one step. The mode is
+ * Windows' own (attributes stay those of a new file). */
+static int replace_file(const char *real, const char *shown, const char *data, size_t len,
+                        unsigned short mode, char *err, size_t errlen)
+{
+    char tmp[PATH_MAX + 16];
+    FILE *f;
+    bool ok;
+    (void)mode;
+    if ((size_t)snprintf(tmp, sizeof tmp, "%s.%lu.tmp", real, (unsigned long)GetCurrentProcessId()) >=
+        sizeof tmp)
+        return set_error(err, errlen, "%s: path too long", shown);
+    f = fopen(tmp, "wb");
+    if (f == NULL)
+        return set_error(err, errlen, "%s: cannot create a file beside it: %s", shown,
+                         strerror(errno));
+    ok = fwrite(data, 1, len, f) == len && fflush(f) == 0 && _commit(_fileno(f)) == 0;
+    ok = (fclose(f) == 0) && ok;
+    if (ok && MoveFileExA(tmp, real, MOVEFILE_REPLACE_EXISTING | MOVEFILE_WRITE_THROUGH))
+        return 0;
+    (void)set_error(err, errlen, "%s: cannot write%s", shown, ok ? " (replace failed)" : "");
+    (void)remove(tmp);
+    return -1;
+}
+#define realpath(path, out) _fullpath((out), (path), PATH_MAX)
+#else
 /* Write len bytes to a new file beside real (same folder: rename is atomic) with mode, then
  * rename it over real. */
 static int replace_file(const char *real, const char *shown, const char *data, size_t len,
@@ -1116,6 +1154,7 @@ fail:
     (void)unlink(tmp);
     return -1;
 }
+#endif
 
 int j288_robot_config_write_joint(const char *path, const char *joint, const j288_robot_config_update_t *upd,
                             char *err, size_t errlen)

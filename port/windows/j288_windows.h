@@ -84,6 +84,8 @@ typedef struct {
     uint32_t margin_us; /* reply margin for j288_windows_bus_config(); 0: 20 ms */
     uint32_t idle_us;   /* line-idle report after bytes; 0: 2 ms */
     bool echo;          /* the adapter hears its own transmit: the bus checks and skips it */
+    bool no_low_latency; /* accepted for the Linux port's options; nothing to switch here (the
+                            FTDI latency timer is a driver setting: see Latency above) */
 } j288_windows_options_t;
 
 /* Port counters (the bus keeps its own in j288_bus_stats()). */

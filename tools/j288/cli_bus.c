@@ -70,6 +70,24 @@ static void on_signal(int sig)
     }
 }
 
+#ifdef _WIN32
+/* Ctrl-C and Ctrl-Break (and closing the console) run this on a thread of their own: record
+ * the stop as SIGINT (SIGTERM for the others) for the command loops, which lock every bus
+ * they drove. Closing the console ends the process a few seconds after this returns, so it
+ * waits a little for the locks to go out. */
+static BOOL WINAPI on_console_event(DWORD type)
+{
+    on_signal(type == CTRL_C_EVENT || type == CTRL_BREAK_EVENT ? SIGINT : SIGTERM);
+    if (type == CTRL_CLOSE_EVENT || type == CTRL_LOGOFF_EVENT || type == CTRL_SHUTDOWN_EVENT)
+        Sleep(2000);
+    return TRUE; /* handled: the process goes on to its safe stop */
+}
+
+void cli_signals_install(void)
+{
+    (void)SetConsoleCtrlHandler(on_console_event, TRUE);
+}
+#else
 void cli_signals_install(void)
 {
     struct sigaction sa;
@@ -80,12 +98,20 @@ void cli_signals_install(void)
     sigaction(SIGINT, &sa, NULL);
     sigaction(SIGTERM, &sa, NULL);
 }
+#endif
 
 int cli_signal_exit_code(void)
 {
     return cli_stop_signal == SIGTERM ? CLI_EXIT_SIGTERM : CLI_EXIT_SIGINT;
 }
 
+#ifdef _WIN32
+static bool is_pseudo_terminal(const char *dev)
+{
+    (void)dev; /* COM ports only (Wine maps them onto ptys, but says nothing of it) */
+    return false;
+}
+#else
 static bool is_pseudo_terminal(const char *dev)
 {
     char real[PATH_MAX];
@@ -94,6 +120,7 @@ static bool is_pseudo_terminal(const char *dev)
     }
     return strncmp(real, "/dev/pts/", 9) == 0;
 }
+#endif
 
 int cli_bus_open(cli_bus_t *b, const cli_bus_opts_t *o, int default_retries)
 {

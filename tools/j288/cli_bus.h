@@ -17,7 +17,7 @@
 
 #include "args.h"
 #include "cli.h"
-#include "j288_linux.h"
+#include "j288_host_port.h"
 #include "j288_robot.h"
 #include "j288_robot_config.h"
 #include "json.h"
