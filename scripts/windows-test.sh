@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# usage: WIN=build/windows SIM=build/bin/j288-sim scripts/windows-test.sh [--bench] UNIT_TEST.exe...
+# usage: WIN=build/windows SIM=build/bin/j288-sim [J288_EXE=build/windows/j288.exe]
+#        scripts/windows-test.sh [--bench] UNIT_TEST.exe...
 # The Windows build under Wine (make test-windows, make bench-windows):
 #  1. a private Wine prefix, $WIN/wine (created on first use, 10-30 s; never ~/.wine), headless
 #     (DISPLAY unset), quiet (WINEDEBUG=-all), one wineserver for the whole run whose output
@@ -8,9 +9,10 @@
 #  3. the Windows port end to end: j288-sim on pseudo-terminals, the prefix's dosdevices/comN
 #     symlinked to them, test_windows_port.exe (through j288.dll) on COM5..COM8, and the frames
 #     it sent compared byte for byte with what the simulator logged;
-#  4. a CMake consumer (test/cmake_consumer, add_subdirectory) cross-built with
+#  4. j288.exe end to end (test/e2e/windows_cli.sh; $J288_EXE names it, empty: skipped);
+#  5. a CMake consumer (test/cmake_consumer, add_subdirectory) cross-built with
 #     cmake/mingw-w64.cmake and run under wine (skipped with a notice without cmake);
-#  5. the Wine server stopped (also on failure or interruption).
+#  6. the Wine server stopped (also on failure or interruption).
 # --bench runs bench_windows_port.exe against one simulator instead of 2 and 3.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -79,6 +81,13 @@ if cmp -s "$tmp/tx.unix" "$tmp/rx.log"; then
 else
     echo "FAIL  byte-exact: frames differ:"; diff "$tmp/tx.unix" "$tmp/rx.log" | head -n 5
     exit 1
+fi
+
+echo "== j288.exe end to end (test/e2e/windows_cli.sh)"
+if [ -n "${J288_EXE:-}" ]; then
+    bash test/e2e/windows_cli.sh "$J288_EXE"
+else
+    echo "notice: j288.exe is not built yet (it needs host/j288_host_wait.h): skipped"
 fi
 
 echo "== a CMake consumer cross-built with cmake/mingw-w64.cmake"

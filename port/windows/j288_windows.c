@@ -93,6 +93,13 @@ bool j288_windows_device_path(const char *dev, char *out, size_t cap)
     return n > 0 && (size_t)n < cap;
 }
 
+bool j288_windows_same_device(const char *a, const char *b)
+{
+    char la[sizeof ((j288_windows_t *)0)->dev + 4u], lb[sizeof la];
+    return a != NULL && b != NULL && j288_windows_device_path(a, la, sizeof la) &&
+           j288_windows_device_path(b, lb, sizeof lb) && _stricmp(la, lb) == 0;
+}
+
 static int open_error(j288_windows_t *wp, DWORD e)
 {
     char t[160];
@@ -715,6 +722,11 @@ const char *j288_windows_error(const j288_windows_t *wp)
 const char *j288_windows_notices(const j288_windows_t *wp)
 {
     return (wp == NULL) ? "" : wp->notice;
+}
+
+const char *j288_windows_device(const j288_windows_t *wp)
+{
+    return (wp == NULL) ? "" : wp->dev;
 }
 
 uint32_t j288_windows_baud(const j288_windows_t *wp)

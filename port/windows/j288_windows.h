@@ -227,6 +227,13 @@ bool j288_windows_baud_ok(uint32_t asked, uint32_t got);
  * Returns false when it does not fit in cap. Pure; any thread. */
 bool j288_windows_device_path(const char *dev, char *out, size_t cap);
 
+/* Whether two names ("COM5", "\\.\com5") name the same port: equal in the long form, case
+ * ignored (Windows' device names are). False when either is NULL or too long. Pure. */
+bool j288_windows_same_device(const char *a, const char *b);
+
+/* The name wp was opened with ("" before any open). Never NULL. */
+const char *j288_windows_device(const j288_windows_t *wp);
+
 /* The baud rate the driver reports after open (0 when closed). */
 uint32_t j288_windows_baud(const j288_windows_t *wp);
 

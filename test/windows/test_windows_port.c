@@ -76,6 +76,10 @@ static void test_device_path(void)
     TEST_ASSERT_TRUE(j288_windows_device_path("\\\\.\\COM7", out, sizeof out));
     TEST_ASSERT_EQUAL_STRING("\\\\.\\COM7", out);
     TEST_ASSERT_FALSE(j288_windows_device_path("COM123456789012", out, sizeof out));
+    TEST_ASSERT_TRUE(j288_windows_same_device("COM5", "\\\\.\\com5"));
+    TEST_ASSERT_TRUE(j288_windows_same_device("com12", "COM12"));
+    TEST_ASSERT_FALSE(j288_windows_same_device("COM1", "COM12"));
+    TEST_ASSERT_FALSE(j288_windows_same_device("COM1", NULL));
 }
 
 static void test_baud_read_back_tolerance(void)
@@ -127,6 +131,7 @@ static void test_6mbps_refused_when_not_applied(void)
     TEST_ASSERT_NOT_NULL(strstr(j288_windows_error(&g_wp), "cannot do 6000000 baud"));
     open_port(g_clean, 0, false);
     TEST_ASSERT_EQUAL_UINT32(WINE_MAX_BAUD, j288_windows_baud(&g_wp));
+    TEST_ASSERT_EQUAL_STRING(g_clean, j288_windows_device(&g_wp));
 }
 
 /* ---- transactions ------------------------------------------------------------------------- */

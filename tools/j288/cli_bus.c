@@ -127,6 +127,8 @@ int cli_bus_open(cli_bus_t *b, const cli_bus_opts_t *o, int default_retries)
     j288_linux_options_t lo;
     j288_bus_config_t cfg;
     const char *dev = o->port;
+    uint32_t baud = o->baud;
+    long long env_baud;
     int rc;
 
     memset(b, 0, sizeof *b);
@@ -138,11 +140,16 @@ int cli_bus_open(cli_bus_t *b, const cli_bus_opts_t *o, int default_retries)
         return CLI_EXIT_USAGE;
     }
     b->dev = dev;
+    if (baud == 0u && getenv("J288_BAUD") != NULL && getenv("J288_BAUD")[0] != '\0') {
+        if (cli_parse_int("$J288_BAUD", getenv("J288_BAUD"), 9600, 100000000, &env_baud) != 0)
+            return CLI_EXIT_USAGE;
+        baud = (uint32_t)env_baud;
+    }
     memset(&lo, 0, sizeof lo);
     lo.echo = o->echo;
     lo.margin_us =
         o->margin_us != 0u ? o->margin_us : (is_pseudo_terminal(dev) ? PTY_MARGIN_US : 0u);
-    rc = j288_linux_open(&b->lp, dev, o->baud, &lo);
+    rc = j288_linux_open(&b->lp, dev, baud, &lo);
     if (rc != J288_OK) {
         cli_error("%s", j288_linux_error(&b->lp));
         return CLI_EXIT_FAIL;

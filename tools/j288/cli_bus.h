@@ -44,7 +44,7 @@ enum {
 #define CLI_BUS_COMMON_HELP                                                                        \
     "common options:\n"                                                                            \
     "  --port DEV       serial device (or give it before the command; default $J288_PORT)\n"       \
-    "  --baud N         line rate, default 6000000\n"                                              \
+    "  --baud N         line rate, default $J288_BAUD, else 6000000\n"                            \
     "  --margin-us N    reply deadline margin for host latency; default 20000 for a USB\n"         \
     "                   adapter, 5000 for a pseudo-terminal (the simulator)\n"                     \
     "  --echo           the adapter hears its own transmit (skip and check the echo)\n"            \
