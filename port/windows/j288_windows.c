@@ -31,8 +31,7 @@
 /* With a stop flag set, never sleep longer than this, so the flag is seen promptly. */
 #define STOP_SLICE_US 20000u
 
-static void set_err(j288_windows_t *wp, const char *fmt, ...)
-    __attribute__((format(printf, 2, 3)));
+static void set_err(j288_windows_t *wp, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
 
 static void set_err(j288_windows_t *wp, const char *fmt, ...)
 {
@@ -45,10 +44,10 @@ static void set_err(j288_windows_t *wp, const char *fmt, ...)
 /* The system's text for a Win32 error code, one line, in buf. */
 static const char *win_text(DWORD code, char *buf, size_t cap)
 {
-    DWORD n = FormatMessageA(FORMAT_MESSAGE_FROM_SYSTEM | FORMAT_MESSAGE_IGNORE_INSERTS, NULL,
-                             code, 0, buf, (DWORD)cap, NULL);
-    while (n > 0u && (buf[n - 1u] == '\n' || buf[n - 1u] == '\r' || buf[n - 1u] == '.' ||
-                      buf[n - 1u] == ' '))
+    DWORD n = FormatMessageA(FORMAT_MESSAGE_FROM_SYSTEM | FORMAT_MESSAGE_IGNORE_INSERTS, NULL, code,
+                             0, buf, (DWORD)cap, NULL);
+    while (n > 0u &&
+           (buf[n - 1u] == '\n' || buf[n - 1u] == '\r' || buf[n - 1u] == '.' || buf[n - 1u] == ' '))
         n--;
     if (n == 0u)
         (void)snprintf(buf, cap, "error %lu", (unsigned long)code);
@@ -95,7 +94,7 @@ bool j288_windows_device_path(const char *dev, char *out, size_t cap)
 
 bool j288_windows_same_device(const char *a, const char *b)
 {
-    char la[sizeof ((j288_windows_t *)0)->dev + 4u], lb[sizeof la];
+    char la[sizeof((j288_windows_t *)0)->dev + 4u], lb[sizeof la];
     return a != NULL && b != NULL && j288_windows_device_path(a, la, sizeof la) &&
            j288_windows_device_path(b, lb, sizeof lb) && _stricmp(la, lb) == 0;
 }
@@ -239,8 +238,8 @@ int j288_windows_open(j288_windows_t *wp, const char *dev, uint32_t baud,
         wp->opt.idle_us = J288_WINDOWS_DEFAULT_IDLE_US;
     wp->baud = (baud == 0u) ? J288_DEFAULT_BAUD : baud;
 
-    wp->h = CreateFileA(path, GENERIC_READ | GENERIC_WRITE, 0 /* exclusive */, NULL,
-                        OPEN_EXISTING, FILE_FLAG_OVERLAPPED, NULL);
+    wp->h = CreateFileA(path, GENERIC_READ | GENERIC_WRITE, 0 /* exclusive */, NULL, OPEN_EXISTING,
+                        FILE_FLAG_OVERLAPPED, NULL);
     if (wp->h == INVALID_HANDLE_VALUE)
         return open_error(wp, GetLastError());
     /* Timer waits (reply deadlines, idle) at 1 ms instead of the default 15.6 ms tick. */
@@ -573,6 +572,7 @@ unsigned j288_windows_wait_any(j288_windows_t *const ports[], unsigned n, uint32
     HANDLE ev[J288_WINDOWS_WAIT_MAX];
     unsigned who[J288_WINDOWS_WAIT_MAX];
     DWORD count = 0, i;
+    DWORD ms = wait_ms((int32_t)(timeout_us > INT32_MAX ? INT32_MAX : timeout_us));
     unsigned k, got = 0;
     if (n > J288_WINDOWS_WAIT_MAX)
         n = J288_WINDOWS_WAIT_MAX;
@@ -586,12 +586,10 @@ unsigned j288_windows_wait_any(j288_windows_t *const ports[], unsigned n, uint32
         count++;
     }
     if (count == 0u) {
-        Sleep(wait_ms((int32_t)(timeout_us > INT32_MAX ? INT32_MAX : timeout_us)));
+        Sleep(ms);
         return 0;
     }
-    if (WaitForMultipleObjects(count, ev, FALSE,
-                               wait_ms((int32_t)(timeout_us > INT32_MAX ? INT32_MAX : timeout_us))) ==
-        WAIT_TIMEOUT)
+    if (WaitForMultipleObjects(count, ev, FALSE, ms) == WAIT_TIMEOUT)
         return 0;
     /* It names only the first signalled event: look at each. */
     for (i = 0; i < count; i++) {
@@ -622,8 +620,7 @@ void j288_windows_bus_config(const j288_windows_t *wp, j288_bus_config_t *cfg)
     if (wp == NULL)
         return;
     cfg->baud = (wp->baud_actual != 0u) ? wp->baud_actual : wp->baud;
-    cfg->margin_us =
-        (wp->opt.margin_us != 0u) ? wp->opt.margin_us : J288_WINDOWS_DEFAULT_MARGIN_US;
+    cfg->margin_us = (wp->opt.margin_us != 0u) ? wp->opt.margin_us : J288_WINDOWS_DEFAULT_MARGIN_US;
     cfg->echo = wp->opt.echo;
 }
 
@@ -664,8 +661,8 @@ static void poll_once(j288_windows_t *wp, j288_sched_t *s, uint32_t now)
 int j288_windows_run(j288_windows_t *wp, j288_sched_t *s, uint32_t until_us, unsigned flags)
 {
     bool until_idle = (flags & J288_WINDOWS_RUN_UNTIL_IDLE) != 0u;
-    bool see_stop = (flags & J288_WINDOWS_RUN_IGNORE_STOP) == 0u && wp != NULL &&
-                    wp->stop_flag != NULL;
+    bool see_stop =
+        (flags & J288_WINDOWS_RUN_IGNORE_STOP) == 0u && wp != NULL && wp->stop_flag != NULL;
     if (wp == NULL || wp->bus == NULL)
         return J288_ERR_NULL;
     for (;;) {

@@ -77,13 +77,13 @@ extern "C" {
 #define J288_WINDOWS_READ_SLICE_MS 100u
 
 #define J288_WINDOWS_MSG_LEN 320u
-#define J288_WINDOWS_RX_BUF 256u
+#define J288_WINDOWS_RX_BUF  256u
 
 /* All-zero means defaults. */
 typedef struct {
-    uint32_t margin_us; /* reply margin for j288_windows_bus_config(); 0: 20 ms */
-    uint32_t idle_us;   /* line-idle report after bytes; 0: 2 ms */
-    bool echo;          /* the adapter hears its own transmit: the bus checks and skips it */
+    uint32_t margin_us;  /* reply margin for j288_windows_bus_config(); 0: 20 ms */
+    uint32_t idle_us;    /* line-idle report after bytes; 0: 2 ms */
+    bool echo;           /* the adapter hears its own transmit: the bus checks and skips it */
     bool no_low_latency; /* accepted for the Linux port's options; nothing to switch here (the
                             FTDI latency timer is a driver setting: see Latency above) */
 } j288_windows_options_t;
@@ -101,12 +101,12 @@ typedef struct {
 
 typedef struct j288_windows {
     /* Private: use the functions below. */
-    HANDLE h;          /* INVALID_HANDLE_VALUE when closed */
-    HANDLE rx_event;   /* manual-reset, the read's */
-    HANDLE tx_event;   /* manual-reset, the write's */
+    HANDLE h;        /* INVALID_HANDLE_VALUE when closed */
+    HANDLE rx_event; /* manual-reset, the read's */
+    HANDLE tx_event; /* manual-reset, the write's */
     OVERLAPPED rx_ov;
     OVERLAPPED tx_ov;
-    bool rx_pending;   /* a ReadFile into rx_buf is in flight */
+    bool rx_pending; /* a ReadFile into rx_buf is in flight */
     j288_bus_t *bus;
     j288_windows_options_t opt;
     uint32_t baud;        /* requested */
@@ -165,7 +165,7 @@ uint32_t j288_windows_now_us(void);
 void j288_windows_set_stop_flag(j288_windows_t *wp, const volatile sig_atomic_t *flag);
 
 /* Flags for j288_windows_run(): as J288_LINUX_RUN_*. */
-#define J288_WINDOWS_RUN_UNTIL_IDLE 0x1u /* return once the bus (and scheduler) is idle */
+#define J288_WINDOWS_RUN_UNTIL_IDLE  0x1u /* return once the bus (and scheduler) is idle */
 #define J288_WINDOWS_RUN_IGNORE_STOP 0x2u /* ignore the stop flag: for flushing a stop frame */
 
 /*

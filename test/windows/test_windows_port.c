@@ -23,9 +23,9 @@
 #include "j288/j288.h"
 #include "j288_windows.h"
 
-#define WINE_MAX_BAUD 4000000u
+#define WINE_MAX_BAUD            4000000u
 #define LOADED_MACHINE_MARGIN_US 250000u
-#define EXACT_TRANSACTIONS 2000
+#define EXACT_TRANSACTIONS       2000
 
 static const char *g_clean, *g_silent, *g_echo, *g_vanish, *g_txlog;
 static j288_windows_t g_wp;
@@ -165,7 +165,8 @@ static void test_transactions_byte_exact(void)
         TEST_ASSERT_EQUAL_UINT(J288_MODE_FOC, txn.reply.status);
     }
     fclose(log);
-    TEST_ASSERT_EQUAL_UINT32(EXACT_TRANSACTIONS * J288_CMD_LEN, j288_windows_stats(&g_wp)->tx_bytes);
+    TEST_ASSERT_EQUAL_UINT32(EXACT_TRANSACTIONS * J288_CMD_LEN,
+                             j288_windows_stats(&g_wp)->tx_bytes);
     TEST_ASSERT_EQUAL_UINT32(EXACT_TRANSACTIONS * J288_REPLY_LEN,
                              j288_windows_stats(&g_wp)->rx_bytes);
     TEST_ASSERT_EQUAL_UINT32(0u, j288_windows_stats(&g_wp)->flushed_bytes);
@@ -208,8 +209,8 @@ static void test_timeouts(void)
      * (Windows ends it empty every J288_WINDOWS_READ_SLICE_MS; Wine 8 keeps it pending until
      * a byte comes: both are fine). */
     for (i = 0; i < 3; i++)
-        TEST_ASSERT_EQUAL_INT(J288_OK, j288_windows_run(&g_wp, NULL,
-                                                        j288_windows_now_us() + 250000u, 0));
+        TEST_ASSERT_EQUAL_INT(J288_OK,
+                              j288_windows_run(&g_wp, NULL, j288_windows_now_us() + 250000u, 0));
     TEST_ASSERT_FALSE(j288_windows_offline(&g_wp));
     /* An id nobody answers on the clean bus: the same. */
     j288_windows_close(&g_wp);
