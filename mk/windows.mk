@@ -46,14 +46,6 @@ $(WIN_PORT_A): $(WIN_OBJ)/port/windows/j288_windows.o
 	rm -f $@
 	$(WIN_AR) rcs $@ $^
 
-# The DLL exports every global symbol of lib/ and the port (no __declspec in the headers:
-# mingw's linker exports all when none is marked); programs link the import library.
-WIN_DLL_OBJ := $(LIB_SRC:%.c=$(WIN_OBJ)/%.o) $(WIN_OBJ)/port/windows/j288_windows.o
-$(WIN_DLL) $(WIN_IMPLIB) &: $(WIN_DLL_OBJ)
-	@mkdir -p $(@D)
-	$(WIN_CC) -shared $(WIN_CFLAGS) $(WIN_DLL_OBJ) -o $(WIN_DLL) \
-	    -Wl,--out-implib,$(WIN_IMPLIB) $(WIN_LIBS)
-
 # ---- the host layer and the CLI: j288.exe ----------------------------------------------------
 # The runner, the config reader and tools/j288 over the Windows port (host/j288_host_port.h),
 # with Debian's libyaml source cross-built (scripts/libyaml-mingw.sh; without it the reader's
@@ -65,8 +57,11 @@ WIN_TOOL_CFLAGS := $(WIN_CFLAGS) -Wno-float-conversion
 WIN_YAML_ENV := $(WIN)/libyaml/libyaml.env
 win_yaml_var = $$(sed -n 's/^$(1)=//p' $(WIN_YAML_ENV))
 WIN_HOST_HDR := $(wildcard host/*.h) $(WIN_PORT_HDR) $(LIB_HDR)
+# The runner's one OS-specific call in its own file (host/j288_host_wait.h, issue 18's host
+# layer): until that is merged, j288.exe and the runner in j288.dll are not built.
+WIN_HOST_READY := $(wildcard host/j288_host_wait.h)
 WIN_HOST_OBJ := $(WIN_OBJ)/host/j288_robot.o $(WIN_OBJ)/host/j288_robot_config.o \
-    $(WIN_OBJ)/host/j288_host_wait.o
+    $(WIN_OBJ)/host/j288_host_wait_win32.o
 WIN_J288_OBJ := $(J288_SRC:%.c=$(WIN_OBJ)/%.o)
 WIN_J288 := $(WIN)/j288.exe
 
@@ -84,6 +79,22 @@ $(WIN_OBJ)/tools/j288/%.o: tools/j288/%.c $(J288_HDR) $(WIN_HOST_HDR)
 $(WIN_J288): $(WIN_J288_OBJ) $(WIN_HOST_OBJ) $(WIN_PORT_A) $(WIN_LIB_A) $(WIN_YAML_ENV)
 	@mkdir -p $(@D)
 	$(WIN_CC) $(WIN_TOOL_CFLAGS) $(filter %.o %.a,$^) -o $@ $(call win_yaml_var,YAML_LIBS) $(WIN_LIBS)
+
+# The DLL exports every global symbol of lib/ and the port (no __declspec in the headers:
+# mingw's linker exports all when none is marked); programs link the import library.
+# With the host layer (see WIN_HOST_READY) it holds the runner and the config reader too:
+# what the Python package binds.
+WIN_DLL_OBJ := $(LIB_SRC:%.c=$(WIN_OBJ)/%.o) $(WIN_OBJ)/port/windows/j288_windows.o
+WIN_DLL_LIBS :=
+ifneq ($(WIN_HOST_READY),)
+WIN_DLL_OBJ += $(WIN_HOST_OBJ)
+WIN_DLL_LIBS = $(call win_yaml_var,YAML_LIBS)
+$(WIN_DLL) $(WIN_IMPLIB): $(WIN_YAML_ENV)
+endif
+$(WIN_DLL) $(WIN_IMPLIB) &: $(WIN_DLL_OBJ)
+	@mkdir -p $(@D)
+	$(WIN_CC) -shared $(WIN_CFLAGS) $(WIN_DLL_OBJ) -o $(WIN_DLL) \
+	    -Wl,--out-implib,$(WIN_IMPLIB) $(WIN_DLL_LIBS) $(WIN_LIBS)
 
 # ---- tests and benchmark ---------------------------------------------------------------------
 WIN_UNITY_OBJ := $(WIN_OBJ)/unity/unity.o
@@ -111,9 +122,7 @@ $(WIN_BENCH): $(WIN_OBJ)/test/windows/bench_windows_port.o $(WIN_PORT_A) $(WIN_L
 
 WIN_ALL := $(WIN_LIB_A) $(WIN_PORT_A) $(WIN_DLL) $(WIN_IMPLIB) $(WIN_UNIT_TESTS) $(WIN_PORT_TEST) \
     $(WIN_BENCH)
-# j288.exe needs the runner's one OS-specific call in its own file (host/j288_host_wait.h,
-# issue 18's host layer); until that is merged it is not built.
-ifneq ($(wildcard host/j288_host_wait.h),)
+ifneq ($(WIN_HOST_READY),)
 WIN_ALL += $(WIN_J288)
 endif
 

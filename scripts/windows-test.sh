@@ -9,7 +9,8 @@
 #  3. the Windows port end to end: j288-sim on pseudo-terminals, the prefix's dosdevices/comN
 #     symlinked to them, test_windows_port.exe (through j288.dll) on COM5..COM8, and the frames
 #     it sent compared byte for byte with what the simulator logged;
-#  4. j288.exe end to end (test/e2e/windows_cli.sh; $J288_EXE names it, empty: skipped);
+#  4. j288.exe end to end (test/e2e/windows_cli.sh; $J288_EXE names it, empty: skipped), and
+#     j288.dll exporting every function the Python package binds (test/windows/dll_exports.py);
 #  5. a CMake consumer (test/cmake_consumer, add_subdirectory) cross-built with
 #     cmake/mingw-w64.cmake and run under wine (skipped with a notice without cmake);
 #  6. the Wine server stopped (also on failure or interruption).
@@ -86,6 +87,8 @@ fi
 echo "== j288.exe end to end (test/e2e/windows_cli.sh)"
 if [ -n "${J288_EXE:-}" ]; then
     bash test/e2e/windows_cli.sh "$J288_EXE"
+    # The Python package on Windows loads j288.dll: it must export what the package binds.
+    python3 test/windows/dll_exports.py "$WIN/j288.dll" "${WIN_OBJDUMP:-x86_64-w64-mingw32-objdump}"
 else
     echo "notice: j288.exe is not built yet (it needs host/j288_host_wait.h): skipped"
 fi
