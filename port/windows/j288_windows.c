@@ -536,6 +536,8 @@ static int port_wait(void *ctx, uint32_t until_us)
         return J288_ERR_OFFLINE;
     if (wp->rx_pending)
         (void)WaitForSingleObject(wp->rx_event, wait_ms(left));
+    else
+        Sleep(wait_ms(left)); /* the read ended at once (ERROR_TIMEOUT): do not spin */
     n = finish_read(wp, true);
     if (n < 0)
         return J288_ERR_OFFLINE;
