@@ -28,12 +28,13 @@ $(CLI_TEST): $(OBJ)/test/cli/test_cli_helpers.o $(CLI_CAPTURE_OBJ) \
 # The tool's robot config and joint selection (cli_joint.c), with the bus plumbing it calls.
 CLI_JOINT_TEST := $(BUILD)/test/test_cli_joint
 $(OBJ)/test/cli/test_cli_joint.o: test/cli/test_cli_joint.c $(J288_HDR) $(TEST_HDR) $(UNITY)/unity.c \
-    host/j288_robot_config.h $(YAML_ENV)
+    host/j288_robot_config.h host/j288_robot.h $(YAML_ENV)
 	@mkdir -p $(@D)
 	$(CC) $(TEST_CPPFLAGS) -Itools/j288 $(TOOL_CPPFLAGS) $(call yaml_var,YAML_CFLAGS) $(CFLAGS_COMMON) -c $< -o $@
 
 $(CLI_JOINT_TEST): $(OBJ)/test/cli/test_cli_joint.o $(CLI_CAPTURE_OBJ) \
-    $(addprefix $(OBJ)/tools/j288/,cli_joint.o cli_bus.o args.o json.o report.o) $(CONFIG_OBJ) \
+    $(addprefix $(OBJ)/tools/j288/,cli_joint.o cli_bus.o args.o json.o report.o) \
+    $(OBJ)/host/j288_robot.o $(OBJ)/host/j288_host_wait.o $(CONFIG_OBJ) \
     $(UNITY_OBJ) $(LINUX_A) $(LIB_A)
 	@mkdir -p $(@D)
 	$(CC) $(CFLAGS_COMMON) $^ -o $@ $(LDFLAGS_COMMON) $(call yaml_var,YAML_LIBS) -lm
