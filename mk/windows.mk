@@ -1,11 +1,12 @@
 # Windows: cross-built with mingw-w64, tested under Wine (docs: README "Windows").
-#   make windows        into $(WIN): j288.dll with its import library libj288.dll.a (lib/ +
-#                       port/windows), libj288.a (lib/), libj288_windows.a (port/windows),
-#                       every test/unit program, the Windows port's test, a benchmark; all with
-#                       the full warning set and -Werror
-#   make test-windows   every unit test program under Wine, then the Windows port end to end
-#                       against j288-sim through Wine's COM mapping (scripts/windows-test.sh):
-#                       a private prefix under $(WIN)/wine, the Wine server stopped at the end
+#   make windows        into $(WIN): j288.exe (the CLI), j288.dll with its import library
+#                       libj288.dll.a (lib/ + port/windows + the runner and config reader),
+#                       libj288.a (lib/), libj288_windows.a (port/windows), every test/unit
+#                       program, the Windows port's test, a benchmark; all -Werror
+#   make test-windows   every unit test program under Wine, then the Windows port and j288.exe
+#                       end to end against j288-sim through Wine's COM mapping
+#                       (scripts/windows-test.sh): a private prefix under $(WIN)/wine, the
+#                       Wine server stopped at the end
 #   make bench-windows  the port's benchmark under Wine (indicative only: Wine's serial layer)
 # Without the cross compiler (or Wine, for the tests) they skip with a notice; CI=true fails.
 .PHONY: windows windows-build test-windows bench-windows
@@ -57,9 +58,6 @@ WIN_TOOL_CFLAGS := $(WIN_CFLAGS) -Wno-float-conversion
 WIN_YAML_ENV := $(WIN)/libyaml/libyaml.env
 win_yaml_var = $$(sed -n 's/^$(1)=//p' $(WIN_YAML_ENV))
 WIN_HOST_HDR := $(wildcard host/*.h) $(WIN_PORT_HDR) $(LIB_HDR)
-# The runner's one OS-specific call in its own file (host/j288_host_wait.h, issue 18's host
-# layer): until that is merged, j288.exe and the runner in j288.dll are not built.
-WIN_HOST_READY := $(wildcard host/j288_host_wait.h)
 WIN_HOST_OBJ := $(WIN_OBJ)/host/j288_robot.o $(WIN_OBJ)/host/j288_robot_config.o \
     $(WIN_OBJ)/host/j288_host_wait_win32.o
 WIN_J288_OBJ := $(J288_SRC:%.c=$(WIN_OBJ)/%.o)
@@ -82,19 +80,12 @@ $(WIN_J288): $(WIN_J288_OBJ) $(WIN_HOST_OBJ) $(WIN_PORT_A) $(WIN_LIB_A) $(WIN_YA
 
 # The DLL exports every global symbol of lib/ and the port (no __declspec in the headers:
 # mingw's linker exports all when none is marked); programs link the import library.
-# With the host layer (see WIN_HOST_READY) it holds the runner and the config reader too:
-# what the Python package binds.
-WIN_DLL_OBJ := $(LIB_SRC:%.c=$(WIN_OBJ)/%.o) $(WIN_OBJ)/port/windows/j288_windows.o
-WIN_DLL_LIBS :=
-ifneq ($(WIN_HOST_READY),)
-WIN_DLL_OBJ += $(WIN_HOST_OBJ)
-WIN_DLL_LIBS = $(call win_yaml_var,YAML_LIBS)
-$(WIN_DLL) $(WIN_IMPLIB): $(WIN_YAML_ENV)
-endif
-$(WIN_DLL) $(WIN_IMPLIB) &: $(WIN_DLL_OBJ)
+# It holds the runner and the config reader too: what the Python package binds.
+WIN_DLL_OBJ := $(LIB_SRC:%.c=$(WIN_OBJ)/%.o) $(WIN_OBJ)/port/windows/j288_windows.o $(WIN_HOST_OBJ)
+$(WIN_DLL) $(WIN_IMPLIB) &: $(WIN_DLL_OBJ) $(WIN_YAML_ENV)
 	@mkdir -p $(@D)
 	$(WIN_CC) -shared $(WIN_CFLAGS) $(WIN_DLL_OBJ) -o $(WIN_DLL) \
-	    -Wl,--out-implib,$(WIN_IMPLIB) $(WIN_DLL_LIBS) $(WIN_LIBS)
+	    -Wl,--out-implib,$(WIN_IMPLIB) $(call win_yaml_var,YAML_LIBS) $(WIN_LIBS)
 
 # ---- tests and benchmark ---------------------------------------------------------------------
 WIN_UNITY_OBJ := $(WIN_OBJ)/unity/unity.o
@@ -122,9 +113,7 @@ $(WIN_BENCH): $(WIN_OBJ)/test/windows/bench_windows_port.o $(WIN_PORT_A) $(WIN_L
 
 WIN_ALL := $(WIN_LIB_A) $(WIN_PORT_A) $(WIN_DLL) $(WIN_IMPLIB) $(WIN_UNIT_TESTS) $(WIN_PORT_TEST) \
     $(WIN_BENCH)
-ifneq ($(WIN_HOST_READY),)
 WIN_ALL += $(WIN_J288)
-endif
 
 windows-build: $(WIN_ALL)
 
@@ -137,8 +126,7 @@ windows:
 test-windows:
 	@$(WIN_NEED_CC); $(WIN_NEED_WINE); \
 	 $(MAKE) --no-print-directory windows-build $(SIM_BIN) && \
-	 WIN=$(WIN) SIM=$(SIM_BIN) J288_EXE=$(filter $(WIN_J288),$(WIN_ALL)) \
-	 bash scripts/windows-test.sh $(WIN_UNIT_TESTS)
+	 WIN=$(WIN) SIM=$(SIM_BIN) bash scripts/windows-test.sh $(WIN_UNIT_TESTS)
 
 bench-windows:
 	@$(WIN_NEED_CC); $(WIN_NEED_WINE); \

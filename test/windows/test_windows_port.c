@@ -5,7 +5,7 @@
  *
  *   test_windows_port.exe CLEAN SILENT ECHO VANISH TXLOG
  *     CLEAN   servos 1, 2, 3                    SILENT  servo 1 that never answers (--drop 1)
- *     ECHO    servo 1 behind an echoing line    VANISH  servo 1, exits after a few seconds
+ *     ECHO    servo 1 behind an echoing line    VANISH  servo 1, stopped once it hears us
  *     TXLOG   a file: every command frame the byte-exact test sent, one hex line each (the
  *             script compares it with the simulator's log of what it received)
  *
@@ -295,7 +295,7 @@ static void test_two_ports_one_wait(void)
     TEST_ASSERT_EQUAL_UINT(0u, j288_windows_wait_any(ports, 0, 1000u, ready));
 }
 
-/* The simulator exits: the port says the device vanished, once, and then fails fast. */
+/* The simulator goes away: the port says the device vanished, once, and then fails fast. */
 static void test_vanished_device(void)
 {
     j288_cmd_raw_t c = lock_cmd(1);
@@ -303,7 +303,7 @@ static void test_vanished_device(void)
     int rc = J288_OK;
     int i;
     open_port(g_vanish, LOADED_MACHINE_MARGIN_US, false);
-    /* The simulator exits after a few seconds; bounded: at most ~60 s of replies. */
+    /* The script stops the simulator once it has logged our first frame; bounded. */
     for (i = 0; i < 200000 && rc != J288_ERR_OFFLINE; i++)
         rc = j288_bus_transfer_blocking(&g_bus, &c, &txn);
     TEST_ASSERT_EQUAL_INT(J288_ERR_OFFLINE, rc);
