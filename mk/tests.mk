@@ -21,7 +21,8 @@ CLI_CAPTURE_OBJ := $(OBJ)/test/cli/cli_capture.o
 $(CLI_CAPTURE_OBJ) $(OBJ)/test/cli/test_cli_helpers.o $(OBJ)/test/cli/test_cli_joint.o: test/cli/cli_capture.h
 
 $(CLI_TEST): $(OBJ)/test/cli/test_cli_helpers.o $(CLI_CAPTURE_OBJ) \
-    $(addprefix $(OBJ)/tools/j288/,args.o hexparse.o json.o frameview.o report.o) $(UNITY_OBJ) $(LIB_A)
+    $(addprefix $(OBJ)/tools/j288/,args.o hexparse.o json.o frameview.o report.o) $(NUMBER_OBJ) \
+    $(UNITY_OBJ) $(LIB_A)
 	@mkdir -p $(@D)
 	$(CC) $(CFLAGS_COMMON) $^ -o $@ $(LDFLAGS_COMMON) -lm
 
@@ -65,8 +66,14 @@ $(CODEC_CRC_TEST_NAMES:%=$(BUILD)/crc-\%/test/%): $(UNITY)/unity.c codec-force
 # sources (the cli target links the tool's parsers as functions, not by exec).
 FUZZ_NAMES := $(sort $(patsubst test/fuzz/fuzz_%.c,%,$(wildcard test/fuzz/fuzz_*.c)))
 FUZZ_REPLAY_TESTS := $(FUZZ_NAMES:%=$(BUILD)/test/fuzz_replay_%)
-FUZZ_EXTRA_cli := tools/j288/hexparse.c tools/j288/args.c
+FUZZ_EXTRA_cli := tools/j288/hexparse.c tools/j288/args.c host/j288_number.c
 FUZZ_CPPFLAGS_cli := -Itools/j288 $(TOOL_CPPFLAGS)
+# The config target links the reader and libyaml (FUZZ_LIBS_<name>: a target's libraries).
+FUZZ_EXTRA_config := host/j288_robot_config.c host/j288_number.c
+FUZZ_CPPFLAGS_config := -Ihost $(call yaml_var,YAML_CFLAGS)
+FUZZ_LIBS_config := $(call yaml_var,YAML_LIBS)
+$(OBJ)/test/fuzz/fuzz_config.o: host/j288_robot_config.h $(YAML_ENV)
+$(BUILD)/test/fuzz_replay_config: LDFLAGS_COMMON += $(FUZZ_LIBS_config)
 
 $(OBJ)/test/fuzz/replay_%.o: test/fuzz/replay_main.c test/fuzz/fuzz_common.h
 	@mkdir -p $(@D)
@@ -99,7 +106,8 @@ CONFIG_TEST := $(BUILD)/test/test_robot_config
 $(OBJ)/test/linux/test_robot_config.o: test/linux/test_robot_config.c host/j288_robot_config.h \
     $(TEST_HDR) $(UNITY)/unity.c $(YAML_ENV)
 	@mkdir -p $(@D)
-	$(CC) $(TEST_CPPFLAGS) -Iport/linux -Ihost $(call yaml_var,YAML_CFLAGS) $(CFLAGS_COMMON) -c $< -o $@
+	$(CC) $(TEST_CPPFLAGS) -Iport/linux -Ihost $(call yaml_var,YAML_CFLAGS) \
+	    -DJ288_EXAMPLE_CONFIG='"examples/robot.yaml"' $(CFLAGS_COMMON) -c $< -o $@
 
 $(CONFIG_TEST): $(OBJ)/test/linux/test_robot_config.o $(CONFIG_OBJ) $(UNITY_OBJ) $(LIB_A)
 	@mkdir -p $(@D)
@@ -136,6 +144,8 @@ TEST_SCRIPTS += test/e2e/cli_offline.sh test/e2e/cli_bus.sh tools/vectors/check-
     test/e2e/sim_cli.sh test/e2e/example_linux.sh test/abi/check-abi.sh
 # The joint frame end to end against the simulator's truth (the tool, the config, the sim).
 TEST_SCRIPTS += test/e2e/joint_sim.sh
+# j288 top on a terminal (tmux: capture-pane, send-keys) and through a pipe.
+TEST_SCRIPTS += test/e2e/cli_top.sh
 # The scripts' own process helpers (whom they signal, what their cleanup removes).
 TEST_SCRIPTS += test/e2e/lib_sim_check.sh
 TEST_DEPS += $(J288_BIN) $(SIM_BIN) $(EXAMPLE_LINUX) $(LIB_A)

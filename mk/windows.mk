@@ -59,8 +59,10 @@ WIN_YAML_ENV := $(WIN)/libyaml/libyaml.env
 win_yaml_var = $$(sed -n 's/^$(1)=//p' $(WIN_YAML_ENV))
 WIN_HOST_HDR := $(wildcard host/*.h) $(WIN_PORT_HDR) $(LIB_HDR)
 WIN_HOST_OBJ := $(WIN_OBJ)/host/j288_robot.o $(WIN_OBJ)/host/j288_robot_config.o \
-    $(WIN_OBJ)/host/j288_host_wait_win32.o
-WIN_J288_OBJ := $(J288_SRC:%.c=$(WIN_OBJ)/%.o)
+    $(WIN_OBJ)/host/j288_number.o $(WIN_OBJ)/host/j288_host_wait_win32.o
+# j288 top is a POSIX terminal program: tools/j288/windows/cmd_top.c says so instead.
+WIN_J288_OBJ := $(patsubst %.c,$(WIN_OBJ)/%.o,$(filter-out tools/j288/cmd_top.c,$(J288_SRC)) \
+    tools/j288/windows/cmd_top.c)
 WIN_J288 := $(WIN)/j288.exe
 
 $(WIN_YAML_ENV):

@@ -2,6 +2,7 @@
 # j288.exe (the CLI cross-built for Windows) under Wine against j288-sim, checked against the
 # simulator's truth: scan, status --json, move (where the servo really ended), log --csv,
 # Ctrl-C during a move (every driven servo locked, exit 130), a robot config with two buses,
+# what is Linux-only (zero/calibrate writing the config back, top) refused with the reason,
 # $J288_BAUD, and 6 Mbps refused with a clear error (Wine leaves a pseudo-terminal at 38400
 # above 4 Mbps). COM11 and COM12 (names above COM9 take the \\.\ form) are the prefix's
 # dosdevices symlinks to the simulators' ptys.
@@ -107,6 +108,14 @@ t_robot_two_buses() {
     j288 --config "$(winepath -w "$cfg")" log --rate 100 --duration 0.5 --json
     [ "$E2E_RC" -eq 0 ] && [[ "$E2E_OUT" == *'"joints": 6, "buses": 2'* ]] ||
         { echo "exit $E2E_RC: $E2E_OUT $E2E_ERR"; return 1; }
+    # Writing a config back is POSIX-only: refused with the reason, before anything is sent.
+    : >"$LOG_A"
+    j288 zero --joint left_1 --config "$(winepath -w "$cfg")"
+    [ "$E2E_RC" -ne 0 ] && [[ "$E2E_ERR" == *"not available on Windows"* ]] && [ ! -s "$LOG_A" ] ||
+        { echo "zero: exit $E2E_RC: $E2E_ERR"; return 1; }
+    j288 top --once --config "$(winepath -w "$cfg")"
+    [ "$E2E_RC" -eq 2 ] && [[ "$E2E_ERR" == *"not available on Windows"* ]] ||
+        { echo "top: exit $E2E_RC: $E2E_ERR"; return 1; }
     # The same port twice under two names is refused before anything is opened.
     sed 's/port: COM12/port: \\\\.\\com11/' "$cfg" >"$E2E_TMP/twice.yaml"
     j288 --config "$(winepath -w "$E2E_TMP/twice.yaml")" status
