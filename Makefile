@@ -71,7 +71,7 @@ ALL_TARGETS := $(LIB_A) $(UNIT_TESTS)
 # Each fragment may use what the ones before it define.
 include $(sort $(wildcard mk/cpu/*.mk))
 include mk/tools.mk mk/tests.mk mk/target.mk mk/bench.mk mk/hardening.mk mk/firmware.mk
-include mk/robot.mk mk/release.mk mk/python.mk mk/windows.mk
+include mk/robot.mk mk/release.mk mk/python.mk mk/dds.mk mk/windows.mk
 
 all: $(ALL_TARGETS)
 

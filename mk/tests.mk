@@ -122,24 +122,39 @@ $(SIM_MODEL_TEST): $(OBJ)/test/sim/test_sim_model.o $(SIM_MODEL_OBJ) $(UNITY_OBJ
 	@mkdir -p $(@D)
 	$(CC) $(CFLAGS_COMMON) $^ -o $@ $(LDFLAGS_COMMON) -lm
 
-# Built with the D-cache maintenance on and a 32-byte receive buffer (a reply then crosses the
-# half-transfer point), so that both paths are exercised; the target tests use the same.
-STM32_TEST_DEFS := -DJ288_STM32_DCACHE=1 -DJ288_STM32_RX_BUF_SIZE=32u
+# Built with the D-cache maintenance on and a 64-byte receive buffer (a transaction's echo and
+# reply then cross the half, complete and wrap points), so that every path is exercised, and
+# with the bytes handed to the bus watched (test_rx_sink); the target tests use the same.
+# Against the F4's USART and DMA registers, the G4's (test_stm32_port_g4), and the F4's under
+# the H7's name (test_stm32_port_h7).
+STM32_TEST_DEFS := -DJ288_STM32_DCACHE=1 -DJ288_STM32_RX_BUF_SIZE=64u -DJ288_STM32_RX_SINK=test_rx_sink
 STM32_HDRS := $(wildcard port/stm32_hal/*.h test/stm32/*.h test/stm32/stub/*.h) $(TEST_HDR)
-STM32_TEST := $(BUILD)/test/test_stm32_port
 STM32_TEST_SRC := port/stm32_hal/j288_stm32.c test/stm32/fake_hal.c test/stm32/test_stm32_port.c
-$(OBJ)/stm32host/%.o: %.c $(STM32_HDRS) $(UNITY)/unity.c
-	@mkdir -p $(@D)
-	$(CC) $(TEST_CPPFLAGS) -Iport/stm32_hal -Itest/stm32/stub -Itest/stm32 $(STM32_TEST_DEFS) \
-	    $(CFLAGS_COMMON) -c $< -o $@
 
-$(STM32_TEST): $(STM32_TEST_SRC:%.c=$(OBJ)/stm32host/%.o) $(UNITY_OBJ) $(LIB_A)
-	@mkdir -p $(@D)
-	$(CC) $(CFLAGS_COMMON) $^ -o $@ $(LDFLAGS_COMMON) -lm
+# $(call STM32_HOST_TEST,name,objdir,defs): test_stm32_port built with the stub's defs.
+define STM32_HOST_TEST
+$$(OBJ)/$(2)/%.o: %.c $$(STM32_HDRS) $$(UNITY)/unity.c
+	@mkdir -p $$(@D)
+	$$(CC) $$(TEST_CPPFLAGS) -Iport/stm32_hal -Itest/stm32/stub -Itest/stm32 $$(STM32_TEST_DEFS) $(3) \
+	    $$(CFLAGS_COMMON) -c $$< -o $$@
+
+$$(BUILD)/test/$(1): $$(STM32_TEST_SRC:%.c=$$(OBJ)/$(2)/%.o) $$(UNITY_OBJ) $$(LIB_A)
+	@mkdir -p $$(@D)
+	$$(CC) $$(CFLAGS_COMMON) $$^ -o $$@ $$(LDFLAGS_COMMON) -lm
+endef
+STM32_TEST := $(BUILD)/test/test_stm32_port
+STM32_G4_TEST := $(BUILD)/test/test_stm32_port_g4
+# The F4's register model under the H7's name: what the port decides by family (the RAM its
+# DMA reaches).
+STM32_H7_TEST := $(BUILD)/test/test_stm32_port_h7
+$(eval $(call STM32_HOST_TEST,test_stm32_port,stm32host,))
+$(eval $(call STM32_HOST_TEST,test_stm32_port_g4,stm32host-g4,-DJ288_STUB_G4))
+$(eval $(call STM32_HOST_TEST,test_stm32_port_h7,stm32host-h7,-DJ288_STUB_H7))
 
 # ---- the lists -------------------------------------------------------------------------------
 HOST_TESTS += $(CLI_TEST) $(foreach v,$(CODEC_CRC_VARIANTS),$(CODEC_CRC_TEST_NAMES:%=$(BUILD)/crc-$(v)/test/%)) \
-    $(FUZZ_REPLAY_TESTS) $(LINUX_PORT_TEST) $(CONFIG_TEST) $(SIM_MODEL_TEST) $(STM32_TEST)
+    $(FUZZ_REPLAY_TESTS) $(LINUX_PORT_TEST) $(CONFIG_TEST) $(SIM_MODEL_TEST) $(STM32_TEST) \
+    $(STM32_G4_TEST) $(STM32_H7_TEST)
 TEST_SCRIPTS += test/e2e/cli_offline.sh test/e2e/cli_bus.sh tools/vectors/check-drift.sh \
     test/e2e/sim_cli.sh test/e2e/example_linux.sh test/abi/check-abi.sh
 # The joint frame end to end against the simulator's truth (the tool, the config, the sim).
@@ -150,7 +165,7 @@ TEST_SCRIPTS += test/e2e/cli_top.sh
 TEST_SCRIPTS += test/e2e/lib_sim_check.sh
 TEST_DEPS += $(J288_BIN) $(SIM_BIN) $(EXAMPLE_LINUX) $(LIB_A)
 ALL_TARGETS += $(CLI_TEST) $(FUZZ_REPLAY_TESTS) $(LINUX_PORT_TEST) $(CONFIG_TEST) $(SIM_MODEL_TEST) \
-    $(STM32_TEST)
+    $(STM32_TEST) $(STM32_G4_TEST) $(STM32_H7_TEST)
 
 .PHONY: check-abi vectors-check
 check-abi: $(LIB_A)
