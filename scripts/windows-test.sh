@@ -21,9 +21,11 @@ SIM=${SIM:-build/bin/j288-sim}
 bench=false
 if [ "${1:-}" = --bench ]; then bench=true; shift; fi
 
-export WINEPREFIX=$PWD/$WIN/wine WINEDEBUG=-all WINEDLLOVERRIDES="mscoree,mshtml="
+mkdir -p "$WIN"
+WIN=$(cd "$WIN" && pwd) # BUILD may be relative or absolute
+export WINEPREFIX=$WIN/wine WINEDEBUG=-all WINEDLLOVERRIDES="mscoree,mshtml="
 # j288.dll for the programs linked with its import library.
-export WINEPATH="$(winepath -w "$PWD/$WIN" 2>/dev/null || echo "Z:${PWD//\//\\}\\${WIN//\//\\}")"
+export WINEPATH="Z:${WIN//\//\\}"
 unset DISPLAY WAYLAND_DISPLAY
 
 tmp=$(mktemp -d /tmp/j288-wine.XXXXXX)
