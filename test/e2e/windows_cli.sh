@@ -48,7 +48,7 @@ t_6mbps_refused() {
     [ "$E2E_RC" -eq 2 ] && [[ "$E2E_ERR" == *'$J288_BAUD'* ]] || { echo "exit $E2E_RC: $E2E_ERR"; return 1; }
 }
 t_scan() {
-    j288 --port COM11 scan
+    j288 --port COM11 scan "${M[@]}"
     [ "$E2E_RC" -eq 0 ] || { echo "exit $E2E_RC: $E2E_ERR"; return 1; }
     [ "$(printf '%s\n' "$E2E_OUT" | grep -cE '^[123] +lock ')" -eq 3 ] &&
         [[ "$E2E_OUT" == *"3 servos answered on COM11"* ]] || { echo "$E2E_OUT"; return 1; }
