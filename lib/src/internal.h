@@ -27,8 +27,11 @@
 #endif
 
 /* A small function on a hot path that has more than one caller: inlined in each (the
- * compiler would otherwise keep one out-of-line copy and a call). Only a hint. */
-#if defined(__GNUC__)
+ * compiler would otherwise keep one out-of-line copy and a call). Only a hint, and only when
+ * optimising: at -O0 (make coverage, debugging) forced inlining speeds nothing and would
+ * multiply the branches that coverage counts, each inlined copy of a test on a constant
+ * argument counting as a branch taken one way. */
+#if defined(__GNUC__) && defined(__OPTIMIZE__)
 #define J288_INLINE_HOT inline __attribute__((always_inline))
 #else
 #define J288_INLINE_HOT inline
@@ -55,6 +58,38 @@ static inline void j288_store_le32(uint8_t *p, uint32_t v)
     (void)memcpy(p, &v, sizeof v);
 #else
     j288_put_u32le(p, v);
+#endif
+}
+
+/* Copy a whole frame (J288_CMD_LEN or J288_REPLY_LEN bytes, n a constant at every call).
+ * Where the core loads unaligned words, memcpy, which the compiler turns into a few word
+ * moves; elsewhere (Cortex-M0, RV32) memcpy is a library call that copies a byte at a time in
+ * a loop (about 6 instructions a byte), so the bytes are moved in straight-line code here, two
+ * instructions a byte, and no word is read from a pointer of unknown alignment. */
+static inline void j288_copy4(uint8_t *dst, const uint8_t *src)
+{
+    dst[0] = src[0];
+    dst[1] = src[1];
+    dst[2] = src[2];
+    dst[3] = src[3];
+}
+
+static J288_INLINE_HOT void j288_copy_frame(uint8_t *dst, const uint8_t *src, size_t n)
+{
+#if J288_STORE32_AS_WORD
+    (void)memcpy(dst, src, n);
+#else
+    /* 20 = 5 * 4 and 26 = 6 * 4 + 2 */
+    j288_copy4(&dst[0], &src[0]);
+    j288_copy4(&dst[4], &src[4]);
+    j288_copy4(&dst[8], &src[8]);
+    j288_copy4(&dst[12], &src[12]);
+    j288_copy4(&dst[16], &src[16]);
+    if (n == J288_REPLY_LEN) {
+        j288_copy4(&dst[20], &src[20]);
+        dst[24] = src[24];
+        dst[25] = src[25];
+    }
 #endif
 }
 

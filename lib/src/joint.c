@@ -337,12 +337,23 @@ void j288_joint_target_init(const j288_joint_t *j, j288_joint_target_t *t)
     }
 }
 
-/* *x within [lo, hi], or saturated there (bit into *clamped) in clamp mode, or err. */
-static int limit_one(j288_real_t *x, j288_real_t lo, j288_real_t hi, bool clamp, unsigned bit,
-                     int err, unsigned *clamped)
+static bool target_has_nan(const j288_joint_target_t *t)
 {
-    if (in_range(*x, lo, hi)) {
+    return (t->pos != t->pos) || (t->speed != t->speed) || (t->torque != t->torque) ||
+           (t->kp != t->kp) || (t->kd != t->kd);
+}
+
+/* *x within [lo, hi], or saturated there (bit into *clamped) in clamp mode, or err. A NaN
+ * anywhere in the target (t) fails first: NaN is never clamped, and its error comes before
+ * any other. */
+static int limit_one(const j288_joint_target_t *t, j288_real_t *x, j288_real_t lo,
+                     j288_real_t hi, bool clamp, unsigned bit, int err, unsigned *clamped)
+{
+    if (in_range(*x, lo, hi)) { /* false for NaN */
         return J288_OK;
+    }
+    if (target_has_nan(t)) {
+        return J288_ERR_NOT_FINITE;
     }
     if (!clamp) {
         return err;
@@ -354,29 +365,36 @@ static int limit_one(j288_real_t *x, j288_real_t lo, j288_real_t hi, bool clamp,
 
 static int apply_limits(const j288_joint_config_t *c, j288_joint_target_t *t, unsigned *clamped)
 {
-    int err = limit_one(&t->pos, c->pos_min, c->pos_max, c->clamp, J288_FIELD_POS,
+    int err = limit_one(t, &t->pos, c->pos_min, c->pos_max, c->clamp, J288_FIELD_POS,
                         J288_ERR_LIMIT_POS, clamped);
     if ((err == J288_OK) && (c->max_speed > ZERO)) {
-        err = limit_one(&t->speed, -c->max_speed, c->max_speed, c->clamp, J288_FIELD_SPEED,
+        err = limit_one(t, &t->speed, -c->max_speed, c->max_speed, c->clamp, J288_FIELD_SPEED,
                         J288_ERR_LIMIT_SPEED, clamped);
     }
     if ((err == J288_OK) && (c->max_torque > ZERO)) {
-        err = limit_one(&t->torque, -c->max_torque, c->max_torque, c->clamp, J288_FIELD_TAU,
+        err = limit_one(t, &t->torque, -c->max_torque, c->max_torque, c->clamp, J288_FIELD_TAU,
                         J288_ERR_LIMIT_TORQUE, clamped);
     }
     return err;
 }
 
-static bool target_has_nan(const j288_joint_target_t *t)
+/* a + b when it fits int32 (false otherwise), wrap-free: in unsigned arithmetic, the sum
+ * overflowed when both operands have the same sign and the sum has the other. */
+static bool add_i32(int32_t a, int32_t b, int32_t *sum)
 {
-    const j288_real_t v[5] = {t->pos, t->speed, t->torque, t->kp, t->kd};
-    unsigned i;
-    for (i = 0u; i < 5u; i++) {
-        if (v[i] != v[i]) {
-            return true;
-        }
+    uint32_t ua = (uint32_t)a;
+    uint32_t ub = (uint32_t)b;
+    uint32_t us = ua + ub;
+    if ((((ua ^ us) & (ub ^ us)) & 0x80000000u) != 0u) {
+        return false;
     }
-    return false;
+    if (us <= (uint32_t)INT32_MAX) {
+        *sum = (int32_t)us;
+    } else {
+        uint32_t below = us - 0x80000000u; /* us - 2^32 = below - 2^31, without overflow */
+        *sum = (int32_t)below - INT32_MAX - 1;
+    }
+    return true;
 }
 
 /* The limited target in the rotor frame, its position relative to the anchor. */
@@ -385,7 +403,6 @@ static int target_to_raw(const j288_joint_t *j, const j288_joint_target_t *t,
 {
     j288_cmd_si_t si;
     unsigned wire = 0u;
-    int64_t pos;
     int err;
 
     si.id = j->cfg.id;
@@ -401,11 +418,9 @@ static int target_to_raw(const j288_joint_t *j, const j288_joint_target_t *t,
     if (err != J288_OK) {
         return err;
     }
-    pos = (int64_t)j->ref_pos + (int64_t)raw->pos;
-    if ((pos > (int64_t)INT32_MAX) || (pos < (int64_t)INT32_MIN)) {
+    if (!add_i32(j->ref_pos, raw->pos, &raw->pos)) {
         return J288_ERR_RANGE_POS;
     }
-    raw->pos = (int32_t)pos;
     *clamped |= wire;
     return J288_OK;
 }
@@ -424,16 +439,15 @@ int j288_joint_command(const j288_joint_t *j, const j288_joint_target_t *t, j288
     if (!j->st.known) {
         return j->st.cal_mismatch ? J288_ERR_CAL_MISMATCH : J288_ERR_ANGLE_UNKNOWN;
     }
-    if (target_has_nan(t)) {
-        return J288_ERR_NOT_FINITE;
-    }
+    /* NaN is refused before anything else, but tested only where a step fails (a NaN fails
+     * every limit and every conversion): a good target pays no test of its own. */
     v = *t;
     err = apply_limits(&j->cfg, &v, &mask);
     if (err == J288_OK) {
         err = target_to_raw(j, &v, &raw, &mask);
     }
     if (err != J288_OK) {
-        return err;
+        return target_has_nan(t) ? J288_ERR_NOT_FINITE : err;
     }
     *cmd = raw;
     if (clamped != NULL) {

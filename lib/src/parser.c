@@ -236,7 +236,7 @@ J288_NOINLINE static int feed_after_bad_reply(j288_parser_t *p, const uint8_t *d
     rc = scan(p, &data[J288_REPLY_LEN], len - J288_REPLY_LEN, consumed, &f);
     *consumed += J288_REPLY_LEN;
     if ((rc == J288_PARSE_FRAME) && (f != p->buf)) {
-        (void)memcpy(p->buf, f, J288_REPLY_LEN); /* a reply parser: checked where it lies */
+        j288_copy_frame(p->buf, f, J288_REPLY_LEN); /* a reply parser: checked where it lies */
     }
     return rc;
 }
@@ -255,7 +255,7 @@ int j288_parser_feed(j288_parser_t *p, const uint8_t *data, size_t len, size_t *
     if (reply_at_start(p, data, len)) {
         if (j288_reply_crc_ok(p->crc, data)) {
             p->stats.frames++;
-            (void)memcpy(p->buf, data, J288_REPLY_LEN);
+            j288_copy_frame(p->buf, data, J288_REPLY_LEN);
             *consumed = J288_REPLY_LEN;
             return J288_PARSE_FRAME;
         }
@@ -263,12 +263,11 @@ int j288_parser_feed(j288_parser_t *p, const uint8_t *data, size_t len, size_t *
     }
     rc = scan(p, data, len, consumed, &f);
     if ((rc == J288_PARSE_FRAME) && (f != p->buf)) {
-        /* Checked in the caller's data: the parser keeps its own copy (constant lengths, so
-         * that the compiler copies words). */
+        /* Checked in the caller's data: the parser keeps its own copy (constant lengths). */
         if (p->kind == J288_PARSE_REPLY) {
-            (void)memcpy(p->buf, f, J288_REPLY_LEN);
+            j288_copy_frame(p->buf, f, J288_REPLY_LEN);
         } else {
-            (void)memcpy(p->buf, f, J288_CMD_LEN);
+            j288_copy_frame(p->buf, f, J288_CMD_LEN);
         }
     }
     return rc;

@@ -4,34 +4,27 @@
 #if J288_CONFIG_SI
 
 #include <stdint.h>
+#include <string.h>
+
+#include "internal.h"
 
 #define N_RATIO ((j288_real_t)J288_GEAR_RATIO)
 
 typedef enum { Q_TORQUE, Q_SPEED, Q_POS, Q_KP, Q_KD } quantity_t;
 
-/* LSB per SI unit on the requested side. Rotor angle = N * output angle, rotor torque =
- * output torque / N, rotor gains = output gains / N^2. */
+/* LSB per SI unit on the requested side (J288_SIDE_ROTOR or J288_SIDE_OUTPUT, checked by
+ * every caller). Rotor angle = N * output angle, rotor torque = output torque / N, rotor
+ * gains = output gains / N^2. A table of constants: converting a whole command looks each
+ * factor up instead of computing it (a division each on the output side). */
 static j288_real_t lsb_per_unit(quantity_t q, j288_side_t side)
 {
-    static const j288_real_t rotor[5] = {
-        (j288_real_t)J288_SCALE_TORQUE, (j288_real_t)J288_SCALE_SPEED,
-        (j288_real_t)J288_SCALE_POS, (j288_real_t)J288_SCALE_KP, (j288_real_t)J288_SCALE_KD};
-    j288_real_t k = rotor[q];
-    if (side == J288_SIDE_OUTPUT) {
-        switch (q) {
-        case Q_SPEED:
-        case Q_POS:
-            k = k * N_RATIO;
-            break;
-        case Q_TORQUE:
-            k = k / N_RATIO;
-            break;
-        default:
-            k = k / (N_RATIO * N_RATIO);
-            break;
-        }
-    }
-    return k;
+    static const j288_real_t k[2][5] = {
+        {(j288_real_t)J288_SCALE_TORQUE, (j288_real_t)J288_SCALE_SPEED,
+         (j288_real_t)J288_SCALE_POS, (j288_real_t)J288_SCALE_KP, (j288_real_t)J288_SCALE_KD},
+        {(j288_real_t)J288_SCALE_TORQUE / N_RATIO, (j288_real_t)J288_SCALE_SPEED * N_RATIO,
+         (j288_real_t)J288_SCALE_POS * N_RATIO, (j288_real_t)J288_SCALE_KP / (N_RATIO * N_RATIO),
+         (j288_real_t)J288_SCALE_KD / (N_RATIO * N_RATIO)}};
+    return k[(side == J288_SIDE_OUTPUT) ? 1 : 0][q];
 }
 
 static bool side_ok(j288_side_t side)
@@ -64,21 +57,31 @@ static bool round_magnitude(j288_real_t a, uint32_t *mag)
     return true;
 }
 
-/* v rounded half away from zero, when the result lies in [lo, hi] (lo < 0 < hi). */
-static bool round_into(j288_real_t v, int32_t lo, int32_t hi, int32_t *out)
+/* Below this magnitude v +- 1/2 is exact in float (and in double), so that truncating it
+ * rounds v half away from zero: one conversion. Every 16-bit field's window lies below it. */
+#define ROUND_FAST_LIMIT ((j288_real_t)8388608.0) /* 2^23 */
+
+/* v rounded half away from zero into [lo, hi], |v| < ROUND_FAST_LIMIT. */
+static J288_INLINE_HOT bool round_fast(j288_real_t v, int32_t lo, int32_t hi, int32_t *out)
+{
+    j288_real_t h = (v < (j288_real_t)0) ? (v - (j288_real_t)0.5) : (v + (j288_real_t)0.5);
+    int32_t r = (int32_t)h;
+    if ((r < lo) || (r > hi)) {
+        return false;
+    }
+    *out = r;
+    return true;
+}
+
+/* The same for the 32-bit field beyond ROUND_FAST_LIMIT (v within [INT32_MIN - 1,
+ * INT32_MAX + 1]), by magnitude. */
+static bool round_into32(j288_real_t v, int32_t lo, int32_t hi, int32_t *out)
 {
     bool neg = v < (j288_real_t)0;
     /* largest magnitude allowed on this side; -(lo + 1) + 1 avoids negating INT32_MIN */
     uint32_t limit = neg ? ((uint32_t)(-(lo + 1)) + 1u) : (uint32_t)hi;
     uint32_t mag = 0u;
 
-    /* A coarse window first: catches infinities and keeps the conversions defined. Exactly
-     * half past a limit rounds away from zero, out of range, and is caught by the integer
-     * test; comparing v against lo - 0.5 would be wrong in float, where that is not
-     * representable for int32. */
-    if (!((v >= (j288_real_t)lo - (j288_real_t)1) && (v <= (j288_real_t)hi + (j288_real_t)1))) {
-        return false;
-    }
     if (!round_magnitude(neg ? -v : v, &mag) || (mag > limit)) {
         return false;
     }
@@ -92,21 +95,60 @@ static bool round_into(j288_real_t v, int32_t lo, int32_t hi, int32_t *out)
     return true;
 }
 
+/* v rounded half away from zero, when the result lies in [lo, hi] (lo < 0 < hi). */
+static J288_INLINE_HOT bool round_into(j288_real_t v, int32_t lo, int32_t hi, int32_t *out)
+{
+    /* A coarse window first: catches NaN and infinities and keeps the conversions defined.
+     * Exactly half past a limit rounds away from zero, out of range, and is caught by the
+     * integer test; comparing v against lo - 0.5 would be wrong in float, where that is not
+     * representable for int32. A 16-bit field's window is symmetric, |v| <= 32769: one test
+     * of the magnitude. */
+    if (hi <= INT16_MAX) {
+        j288_real_t a = (v < (j288_real_t)0) ? -v : v;
+        if (!(a <= (j288_real_t)32769)) {
+            return false;
+        }
+        return round_fast(v, lo, hi, out);
+    }
+    if (!((v >= ((j288_real_t)lo - (j288_real_t)1)) && (v <= ((j288_real_t)hi + (j288_real_t)1)))) {
+        return false;
+    }
+    if ((v > -ROUND_FAST_LIMIT) && (v < ROUND_FAST_LIMIT)) {
+        return round_fast(v, lo, hi, out);
+    }
+    return round_into32(v, lo, hi, out);
+}
+
+/* round_into() for a gain, v >= 0 (or NaN): the window and the rounding need no sign. */
+static J288_INLINE_HOT bool round_gain(j288_real_t v, int32_t hi, int32_t *out)
+{
+    int32_t r;
+    if (!(v <= ((j288_real_t)hi + (j288_real_t)1))) {
+        return false;
+    }
+    r = (int32_t)(v + (j288_real_t)0.5);
+    if (r > hi) {
+        return false;
+    }
+    *out = r;
+    return true;
+}
+
 /*
  * Scale and round one quantity into [lo, hi]. Returns J288_OK, J288_ERR_NOT_FINITE, or
  * range_err; with clamp set, out-of-range values saturate and *was_clamped is set instead.
+ * Inlined where a whole command is converted: the quantity, the limits and the error are
+ * constants there.
  */
-static int convert(j288_real_t si, quantity_t q, j288_side_t side, int32_t lo, int32_t hi,
-                   int range_err, bool clamp, bool *was_clamped, int32_t *out)
+static J288_INLINE_HOT int convert(j288_real_t si, quantity_t q, j288_side_t side, int32_t lo,
+                                   int32_t hi, int range_err, bool clamp, bool *was_clamped,
+                                   int32_t *out)
 {
     j288_real_t v;
     int32_t r = 0;
     bool is_gain = (q == Q_KP) || (q == Q_KD);
 
-    if (si != si) {
-        return J288_ERR_NOT_FINITE;
-    }
-    if (is_gain && (si < (j288_real_t)0)) {
+    if (is_gain && (si < (j288_real_t)0)) { /* (false for NaN) */
         if (!clamp) {
             return J288_ERR_NEG_GAIN;
         }
@@ -115,7 +157,11 @@ static int convert(j288_real_t si, quantity_t q, j288_side_t side, int32_t lo, i
         return J288_OK;
     }
     v = si * lsb_per_unit(q, side);
-    if (!round_into(v, lo, hi, &r)) {
+    /* NaN fails every window: it is told apart only here */
+    if (!(is_gain ? round_gain(v, hi, &r) : round_into(v, lo, hi, &r))) {
+        if (si != si) {
+            return J288_ERR_NOT_FINITE;
+        }
         if (!clamp) {
             return range_err;
         }
@@ -127,8 +173,9 @@ static int convert(j288_real_t si, quantity_t q, j288_side_t side, int32_t lo, i
     return J288_OK;
 }
 
-static int convert16(j288_real_t si, quantity_t q, j288_side_t side, int range_err, bool clamp,
-                     bool *was_clamped, int16_t *out)
+static J288_INLINE_HOT int convert16(j288_real_t si, quantity_t q, j288_side_t side,
+                                     int range_err, bool clamp, bool *was_clamped,
+                                     int16_t *out)
 {
     int32_t v = 0;
     int err = convert(si, q, side, INT16_MIN, INT16_MAX, range_err, clamp, was_clamped, &v);
@@ -138,14 +185,15 @@ static int convert16(j288_real_t si, quantity_t q, j288_side_t side, int range_e
     return err;
 }
 
-static int cmd_from_si(const j288_cmd_si_t *si, j288_side_t side, j288_cmd_raw_t *raw,
-                       bool clamp, unsigned *clamped)
+/* Inlined in both public callers, clamp a constant in each. */
+static J288_INLINE_HOT int cmd_from_si(const j288_cmd_si_t *si, j288_side_t side,
+                                       j288_cmd_raw_t *raw, bool clamp, unsigned *clamped)
 {
-    j288_cmd_raw_t r = {0};
+    j288_cmd_raw_t r;
     bool c[5] = {false, false, false, false, false};
     int err;
-    unsigned mask = 0u;
-    unsigned i;
+
+    (void)memset(&r, 0, sizeof r); /* padding included: *raw gets a whole, defined record */
 
     if ((si == NULL) || (raw == NULL)) {
         return J288_ERR_NULL;
@@ -153,9 +201,6 @@ static int cmd_from_si(const j288_cmd_si_t *si, j288_side_t side, j288_cmd_raw_t
     if (!side_ok(side)) {
         return J288_ERR_BAD_ARG;
     }
-    r.id = si->id;
-    r.status = si->status;
-    r.watchdog = si->watchdog;
     err = convert16(si->tau, Q_TORQUE, side, J288_ERR_RANGE_TAU, clamp, &c[0], &r.tau);
     if (err == J288_OK) {
         err = convert16(si->speed, Q_SPEED, side, J288_ERR_RANGE_SPEED, clamp, &c[1], &r.speed);
@@ -173,15 +218,15 @@ static int cmd_from_si(const j288_cmd_si_t *si, j288_side_t side, j288_cmd_raw_t
     if (err != J288_OK) {
         return err;
     }
-    for (i = 0u; i < 5u; i++) {
-        if (c[i]) {
-            mask |= (1u << i);
-        }
-    }
     if (clamped != NULL) {
-        *clamped = mask;
+        *clamped = (c[0] ? J288_FIELD_TAU : 0u) | (c[1] ? J288_FIELD_SPEED : 0u) |
+                   (c[2] ? J288_FIELD_POS : 0u) | (c[3] ? J288_FIELD_KP : 0u) |
+                   (c[4] ? J288_FIELD_KD : 0u);
     }
-    *raw = r;
+    r.id = si->id;
+    r.status = si->status;
+    r.watchdog = si->watchdog;
+    *raw = r; /* only now: untouched on an error */
     return J288_OK;
 }
 
