@@ -789,6 +789,16 @@ int j288_robot_joint_id(const j288_robot_t *r, unsigned joint)
     return (r == NULL || joint >= r->njoints) ? -1 : (int)r->joint[joint].cfg.id;
 }
 
+int j288_robot_joint_config(const j288_robot_t *r, unsigned joint, j288_joint_config_t *out)
+{
+    if (r == NULL || out == NULL)
+        return J288_ERR_NULL;
+    if (joint >= r->njoints)
+        return J288_ERR_BAD_ARG;
+    *out = r->joint[joint].cfg;
+    return J288_OK;
+}
+
 int j288_robot_read(const j288_robot_t *r, unsigned joint, j288_robot_state_t *st)
 {
     const j288_joint_state_t *js;

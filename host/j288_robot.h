@@ -323,6 +323,10 @@ const char *j288_robot_bus_name(const j288_robot_t *r, unsigned bus);
 int j288_robot_joint_bus(const j288_robot_t *r, unsigned joint);
 int j288_robot_joint_id(const j288_robot_t *r, unsigned joint);
 
+/* The joint's configuration as the joint layer took it (limits, gains with the defaults
+ * filled in, ...). Errors: J288_ERR_NULL, J288_ERR_BAD_ARG. */
+int j288_robot_joint_config(const j288_robot_t *r, unsigned joint, j288_joint_config_t *out);
+
 /* The joint's state after the latest cycle. Errors: J288_ERR_NULL, J288_ERR_BAD_ARG. */
 int j288_robot_read(const j288_robot_t *r, unsigned joint, j288_robot_state_t *st);
 

@@ -29,12 +29,15 @@ logged() { # FILE NEEDLE: wait (bounded, 20 s) until the simulator has logged it
 }
 
 # A fresh simulator with one loaded servo (id 1) and a config without gains (the defaults).
-fresh_sim() {
+# Locked, the loaded joint turns freely: a clamping joint, so that wherever it stopped (just
+# past +-pi too) it can be held.
+fresh_sim() { # NAME [more simulator options]
+    local name=$1; shift
     [ -n "${SIM_PID:-}" ] && stop_sim "$SIM_PID"
-    sim_start_linked "$1" --ids 1 --load-torque 2 --exit-after 120 || return 1
-    LOG=$SIM_DIR/$1.log
-    CFG=$SIM_DIR/$1.yaml
-    printf 'buses:\n  - {name: b, port: %s, margin_us: 250000}\njoints:\n  - {name: hip, bus: b, id: 1}\n' \
+    sim_start_linked "$name" --ids 1 --load-torque 2 --exit-after 120 "$@" || return 1
+    LOG=$SIM_DIR/$name.log
+    CFG=$SIM_DIR/$name.yaml
+    printf 'buses:\n  - {name: b, port: %s, margin_us: 250000}\njoints:\n  - {name: hip, bus: b, id: 1, clamp: true}\n' \
         "$DEV" >"$CFG"
 }
 
@@ -158,8 +161,73 @@ t_robot_stop_json() {
     [ "$("$J288" --config "$CFG" stop --json)" = '{"stopped": "all", "buses": 1, "sent": 1}' ]
 }
 
-for t in after_cli_single after_cli_robot after_ctrl_c after_python_bus after_python_robot \
-    notice_once robot_csv_and_plot robot_stop_json; do
+# A trip in the middle of a run (the tool frozen 1.5 s: its servo's watchdog fires) is
+# cleared and reported, and the command fails: the single-servo form and the robot form.
+t_cli_reports_a_trip() {
+    local form pid rc
+    for form in single robot; do
+        fresh_sim "trip_$form" || return 1
+        if [ $form = single ]; then
+            "$J288" --port "$DEV" hold --id 1 --duration 4 >/dev/null 2>"$SIM_DIR/t.err" &
+        else
+            "$J288" --config "$CFG" hold --duration 4 >/dev/null 2>"$SIM_DIR/t.err" &
+        fi
+        pid=$!
+        BG_PIDS+=("$pid")
+        logged "$LOG" ' id=1 status=1 wd=1' || return 1
+        kill -STOP "$pid"; sleep "$SILENCE"; kill -CONT "$pid"
+        wait_exit "$pid" 30; rc=$?
+        [ $rc -eq 1 ] && grep -q 'had tripped its watchdog' "$SIM_DIR/t.err" ||
+            { echo "$form: exit $rc, stderr $(cat "$SIM_DIR/t.err")"; return 1; }
+        logged "$LOG" ' id=1 status=1 wd=0' || return 1
+    done
+}
+
+# A named joint's limits hold whatever --side; a bad argument is refused before anything is
+# sent (a --speed beyond the wire's range locked the servo for 8 commands, then exit 1); the
+# robot form's limit error names the angle and the limits, exit 2.
+t_limits_and_arguments() {
+    local n
+    fresh_sim limits --start-angle 1:2.9 --load-torque 0 || return 1
+    printf 'buses:\n  - {name: b, port: %s, margin_us: 250000}\njoints:\n  - {name: hip, bus: b, id: 1, limits: [-2.5, 2.5]}\n' \
+        "$DEV" >"$CFG"
+    n=$(cat "$LOG" 2>/dev/null | wc -l)
+    "$J288" --config "$CFG" move --joint hip --pos 5 --side output --duration 0.2 \
+        >/dev/null 2>"$SIM_DIR/l.err"
+    [ $? -eq 2 ] && grep -q 'would bypass its limits \[-2.5, 2.5\]' "$SIM_DIR/l.err" || return 1
+    "$J288" --port "$DEV" move --id 1 --pos 0.5 --speed 1e9 >/dev/null 2>"$SIM_DIR/l.err"
+    [ $? -eq 2 ] && grep -q -- '--speed: 1e+09' "$SIM_DIR/l.err" || return 1
+    [ "$(cat "$LOG" 2>/dev/null | wc -l)" -eq "$n" ] || { echo "something was sent"; return 1; }
+    "$J288" --config "$CFG" hold --duration 0.2 >/dev/null 2>"$SIM_DIR/l.err"
+    [ $? -eq 2 ] && grep -q 'joint hip: at 2.9[0-9]* rad, beyond its limits \[-2.5, 2.5\]' "$SIM_DIR/l.err"
+}
+
+# hold shows its progress on a terminal (a line redrawn in place), none when stderr is not
+# one; calibrate stopped by Ctrl-C says that nothing was written (and writes nothing).
+t_progress_and_interrupted_calibrate() {
+    local pid rc sum
+    fresh_sim progress || return 1
+    script -qec "J288_QUIET=1 $J288 --port $DEV hold --id 1 --duration 0.7" /dev/null \
+        >"$SIM_DIR/tty.out" </dev/null || return 1
+    grep -q $'\rhold servo 1: .*replies' "$SIM_DIR/tty.out" ||
+        grep -q $'\rhold .*s  pos ' "$SIM_DIR/tty.out" || { echo "no progress: $(cat -v "$SIM_DIR/tty.out")"; return 1; }
+    "$J288" --port "$DEV" hold --id 1 --duration 0.3 >/dev/null 2>"$SIM_DIR/q.err" || return 1
+    ! grep -q $'\r' "$SIM_DIR/q.err" || return 1
+    sum=$(md5sum <"$CFG")
+    "$J288" --config "$CFG" calibrate --joint hip >/dev/null 2>"$SIM_DIR/c.err" &
+    pid=$!
+    BG_PIDS+=("$pid")
+    logged "$LOG" ' id=1 status=1 wd=1' || return 1
+    kill -INT "$pid"
+    wait_exit "$pid" 30; rc=$?
+    [ $rc -eq 130 ] && grep -q 'calibration interrupted (servo locked); nothing written' "$SIM_DIR/c.err" &&
+        [ "$(md5sum <"$CFG")" = "$sum" ]
+}
+
+# (HOST_STACK_TESTS: a subset, by name)
+for t in ${HOST_STACK_TESTS:-after_cli_single after_cli_robot after_ctrl_c after_python_bus \
+    after_python_robot notice_once robot_csv_and_plot robot_stop_json cli_reports_a_trip \
+    limits_and_arguments progress_and_interrupted_calibrate}; do
     e2e_check "$t" "t_$t"
 done
 e2e_summary

@@ -189,9 +189,10 @@ void cli_joint_why_unknown(const j288_joint_t *j, const char *name, unsigned rep
 void cli_robot_fill_bus(const cli_robot_t *r, const j288_robot_config_joint_t *rj,
                         cli_bus_opts_t *o);
 
-/* One line for a library error on joint name's target: "joint hip: --pos 2: target position
- * outside the joint's limits [-1.5, 1.5]". */
-void cli_joint_target_error(const j288_joint_t *j, const char *name, const char *what, int rc);
+/* One line for a library error on joint name's target, naming the value and the limit:
+ * "hip: --pos 2: target position outside the joint's limits [-1.5, 1.5]; nothing sent". */
+void cli_joint_target_error(const j288_joint_t *j, const char *name, const char *what,
+                            double value, int rc);
 
 /* How far beyond its limits a joint may be for hold and move to start: from the nearest
  * limit, so that the first command pulls it in by at most this (rad); the runner's hold

@@ -278,7 +278,7 @@ static int cal_move(cli_bus_t *b, j288_joint_t *j, j288_cal_t *cal, const cal_pa
         }
         rc = j288_joint_command(j, &t, &cmd, NULL);
         if (rc != J288_OK) {
-            cli_joint_target_error(j, name, "calibration motion", rc);
+            cli_joint_target_error(j, name, "calibration motion to", (double)t.pos, rc);
             return CLI_EXIT_FAIL;
         }
         rc = cli_bus_transfer(b, &cmd, &txn);
@@ -476,6 +476,11 @@ int cli_cmd_calibrate(int argc, char **argv, const cli_global_t *g)
     memset(&r, 0, sizeof r);
     ec = cal_run(&b, &a, &sel, &jc, &r, &eps);
     cli_bus_close(&b);
+    if (cli_stop_signal != 0) {
+        cli_error("%s: calibration interrupted (servo locked); nothing written%s%s", sel.name,
+                  o.config != NULL ? " to " : "", o.config != NULL ? o.config : "");
+        return cli_signal_exit_code();
+    }
     if (ec != CLI_EXIT_OK) {
         return ec;
     }

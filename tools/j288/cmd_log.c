@@ -646,7 +646,8 @@ static int log_probe(log_run_t *r)
             }
             if (r->a.motion == MOTION_SWING &&
                 !cli_joint_pos_allowed(&r->sel[id].jc, r->q0[id] + r->a.amp)) {
-                cli_joint_target_error(&r->joint[id], r->sel[id].name, "--swing", J288_ERR_LIMIT_POS);
+                cli_joint_target_error(&r->joint[id], r->sel[id].name, "--swing to",
+                                       r->q0[id] + r->a.amp, J288_ERR_LIMIT_POS);
                 return CLI_EXIT_USAGE;
             }
         }
@@ -682,7 +683,7 @@ static void joint_cycle_command(log_run_t *r, uint8_t id, double t)
             j288_sched_set_cmd(r->s, &cmd);
             return;
         }
-        cli_joint_target_error(&r->joint[id], r->sel[id].name, "target", rc);
+        cli_joint_target_error(&r->joint[id], r->sel[id].name, "target", (double)tg.pos, rc);
         r->lost = (uint16_t)(r->lost | (1u << id));
     }
     cli_lock_cmd(id, &cmd);
