@@ -260,6 +260,13 @@ void cli_joint_target_error(const j288_joint_t *j, const char *name, const char 
     }
 }
 
+void cli_joint_gains(const j288_robot_config_joint_t *rj, bool have_kp, double kp, bool have_kd,
+                     double kd, double *out_kp, double *out_kd)
+{
+    *out_kp = have_kp ? kp : (rj != NULL && rj->has_kp ? rj->kp : J288_ROBOT_DEFAULT_KP);
+    *out_kd = have_kd ? kd : (rj != NULL && rj->has_kd ? rj->kd : J288_ROBOT_DEFAULT_KD);
+}
+
 void cli_json_joint_members(cli_json_t *jw, const j288_joint_t *j)
 {
     const j288_joint_state_t *st = j288_joint_state(j);

@@ -13,8 +13,6 @@
 /* Default gains, output side: gentle (a first try on real hardware should not snap), well
  * inside the wire range (kp 0..2128 N*m/rad, kd 0..21.28 N*m*s/rad on the output side);
  * kd gives a damping ratio near 0.7 on the simulator's rotor (2e-6 kg m^2). */
-#define DEFAULT_KP_OUTPUT         20.0
-#define DEFAULT_KD_OUTPUT         2.5
 #define DEFAULT_RATE_HZ           200.0
 #define DEFAULT_MOVE_SPEED_OUTPUT 1.0 /* rad/s */
 
@@ -448,8 +446,7 @@ static int plan_joint(const drive_args_t *d, drive_plan_t *p)
     const j288_joint_config_t *jc = &d->sel.jc;
     j288_cmd_raw_t probe;
     int rc;
-    p->jkp = d->have_kp ? d->kp : (d->sel.rj != NULL && d->sel.rj->has_kp ? (double)jc->kp : DEFAULT_KP_OUTPUT);
-    p->jkd = d->have_kd ? d->kd : (d->sel.rj != NULL && d->sel.rj->has_kd ? (double)jc->kd : DEFAULT_KD_OUTPUT);
+    cli_joint_gains(d->sel.rj, d->have_kp, d->kp, d->have_kd, d->kd, &p->jkp, &p->jkd);
     p->jspeed = d->have_speed ? d->speed : DEFAULT_MOVE_SPEED_OUTPUT;
     if (d->kind == DRIVE_TORQUE) {
         p->jkp = 0.0;
@@ -510,8 +507,8 @@ static int plan_fields(const drive_args_t *d, drive_plan_t *p)
         return -1;
     }
     if (d->kind != DRIVE_TORQUE) {
-        double kp = d->have_kp ? d->kp : DEFAULT_KP_OUTPUT;
-        double kd = d->have_kd ? d->kd : DEFAULT_KD_OUTPUT;
+        double kp = d->have_kp ? d->kp : J288_ROBOT_DEFAULT_KP; /* output side */
+        double kd = d->have_kd ? d->kd : J288_ROBOT_DEFAULT_KD;
         j288_side_t gain_side = d->have_kp ? side : J288_SIDE_OUTPUT;
         rc = j288_kp_to_raw((j288_real_t)kp, gain_side, &p->base.kp);
         if (rc != J288_OK) {
