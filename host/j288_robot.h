@@ -57,7 +57,11 @@
  *
  * Objects are caller-allocated (j288_robot_sizeof() for foreign callers), hold no heap memory
  * and must not move while open. One thread owns a robot; nothing here is ISR- or
- * signal-safe but the stop flag. Results are the library's codes (j288/error.h).
+ * signal-safe but the stop flag. on_event and on_cycle run on that thread from inside the
+ * runner's loop (a cycle, a transfer, a stop): they may read and set targets (read, set_target,
+ * set_targets, hold, lock), never call cycle, run, stop, transfer, exchange, idle or close,
+ * which would re-enter the loop (docs/architecture.md has the table for every layer).
+ * Results are the library's codes (j288/error.h).
  */
 #ifndef J288_ROBOT_H
 #define J288_ROBOT_H

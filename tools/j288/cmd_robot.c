@@ -508,7 +508,7 @@ int cli_cmd_robot(int argc, char **argv, const cli_global_t *g)
             cli_error("%s", j288_robot_error(&robot));
         if (rc != J288_ERR_ABORTED || cli_stop_signal != 0) {
             double secs = (double)(j288_linux_now_us() - t0) * 1e-6;
-            if (a.json && strcmp(cmd, "log") == 0) {
+            if (a.json) {
                 cli_json_t jw;
                 cli_json_init(&jw, stdout);
                 cli_json_begin_object(&jw, NULL);
