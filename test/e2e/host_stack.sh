@@ -60,8 +60,8 @@ second_hold() {
 
 t_after_cli_single() {
     fresh_sim single || return 1
-    "$J288" --port "$DEV" hold --id 1 --duration 0.3 --rate 200 >/dev/null || return 1
-    "$J288" --port "$DEV" stop >/dev/null || return 1
+    "$J288" --port "$DEV" hold --margin-us 250000 --id 1 --duration 0.3 --rate 200 >/dev/null || return 1
+    "$J288" --port "$DEV" stop --margin-us 250000 >/dev/null || return 1
     logged "$LOG" ' id=15 status=0 wd=0' || return 1
     second_hold
 }
@@ -74,14 +74,16 @@ t_after_cli_robot() {
 }
 
 t_after_ctrl_c() {
+    local pid rc
     fresh_sim ctrlc || return 1
     "$J288" --config "$CFG" hold >/dev/null 2>&1 &
-    local pid=$!
+    pid=$!
     BG_PIDS+=("$pid")
     logged "$LOG" ' id=1 status=1 wd=1' || return 1
     kill -INT "$pid"
-    wait_exit "$pid" 20
-    [ $? -eq 130 ] || return 1
+    wait_exit "$pid" 60
+    rc=$?
+    [ $rc -eq 130 ] || { echo "exit $rc"; return 1; }
     second_hold
 }
 
@@ -103,12 +105,15 @@ def first_status(bus):  # a loaded machine may stall the fresh simulator past on
 with j288.Bus(sys.argv[1], margin_us=250000) as bus:
     p = first_status(bus).pos
     x = p - 0.5 if p > 0 else p + 0.5  # joint frame: within [-pi, pi]
-    end = time.monotonic() + 1.0
+    end, st, missed = time.monotonic() + 1.0, None, 0
     while time.monotonic() < end:
-        st = bus.command(1, pos=x, kp=20, kd=1)
+        try:
+            st = bus.command(1, pos=x, kp=20, kd=1)
+        except j288.NoReplyError:  # a reply lost to a loaded machine: the next one counts
+            missed += 1
         time.sleep(0.005)
-    print("pos", st.pos, "target", x, "mode", st.mode)
-    sys.exit(0 if st.mode == 1 and abs(st.pos - x) < 0.2 else 1)
+    print("pos", st.pos, "target", x, "mode", st.mode, "missed", missed)
+    sys.exit(0 if st.mode == 1 and abs(st.pos - x) < 0.2 and missed < 10 else 1)
 EOF
 }
 
@@ -125,9 +130,12 @@ def first_status(bus):  # a loaded machine may stall the fresh simulator past on
             pass
     return bus.status(1)
 with j288.Bus(sys.argv[1], margin_us=250000) as bus:
-    p = first_status(bus).pos
+    p = max(-3.0, min(3.0, first_status(bus).pos))  # the joint frame: within [-pi, pi]
     for _ in range(20):
-        bus.command(1, pos=p, kp=20, kd=1)
+        try:
+            bus.command(1, pos=p, kp=20, kd=1)
+        except j288.NoReplyError:
+            pass
 EOF
     py_second_bus && second_hold
 }
@@ -153,7 +161,7 @@ EOF
 # J288_VERBOSE (J288_QUIET=1, as the other checks set it, silences them).
 t_notice_once() {
     fresh_sim notice || return 1
-    J288_QUIET= "$J288" --port "$DEV" status --id 1 >/dev/null 2>"$SIM_DIR/n.err" ||
+    J288_QUIET= "$J288" --port "$DEV" status --margin-us 250000 --id 1 >/dev/null 2>"$SIM_DIR/n.err" ||
         { echo "status: $(cat "$SIM_DIR/n.err")"; return 1; }
     [ "$(grep -c '^note: .*low-latency' "$SIM_DIR/n.err")" -eq 1 ] || { cat "$SIM_DIR/n.err"; return 1; }
     J288_QUIET= "$J288" --config "$CFG" status >/dev/null 2>"$SIM_DIR/n.err" ||
@@ -190,7 +198,7 @@ t_stop_on_bus_loss() {
     BG_PIDS+=("$pid")
     logged "$LOG" ' id=1 status=1 wd=1' || return 1
     kill -STOP "$SIM_PID"
-    wait_exit "$pid" 20; rc=$?
+    wait_exit "$pid" 60; rc=$?
     kill -CONT "$SIM_PID"
     [ $rc -eq 1 ] && grep -q "bus 'b' stopped answering: every bus stopped (stop on bus loss)" "$SIM_DIR/s.err" ||
         { echo "exit $rc: $(cat "$SIM_DIR/s.err")"; return 1; }
@@ -204,7 +212,7 @@ t_cli_reports_a_trip() {
     for form in single robot; do
         fresh_sim "trip_$form" || return 1
         if [ $form = single ]; then
-            "$J288" --port "$DEV" hold --id 1 --duration 4 >/dev/null 2>"$SIM_DIR/t.err" &
+            "$J288" --port "$DEV" hold --margin-us 250000 --id 1 --duration 4 >/dev/null 2>"$SIM_DIR/t.err" &
         else
             "$J288" --config "$CFG" hold --duration 4 >/dev/null 2>"$SIM_DIR/t.err" &
         fi
@@ -212,7 +220,7 @@ t_cli_reports_a_trip() {
         BG_PIDS+=("$pid")
         logged "$LOG" ' id=1 status=1 wd=1' || { echo "$form: no FOC"; return 1; }
         kill -STOP "$pid"; sleep "$SILENCE"; kill -CONT "$pid"
-        wait_exit "$pid" 30; rc=$?
+        wait_exit "$pid" 60; rc=$?
         [ $rc -eq 1 ] && grep -q 'had tripped its watchdog' "$SIM_DIR/t.err" ||
             { echo "$form: exit $rc, stderr $(cat "$SIM_DIR/t.err")"; return 1; }
         logged "$LOG" ' id=1 status=1 wd=0' || { echo "$form: no clearing command"; return 1; }
@@ -231,7 +239,7 @@ t_limits_and_arguments() {
     "$J288" --config "$CFG" move --joint hip --pos 5 --side output --duration 0.2 \
         >/dev/null 2>"$SIM_DIR/l.err"
     [ $? -eq 2 ] && grep -q 'would bypass its limits \[-2.5, 2.5\]' "$SIM_DIR/l.err" || return 1
-    "$J288" --port "$DEV" move --id 1 --pos 0.5 --speed 1e9 >/dev/null 2>"$SIM_DIR/l.err"
+    "$J288" --port "$DEV" move --margin-us 250000 --id 1 --pos 0.5 --speed 1e9 >/dev/null 2>"$SIM_DIR/l.err"
     [ $? -eq 2 ] && grep -q -- '--speed: 1e+09' "$SIM_DIR/l.err" || return 1
     [ "$(cat "$LOG" 2>/dev/null | wc -l)" -eq "$n" ] || { echo "something was sent"; return 1; }
     "$J288" --config "$CFG" hold --duration 0.2 >/dev/null 2>"$SIM_DIR/l.err"
@@ -243,11 +251,11 @@ t_limits_and_arguments() {
 t_progress_and_interrupted_calibrate() {
     local pid rc sum
     fresh_sim progress || return 1
-    script -qec "J288_QUIET=1 $J288 --port $DEV hold --id 1 --duration 0.7" /dev/null \
+    script -qec "J288_QUIET=1 $J288 --port $DEV hold --id 1 --margin-us 250000 --duration 0.7" /dev/null \
         >"$SIM_DIR/tty.out" </dev/null || return 1
     grep -q $'\rhold servo 1: .*replies' "$SIM_DIR/tty.out" ||
         grep -q $'\rhold .*s  pos ' "$SIM_DIR/tty.out" || { echo "no progress: $(cat -v "$SIM_DIR/tty.out")"; return 1; }
-    "$J288" --port "$DEV" hold --id 1 --duration 0.3 >/dev/null 2>"$SIM_DIR/q.err" || return 1
+    "$J288" --port "$DEV" hold --margin-us 250000 --id 1 --duration 0.3 >/dev/null 2>"$SIM_DIR/q.err" || return 1
     ! grep -q $'\r' "$SIM_DIR/q.err" || return 1
     sum=$(md5sum <"$CFG")
     "$J288" --config "$CFG" calibrate --joint hip >/dev/null 2>"$SIM_DIR/c.err" &
@@ -255,7 +263,7 @@ t_progress_and_interrupted_calibrate() {
     BG_PIDS+=("$pid")
     logged "$LOG" ' id=1 status=1 wd=1' || return 1
     kill -INT "$pid"
-    wait_exit "$pid" 30; rc=$?
+    wait_exit "$pid" 60; rc=$?
     [ $rc -eq 130 ] && grep -q 'calibration interrupted (servo locked); nothing written' "$SIM_DIR/c.err" &&
         [ "$(md5sum <"$CFG")" = "$sum" ]
 }
