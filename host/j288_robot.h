@@ -231,6 +231,8 @@ typedef struct {
     bool swept_ok;       /* the sweep in progress had a good reply */
     uint8_t lock_under_foc[J288_MAX_SERVOS]; /* replies in lock mode to FOC commands in a row */
     j288_joint_t servo_joint[J288_MAX_SERVOS]; /* servo level's joint frame (exchanges) */
+    bool txn_done;       /* j288_robot_transfer()'s submit has ended (its result in txn) */
+    j288_txn_t txn;
     uint16_t servo_joint_on;                   /* bit id: servo_joint[id] initialised */
     uint8_t empty_run;   /* consecutive sweeps without a reply */
     uint32_t sweep_start_us;
