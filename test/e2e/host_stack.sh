@@ -23,12 +23,17 @@ export PYTHONPATH=${J288_PYTHON_DIR:-$PWD/python}${PYTHONPATH:+:$PYTHONPATH}
 SILENCE=1.5 # longer than the servo's 1 s watchdog: the scenario, not a bound
 SAG_MAX=0.1 # rad: kp 20 against 2 N*m holds within 0.1 rad; a tripped servo falls freely
 
-logged() { # FILE NEEDLE: wait (bounded, 20 s) until the simulator has logged it
-    for _ in $(seq 1 400); do grep -q -- "$2" "$1" 2>/dev/null && return 0; sleep 0.05; done
+logged() { # FILE NEEDLE [FROM_LINE]: wait (bounded, 20 s) until the simulator has logged it
+    for _ in $(seq 1 400); do
+        tail -n +"$((${3:-0} + 1))" "$1" 2>/dev/null | grep -q -- "$2" && return 0
+        sleep 0.05
+    done
     return 1
 }
+lines() { cat "$1" 2>/dev/null | wc -l; }
 
-# A fresh simulator with one loaded servo (id 1) and a config without gains (the defaults).
+# A fresh simulator with one loaded servo (id 1) and a config without gains (the defaults);
+# the single-servo commands take its joint by name (--joint hip) for the same reason.
 # Locked, the loaded joint turns freely: a clamping joint, so that wherever it stopped (just
 # past +-pi too) it can be held.
 fresh_sim() { # NAME [more simulator options]
@@ -60,7 +65,7 @@ second_hold() {
 
 t_after_cli_single() {
     fresh_sim single || return 1
-    "$J288" --port "$DEV" hold --margin-us 250000 --id 1 --duration 0.3 --rate 200 >/dev/null || return 1
+    "$J288" --config "$CFG" hold --joint hip --duration 0.3 --rate 200 >/dev/null || return 1
     "$J288" --port "$DEV" stop --margin-us 250000 >/dev/null || return 1
     logged "$LOG" ' id=15 status=0 wd=0' || return 1
     second_hold
@@ -212,7 +217,7 @@ t_cli_reports_a_trip() {
     for form in single robot; do
         fresh_sim "trip_$form" || return 1
         if [ $form = single ]; then
-            "$J288" --port "$DEV" hold --margin-us 250000 --id 1 --duration 4 >/dev/null 2>"$SIM_DIR/t.err" &
+            "$J288" --config "$CFG" hold --joint hip --duration 4 >/dev/null 2>"$SIM_DIR/t.err" &
         else
             "$J288" --config "$CFG" hold --duration 4 >/dev/null 2>"$SIM_DIR/t.err" &
         fi
@@ -235,13 +240,13 @@ t_limits_and_arguments() {
     fresh_sim limits --start-angle 1:2.9 --load-torque 0 || return 1
     printf 'buses:\n  - {name: b, port: %s, margin_us: 250000}\njoints:\n  - {name: hip, bus: b, id: 1, limits: [-2.5, 2.5]}\n' \
         "$DEV" >"$CFG"
-    n=$(cat "$LOG" 2>/dev/null | wc -l)
+    n=$(lines "$LOG")
     "$J288" --config "$CFG" move --joint hip --pos 5 --side output --duration 0.2 \
         >/dev/null 2>"$SIM_DIR/l.err"
     [ $? -eq 2 ] && grep -q 'would bypass its limits \[-2.5, 2.5\]' "$SIM_DIR/l.err" || return 1
     "$J288" --port "$DEV" move --margin-us 250000 --id 1 --pos 0.5 --speed 1e9 >/dev/null 2>"$SIM_DIR/l.err"
     [ $? -eq 2 ] && grep -q -- '--speed: 1e+09' "$SIM_DIR/l.err" || return 1
-    [ "$(cat "$LOG" 2>/dev/null | wc -l)" -eq "$n" ] || { echo "something was sent"; return 1; }
+    [ "$(lines "$LOG")" -eq "$n" ] || { echo "something was sent"; return 1; }
     "$J288" --config "$CFG" hold --duration 0.2 >/dev/null 2>"$SIM_DIR/l.err"
     [ $? -eq 2 ] && grep -q 'joint hip: at 2.9[0-9]* rad, beyond its limits \[-2.5, 2.5\]' "$SIM_DIR/l.err"
 }
@@ -249,19 +254,20 @@ t_limits_and_arguments() {
 # hold shows its progress on a terminal (a line redrawn in place), none when stderr is not
 # one; calibrate stopped by Ctrl-C says that nothing was written (and writes nothing).
 t_progress_and_interrupted_calibrate() {
-    local pid rc sum
+    local pid rc sum n
     fresh_sim progress || return 1
-    script -qec "J288_QUIET=1 $J288 --port $DEV hold --id 1 --margin-us 250000 --duration 0.7" /dev/null \
+    script -qec "J288_QUIET=1 $J288 --config $CFG hold --joint hip --duration 0.7" /dev/null \
         >"$SIM_DIR/tty.out" </dev/null || return 1
     grep -q $'\rhold servo 1: .*replies' "$SIM_DIR/tty.out" ||
         grep -q $'\rhold .*s  pos ' "$SIM_DIR/tty.out" || { echo "no progress: $(cat -v "$SIM_DIR/tty.out")"; return 1; }
-    "$J288" --port "$DEV" hold --margin-us 250000 --id 1 --duration 0.3 >/dev/null 2>"$SIM_DIR/q.err" || return 1
+    "$J288" --config "$CFG" hold --joint hip --duration 0.3 >/dev/null 2>"$SIM_DIR/q.err" || return 1
     ! grep -q $'\r' "$SIM_DIR/q.err" || return 1
     sum=$(md5sum <"$CFG")
+    n=$(lines "$LOG")
     "$J288" --config "$CFG" calibrate --joint hip >/dev/null 2>"$SIM_DIR/c.err" &
     pid=$!
     BG_PIDS+=("$pid")
-    logged "$LOG" ' id=1 status=1 wd=1' || return 1
+    logged "$LOG" ' id=1 status=1 wd=1' "$n" || return 1
     kill -INT "$pid"
     wait_exit "$pid" 60; rc=$?
     [ $rc -eq 130 ] && grep -q 'calibration interrupted (servo locked); nothing written' "$SIM_DIR/c.err" &&
