@@ -93,6 +93,21 @@ t_after_ctrl_c() {
 }
 
 have_python() { "$PY" -c 'import j288' 2>/dev/null; }
+# What the Python sessions share (a module in the scratch folder, on their PYTHONPATH).
+cat >"$SIM_DIR/host_stack_py.py" <<'EOF'
+import j288
+
+
+def first_status(bus):
+    """Servo 1's first status: a loaded machine may stall a fresh simulator past a margin."""
+    for _ in range(4):
+        try:
+            return bus.status(1)
+        except j288.NoReplyError:
+            pass
+    return bus.status(1)
+EOF
+export PYTHONPATH=$SIM_DIR:$PYTHONPATH
 
 # py_second_bus: a second Python session's Bus(port).command(1, pos=X, kp=20, kd=1), repeated
 # for 1 s, drives the joint to X (within the load's sag).
@@ -100,13 +115,7 @@ py_second_bus() {
     sleep "$SILENCE"
     "$PY" - "$DEV" <<'EOF'
 import sys, time, j288
-def first_status(bus):  # a loaded machine may stall the fresh simulator past one margin
-    for _ in range(4):
-        try:
-            return bus.status(1)
-        except j288.NoReplyError:
-            pass
-    return bus.status(1)
+from host_stack_py import first_status
 with j288.Bus(sys.argv[1], margin_us=250000) as bus:
     p = first_status(bus).pos
     x = p - 0.5 if p > 0 else p + 0.5  # joint frame: within [-pi, pi]
@@ -127,13 +136,7 @@ t_after_python_bus() {
     fresh_sim pybus || return 1
     "$PY" - "$DEV" <<'EOF' || return 1
 import sys, j288
-def first_status(bus):  # a loaded machine may stall the fresh simulator past one margin
-    for _ in range(4):
-        try:
-            return bus.status(1)
-        except j288.NoReplyError:
-            pass
-    return bus.status(1)
+from host_stack_py import first_status
 with j288.Bus(sys.argv[1], margin_us=250000) as bus:
     p = max(-3.0, min(3.0, first_status(bus).pos))  # the joint frame: within [-pi, pi]
     for _ in range(20):
