@@ -13,7 +13,7 @@ SO_NAME := libj288.so.$(J288_VERSION_MAJOR)
 SO_LIB := $(BUILD)/lib/libj288.so
 SO_REAL := $(BUILD)/lib/libj288.so.$(J288_VERSION)
 SO_SRC := $(LIB_SRC) port/linux/j288_linux.c host/j288_robot.c host/j288_host_wait.c \
-    host/j288_robot_config.c
+    host/j288_robot_config.c host/j288_number.c
 SO_OBJ := $(SO_SRC:%.c=$(OBJ)/pic/%.o)
 
 $(OBJ)/pic/%.o: %.c $(LIB_HDR) $(ROBOT_HDR) $(YAML_ENV)
@@ -44,7 +44,7 @@ ALL_TARGETS += $(SO_LIB)
 # runner's headers, pkg-config file, the Python package (with _installed.py: where its
 # prefix's shared library is, relative to the package).
 PYTHONDIR ?= $(PREFIX)/lib/python3/dist-packages
-PORT_HDR := port/linux/j288_linux.h host/j288_robot.h host/j288_robot_config.h
+PORT_HDR := port/linux/j288_linux.h host/j288_host_port.h host/j288_robot.h host/j288_robot_config.h
 .PHONY: install-release
 install-release: $(SO_LIB)
 	install -d $(DESTDIR)$(LIBDIR)/pkgconfig $(DESTDIR)$(INCLUDEDIR)/j288 $(DESTDIR)$(PYTHONDIR)/j288

@@ -24,11 +24,11 @@ TOOL_CPPFLAGS := $(HOST_CPPFLAGS) -D_XOPEN_SOURCE=700
 J288_SRC := $(sort $(wildcard tools/j288/*.c))
 J288_HDR := $(wildcard tools/j288/*.h)
 $(OBJ)/tools/j288/%.o: tools/j288/%.c $(J288_HDR) $(LIB_HDR) port/linux/j288_linux.h \
-    host/j288_robot_config.h
+    host/j288_robot_config.h host/j288_number.h
 	@mkdir -p $(@D)
 	$(CC) $(TOOL_CPPFLAGS) $(CFLAGS_COMMON) -c $< -o $@
 
-$(J288_BIN): $(J288_SRC:%.c=$(OBJ)/%.o) $(OBJ)/host/j288_robot_config.o $(LINUX_A) $(LIB_A)
+$(J288_BIN): $(J288_SRC:%.c=$(OBJ)/%.o) $(CONFIG_OBJ) $(LINUX_A) $(LIB_A)
 	@mkdir -p $(@D)
 	$(CC) $(CFLAGS_COMMON) $^ -o $@ $(LDFLAGS_COMMON) $(call yaml_var,YAML_LIBS) -lm
 
@@ -45,15 +45,22 @@ $(SIM_BIN): $(SIM_MODEL_OBJ) $(OBJ)/tools/j288-sim/sim_main.o $(LIB_A)
 # The robot config reader (host/j288_robot_config.c, not in the archive: it needs
 # libyaml). scripts/libyaml.sh finds libyaml (the system's, else Debian's package fetched into
 # $(BUILD)/libyaml) and writes the flags into $(YAML_ENV); without it the reader builds as
-# stubs that say so. Users: $(CONFIG_OBJ), and $(call yaml_var,YAML_LIBS) in a recipe.
+# stubs that say so. Users: $(CONFIG_OBJ) (the reader and the number syntax it shares with the
+# tool's options, $(NUMBER_OBJ)), and $(call yaml_var,YAML_LIBS) in a recipe.
 YAML_ENV := $(BUILD)/libyaml/libyaml.env
 yaml_var = $$(sed -n 's/^$(1)=//p' $(YAML_ENV))
-CONFIG_OBJ := $(OBJ)/host/j288_robot_config.o
+NUMBER_OBJ := $(OBJ)/host/j288_number.o
+CONFIG_OBJ := $(OBJ)/host/j288_robot_config.o $(NUMBER_OBJ)
 
 $(YAML_ENV):
 	bash scripts/libyaml.sh $(BUILD)/libyaml "$(CC)"
 
-$(CONFIG_OBJ): host/j288_robot_config.c host/j288_robot_config.h $(YAML_ENV)
+$(NUMBER_OBJ): host/j288_number.c host/j288_number.h
+	@mkdir -p $(@D)
+	$(CC) $(HOST_CPPFLAGS) $(CFLAGS_COMMON) -c $< -o $@
+
+$(OBJ)/host/j288_robot_config.o: host/j288_robot_config.c host/j288_robot_config.h host/j288_number.h \
+    $(YAML_ENV)
 	@mkdir -p $(@D)
 	$(CC) $(HOST_CPPFLAGS) $(call yaml_var,YAML_CFLAGS) $(CFLAGS_COMMON) -c $< -o $@
 

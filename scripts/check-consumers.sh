@@ -54,7 +54,8 @@ EOF
 # installed PREFIX: what an install must hold, then a find_package consumer against it.
 installed() {
     local p=$1 f
-    for f in include/j288/j288.h include/j288/j288_robot.h lib/libj288.a lib/libj288.so \
+    for f in include/j288/j288.h include/j288/j288_robot.h include/j288/j288_host_port.h \
+        lib/libj288.a lib/libj288.so \
         lib/pkgconfig/j288.pc lib/cmake/j288/j288Config.cmake bin/j288 bin/j288-sim; do
         [ -f "$p/$f" ] || { echo "check-consumers: $p/$f not installed" >&2; exit 1; }
     done

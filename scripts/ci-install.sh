@@ -26,7 +26,14 @@ packages=(
     # RISC-V (mk/cpu/rv32imac.mk): test-target and bench-bus-target on RV32 under QEMU
     gcc-riscv64-unknown-elf picolibc-riscv64-unknown-elf qemu-system-misc
     python3-pytest python3-numpy    # scripts/python-test.sh (make test: the Python package)
-    pkg-config                      # scripts/check-consumers.sh (a pkg-config consumer)
+    pkg-config                      # scripts/check-consumers.sh (a pkg-config consumer); mk/dds.mk
+    tmux                            # test/e2e/cli_top.sh: j288 top on a terminal (required
+                                    # under CI=true, skipped with a notice elsewhere)
+    cyclonedds-dev cyclonedds-tools # j288-dds (mk/dds.mk): libddsc, its pkg-config file, idlc
+    iproute2 util-linux             # the DDS tests' private network namespace (ip, unshare)
+    # Windows (mk/windows.mk): make windows cross-builds with mingw-w64, make test-windows runs
+    # the programs under Wine (64-bit only: no i386 packages, no X server; ~200 MB)
+    gcc-mingw-w64-x86-64-win32 wine wine64
 )
 
 missing=()

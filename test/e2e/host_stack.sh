@@ -65,16 +65,18 @@ second_hold() {
 
 t_after_cli_single() {
     fresh_sim single || return 1
-    "$J288" --config "$CFG" hold --joint hip --duration 0.3 --rate 200 >/dev/null || return 1
-    "$J288" --port "$DEV" stop --margin-us 250000 >/dev/null || return 1
+    "$J288" --config "$CFG" hold --joint hip --duration 0.3 --rate 200 >/dev/null 2>"$SIM_DIR/f.err" &&
+        "$J288" --port "$DEV" stop --margin-us 250000 >/dev/null 2>>"$SIM_DIR/f.err" ||
+        { echo "first session: $(cat "$SIM_DIR/f.err")"; return 1; }
     logged "$LOG" ' id=15 status=0 wd=0' || return 1
     second_hold
 }
 
 t_after_cli_robot() {
     fresh_sim robot || return 1
-    "$J288" --config "$CFG" hold --duration 0.3 >/dev/null || return 1
-    "$J288" --config "$CFG" stop >/dev/null || return 1
+    "$J288" --config "$CFG" hold --duration 0.3 >/dev/null 2>"$SIM_DIR/f.err" &&
+        "$J288" --config "$CFG" stop >/dev/null 2>>"$SIM_DIR/f.err" ||
+        { echo "first session: $(cat "$SIM_DIR/f.err")"; return 1; }
     second_hold
 }
 

@@ -35,23 +35,6 @@ start_sim() {
     sim_start_linked "$1" --exit-after 300 --truth "$TRUTH" "${@:2}"
 }
 
-truth_seq() { sed -n '1s/^# j288-sim truth seq=\([0-9]*\) .*/\1/p' "$TRUTH" 2>/dev/null; }
-# truth_now: ask the simulator for its truth (SIGWINCH) and wait until it is written.
-truth_now() {
-    local seq i
-    seq=$(truth_seq)
-    kill -s WINCH "$SIM_PID"
-    for i in $(seq 1 400); do
-        [ "$(truth_seq)" != "$seq" ] && return 0
-        sleep 0.05
-    done
-    echo "no truth written"; return 1
-}
-# truth_val ID KEY: the value of KEY on servo ID's line of the truth file.
-truth_val() {
-    awk -v id="$1" -v key="$2" '$1 == "id=" id {
-        for (i = 2; i <= NF; i++) { n = index($i, "="); if (substr($i, 1, n - 1) == key) print substr($i, n + 1) } }' "$TRUTH"
-}
 # wait_settled ID: up to 20 s for servo ID's true angle to stop changing.
 wait_settled() {
     local prev= cur i
@@ -75,17 +58,6 @@ wait_power_on() {
 }
 # jget FILE KEY: a top-level JSON value (empty when absent).
 jget() { python3 -c 'import json,sys; o=json.load(open(sys.argv[1])); v=o.get(sys.argv[2]); print("" if v is None else v)' "$1" "$2"; }
-# near A B TOL [PERIOD]: |A - B| <= TOL, modulo PERIOD when given (angles).
-near() {
-    python3 -c '
-import math, sys
-a, b, tol = float(sys.argv[1]), float(sys.argv[2]), float(sys.argv[3])
-d = a - b
-if len(sys.argv) > 4:
-    p = float(sys.argv[4]); d = math.remainder(d, p)
-sys.exit(0 if abs(d) <= tol else 1)' "$@" || { echo "|$1 - $2| > $3${4:+ (mod $4)}"; return 1; }
-}
-TWO_PI=6.283185307179586
 # status_json ID [more options]: status --json into $E2E_TMP/st.json.
 status_json() {
     local id=$1; shift
@@ -351,6 +323,19 @@ t_config_errors() {
     [ "$E2E_RC" -eq 0 ] && grep -q "^servo 1: zero -\?[0-9.]* rad (put 'zero: " <<<"$E2E_OUT" || { echo "zero: $E2E_OUT $E2E_ERR"; return 1; }
     e2e_run "$J288" --port "$DEV" calibrate --id 1 --range 0.04 --speed 0.04 "${M[@]}"
     [ "$E2E_RC" -eq 0 ] && grep -q "^put 'phase: " <<<"$E2E_OUT" || { echo "calibrate: $E2E_OUT $E2E_ERR"; return 1; }
+    # A relative port is the config file's folder's, wherever the tool runs.
+    mkdir -p "$E2E_TMP/robot" && ln -sf "$DEV" "$E2E_TMP/robot/bus0"
+    printf 'buses:\n  - {name: a, port: bus0, margin_us: 250000}\njoints:\n  - {name: j, id: 1}\n' >"$E2E_TMP/robot/robot.yaml"
+    status_joint j "$E2E_TMP/robot/robot.yaml" || return 1
+    # A read-only config: zero and calibrate refuse before sending anything (root too).
+    local frames
+    cp "$cfg" "$E2E_TMP/ro.yaml" && chmod 444 "$E2E_TMP/ro.yaml"
+    frames=$(grep -c 'id=1 ' "$SLOG")
+    expect_bad zero_read_only 1 "^j288 zero: $E2E_TMP/ro.yaml: read-only: .*; nothing was sent\$" \
+        "$J288" zero --joint j --config "$E2E_TMP/ro.yaml"
+    expect_bad calibrate_read_only 1 "^j288 calibrate: $E2E_TMP/ro.yaml: read-only: " \
+        "$J288" calibrate --joint j --config "$E2E_TMP/ro.yaml"
+    [ "$(grep -c 'id=1 ' "$SLOG")" = "$frames" ] || { echo "frames sent to a read-only config's joint"; return 1; }
     stop_sim
 }
 

@@ -47,7 +47,9 @@ void cli_set_error_stream(FILE *f);
 
 /* One line on stderr, prefixed and newline-terminated. */
 void cli_error(const char *fmt, ...)
-#if defined(__GNUC__)
+#if defined(__MINGW_PRINTF_FORMAT)
+    __attribute__((format(__MINGW_PRINTF_FORMAT, 1, 2))) /* C99 formats (%zu) on Windows */
+#elif defined(__GNUC__)
     __attribute__((format(printf, 1, 2)))
 #endif
     ;
@@ -65,6 +67,7 @@ int cli_cmd_log(int argc, char **argv, const cli_global_t *g);
 int cli_cmd_plot(int argc, char **argv, const cli_global_t *g);
 int cli_cmd_zero(int argc, char **argv, const cli_global_t *g);
 int cli_cmd_calibrate(int argc, char **argv, const cli_global_t *g);
+int cli_cmd_top(int argc, char **argv, const cli_global_t *g);
 /* log, status, hold, stop over every bus of a robot config (cmd_robot.c): taken instead of
  * the one-servo command when cli_robot_takes() says so (a --config, no --id or --joint). */
 int cli_cmd_robot(int argc, char **argv, const cli_global_t *g);
