@@ -810,6 +810,16 @@ int j288_robot_joint_id(const j288_robot_t *r, unsigned joint)
     return (r == NULL || joint >= r->njoints) ? -1 : (int)r->joint[joint].cfg.id;
 }
 
+int j288_robot_joint_config(const j288_robot_t *r, unsigned joint, j288_joint_config_t *out)
+{
+    if (r == NULL || out == NULL)
+        return J288_ERR_NULL;
+    if (joint >= r->njoints)
+        return J288_ERR_BAD_ARG;
+    *out = r->joint[joint].cfg;
+    return J288_OK;
+}
+
 int j288_robot_read(const j288_robot_t *r, unsigned joint, j288_robot_state_t *st)
 {
     const j288_joint_state_t *js;
@@ -1042,16 +1052,13 @@ static void servo_from_reply(const j288_txn_t *txn, j288_robot_servo_t *out)
     out->latency_us = txn->latency_us;
 }
 
-typedef struct {
-    bool done;
-    j288_txn_t txn;
-} txn_wait_t;
-
+/* The result lands in the bus object, not on the caller's stack: a transaction given up by
+ * run_txn()'s bound (a process frozen past it) still ends later, into memory that lives. */
 static void txn_done(void *user, const j288_txn_t *txn)
 {
-    txn_wait_t *w = user;
-    w->txn = *txn;
-    w->done = true;
+    j288_robot_bus_t *b = user;
+    b->txn = *txn;
+    b->txn_done = true;
 }
 
 /* One submit, driven by the runner's loop until it ends (its retries and reply budgets, the
@@ -1059,17 +1066,16 @@ static void txn_done(void *user, const j288_txn_t *txn)
 static int run_txn(j288_robot_t *r, j288_robot_bus_t *b, const j288_cmd_raw_t *cmd,
                    j288_txn_t *out)
 {
-    txn_wait_t w;
     uint32_t start = j288_linux_now_us(), bound = stop_bound_us(r);
     int rc;
-    memset(&w, 0, sizeof w);
-    rc = j288_bus_submit(&b->bus, cmd, start, txn_done, &w);
+    b->txn_done = false;
+    rc = j288_bus_submit(&b->bus, cmd, start, txn_done, b);
     if (rc != J288_OK)
         return rc;
     for (;;) {
         uint32_t now = j288_linux_now_us();
         poll_all(r, now);
-        if (w.done)
+        if (b->txn_done)
             break;
         if (!bus_live(b))
             return J288_ERR_OFFLINE;
@@ -1081,10 +1087,10 @@ static int run_txn(j288_robot_t *r, j288_robot_bus_t *b, const j288_cmd_raw_t *c
         wait_all(r, now, start + bound);
     }
     if (out != NULL)
-        *out = w.txn;
-    if (w.txn.result == J288_ERR_OFFLINE || !bus_live(b))
+        *out = b->txn;
+    if (b->txn.result == J288_ERR_OFFLINE || !bus_live(b))
         return J288_ERR_OFFLINE;
-    return w.txn.result;
+    return b->txn.result;
 }
 
 /* Servo id's joint for servo-level use (all-zero configuration), set up on first use. */

@@ -57,7 +57,11 @@
  *
  * Objects are caller-allocated (j288_robot_sizeof() for foreign callers), hold no heap memory
  * and must not move while open. One thread owns a robot; nothing here is ISR- or
- * signal-safe but the stop flag. Results are the library's codes (j288/error.h).
+ * signal-safe but the stop flag. on_event and on_cycle run on that thread from inside the
+ * runner's loop (a cycle, a transfer, a stop): they may read and set targets (read, set_target,
+ * set_targets, hold, lock), never call cycle, run, stop, transfer, exchange, idle or close,
+ * which would re-enter the loop (docs/architecture.md has the table for every layer).
+ * Results are the library's codes (j288/error.h).
  */
 #ifndef J288_ROBOT_H
 #define J288_ROBOT_H
@@ -227,6 +231,8 @@ typedef struct {
     bool swept_ok;       /* the sweep in progress had a good reply */
     uint8_t lock_under_foc[J288_MAX_SERVOS]; /* replies in lock mode to FOC commands in a row */
     j288_joint_t servo_joint[J288_MAX_SERVOS]; /* servo level's joint frame (exchanges) */
+    bool txn_done;       /* j288_robot_transfer()'s submit has ended (its result in txn) */
+    j288_txn_t txn;
     uint16_t servo_joint_on;                   /* bit id: servo_joint[id] initialised */
     uint8_t empty_run;   /* consecutive sweeps without a reply */
     uint32_t sweep_start_us;
@@ -322,6 +328,10 @@ const char *j288_robot_joint_name(const j288_robot_t *r, unsigned joint);
 const char *j288_robot_bus_name(const j288_robot_t *r, unsigned bus);
 int j288_robot_joint_bus(const j288_robot_t *r, unsigned joint);
 int j288_robot_joint_id(const j288_robot_t *r, unsigned joint);
+
+/* The joint's configuration as the joint layer took it (limits, gains with the defaults
+ * filled in, ...). Errors: J288_ERR_NULL, J288_ERR_BAD_ARG. */
+int j288_robot_joint_config(const j288_robot_t *r, unsigned joint, j288_joint_config_t *out);
 
 /* The joint's state after the latest cycle. Errors: J288_ERR_NULL, J288_ERR_BAD_ARG. */
 int j288_robot_read(const j288_robot_t *r, unsigned joint, j288_robot_state_t *st);

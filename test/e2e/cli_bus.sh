@@ -138,8 +138,10 @@ assert o["commands"] >= 1 and o["replies"] + o["failures"] == o["commands"], o
 assert o["failures"] <= max(1, o["commands"] // 20), o'
 expect_true move_ends_with_lock bash -c "grep 'id=2 ' '$MAIN_LOG' | tail -n 1 | grep -q 'status=0'"
 
+# (cut short by --duration: said so, exit 1; the last target stays in force with --keep)
 e2e_run "$J288" --port "$MAIN" move --id 2 --pos 10 --side rotor --speed 50 --duration 0.5 --keep "${M[@]}"
-if [ $E2E_RC -eq 0 ] && grep -q 'last command left in force' <<<"$E2E_OUT"; then e2e_pass move_keep; else
+if [ $E2E_RC -eq 1 ] && grep -q '^cut short by --duration: .*last command left in force' <<<"$E2E_OUT" &&
+    grep -q 'before reaching --pos 10 (last target left in force)' <<<"$E2E_ERR"; then e2e_pass move_keep; else
     e2e_fail move_keep "rc $E2E_RC out '$E2E_OUT' err '$E2E_ERR'"; fi
 expect_true move_keep_no_lock bash -c "grep 'id=2 ' '$MAIN_LOG' | tail -n 1 | grep -q 'status=1'"
 

@@ -181,7 +181,7 @@ t_wrap_high_range() {
 import csv, sys
 rows = [r for r in csv.DictReader(open(sys.argv[1])) if r["ok"] == "1"]
 assert rows and all(abs(float(r["pos_rad"]) - 6.2) < 0.005 for r in rows), rows[:3]' "$E2E_TMP/w1.csv" || return 1
-    expect_bad log_swing_refused 2 "^j288 log: joint j: --swing: target position outside the joint's limits \[5.8, 6.8\]" \
+    expect_bad log_swing_refused 2 "^j288 log: joint j: --swing to [0-9.]*: target position outside the joint's limits \[5.8, 6.8\]" \
         "$J288" log --config "$cfg" --id 1 --swing 1 --duration 1 "${M[@]}"
     stop_sim
 }
@@ -225,7 +225,7 @@ t_limits() {
     start_sim lim --ids 1 --start-angle 1:0.2 --quiet || return 1
     cfg=$(config l "  - name: j" "    id: 1" "    limits: [-0.5, 0.5]" "    max_torque: 1.0" "    max_speed: 2.0")
     frames=$(wc -l <"$SLOG")
-    expect_bad limits_pos_refused 2 "^j288 move: joint j: --pos: target position outside the joint's limits \[-0.5, 0.5\]; nothing sent$" \
+    expect_bad limits_pos_refused 2 "^j288 move: joint j: --pos 0.8: target position outside the joint's limits \[-0.5, 0.5\]; nothing sent$" \
         "$J288" move --joint j --config "$cfg" --pos 0.8
     expect_bad limits_default_range 2 "target position outside the joint's limits \[-3.14159, 3.14159\]" \
         "$J288" --port "$DEV" move --id 1 --pos 4
@@ -315,7 +315,7 @@ t_config_errors() {
     printf 'buses:\n  - {name: a, port: %s}\n  - {name: b, port: /nonexistent/j288}\njoints:\n  - {name: ja, bus: a, id: 1, limits: [-0.1, 0.1]}\n  - {name: jb, bus: b, id: 1}\n' "$DEV" >"$E2E_TMP/two.yaml"
     expect_bad config_id_two_buses 2 'id 1 is used on 2 buses: name the joint with --joint or the bus with --port' \
         "$J288" status --config "$E2E_TMP/two.yaml" --id 1
-    expect_bad config_id_by_port 2 'joint ja: --pos: .*\[-0.1, 0.1\]' \
+    expect_bad config_id_by_port 2 'joint ja: --pos 0.5: .*\[-0.1, 0.1\]' \
         "$J288" --port "$DEV" move --config "$E2E_TMP/two.yaml" --id 1 --pos 0.5
     status_joint ja "$E2E_TMP/two.yaml" || return 1
     # Without a config joint, zero and calibrate print the value.

@@ -176,16 +176,21 @@ int cli_bus_open(cli_bus_t *b, const cli_bus_opts_t *o, int default_retries)
     ro.retries = (uint8_t)(o->retries >= 0 ? o->retries : default_retries);
     rc = j288_robot_open_port(&robot, dev, &ro);
     if (rc != J288_OK) {
-        /* the runner prefixes "bus 'bus': "; the port's own message is what the user needs */
-        const char *msg = j288_robot_error(&robot);
-        const char *colon = strncmp(msg, "bus '", 5) == 0 ? strstr(msg, "': ") : NULL;
-        cli_error("%s", colon != NULL ? colon + 3 : msg);
-        return rc == J288_ERR_BAD_CONFIG && colon == NULL ? CLI_EXIT_USAGE : CLI_EXIT_FAIL;
+        cli_error("%s", cli_bus_error(b));
+        return CLI_EXIT_FAIL;
     }
     cli_print_notices(j288_robot_notices(&robot, 0));
     j288_robot_set_stop_flag(&robot, &cli_stop_signal);
     b->open = true;
     return CLI_EXIT_OK;
+}
+
+const char *cli_bus_error(const cli_bus_t *b)
+{
+    /* the runner prefixes "bus 'bus': "; the port's own message is what the user needs */
+    const char *msg = j288_robot_error(b->robot);
+    const char *colon = strncmp(msg, "bus '", 5) == 0 ? strstr(msg, "': ") : NULL;
+    return colon != NULL ? colon + 3 : msg;
 }
 
 void cli_bus_close(cli_bus_t *b)
@@ -276,10 +281,8 @@ int cli_bus_lock_driven(cli_bus_t *b)
 
 void cli_report_txn_failure(cli_bus_t *b, uint8_t id, int rc)
 {
-    const char *msg = j288_robot_error(b->robot);
-    const char *colon = strncmp(msg, "bus '", 5) == 0 ? strstr(msg, "': ") : NULL;
     if (rc == J288_ERR_OFFLINE || cli_bus_gone(b)) {
-        cli_error("%s", colon != NULL ? colon + 3 : msg);
+        cli_error("%s", cli_bus_error(b));
     } else if (rc == J288_ERR_TIMEOUT) {
         cli_error("no reply from servo %u on %s (check id, power, wiring and --baud)", (unsigned)id,
                   b->dev);

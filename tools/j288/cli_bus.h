@@ -114,6 +114,9 @@ int cli_bus_open(cli_bus_t *b, const cli_bus_opts_t *o, int default_retries);
 void cli_bus_close(cli_bus_t *b);
 /* Close leaving the last command in force (--keep). */
 void cli_bus_close_keep(cli_bus_t *b);
+/* The host layer's latest message without its "bus 'NAME': " prefix (one bus here). */
+const char *cli_bus_error(const cli_bus_t *b);
+
 /* Whether the device has vanished. */
 bool cli_bus_gone(const cli_bus_t *b);
 
@@ -189,9 +192,15 @@ void cli_joint_why_unknown(const j288_joint_t *j, const char *name, unsigned rep
 void cli_robot_fill_bus(const cli_robot_t *r, const j288_robot_config_joint_t *rj,
                         cli_bus_opts_t *o);
 
-/* One line for a library error on joint name's target: "joint hip: --pos 2: target position
- * outside the joint's limits [-1.5, 1.5]". */
-void cli_joint_target_error(const j288_joint_t *j, const char *name, const char *what, int rc);
+/* One line for a library error on joint name's target, naming the value and the limit:
+ * "hip: --pos 2: target position outside the joint's limits [-1.5, 1.5]; nothing sent". */
+void cli_joint_target_error(const j288_joint_t *j, const char *name, const char *what,
+                            double value, int rc);
+
+/* The gains of a drive: the command line's (have_*), else the file's joint's, else the host
+ * layer's defaults (J288_ROBOT_DEFAULT_KP / _KD: the same as the robot form's hold). */
+void cli_joint_gains(const j288_robot_config_joint_t *rj, bool have_kp, double kp, bool have_kd,
+                     double kd, double *out_kp, double *out_kd);
 
 /* How far beyond its limits a joint may be for hold and move to start: from the nearest
  * limit, so that the first command pulls it in by at most this (rad); the runner's hold

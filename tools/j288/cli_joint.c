@@ -241,21 +241,30 @@ int cli_joint_start_inside(const j288_joint_t *j, const char *name, double q, do
     return 0;
 }
 
-void cli_joint_target_error(const j288_joint_t *j, const char *name, const char *what, int rc)
+void cli_joint_target_error(const j288_joint_t *j, const char *name, const char *what,
+                            double value, int rc)
 {
     double lo, hi;
     joint_range(&j->cfg, &lo, &hi);
     if (rc == J288_ERR_LIMIT_POS) {
-        cli_error("%s: %s: %s [%g, %g]; nothing sent", name, what, j288_strerror(rc), lo, hi);
+        cli_error("%s: %s %g: %s [%g, %g]; nothing sent", name, what, value, j288_strerror(rc),
+                  lo, hi);
     } else if (rc == J288_ERR_LIMIT_SPEED) {
-        cli_error("%s: %s: %s (%g rad/s); nothing sent", name, what, j288_strerror(rc),
-                  (double)j->cfg.max_speed);
+        cli_error("%s: %s %g: %s (%g rad/s); nothing sent", name, what, value,
+                  j288_strerror(rc), (double)j->cfg.max_speed);
     } else if (rc == J288_ERR_LIMIT_TORQUE) {
-        cli_error("%s: %s: %s (%g N*m); nothing sent", name, what, j288_strerror(rc),
+        cli_error("%s: %s %g: %s (%g N*m); nothing sent", name, what, value, j288_strerror(rc),
                   (double)j->cfg.max_torque);
     } else {
-        cli_error("%s: %s: %s", name, what, j288_strerror(rc));
+        cli_error("%s: %s %g: %s", name, what, value, j288_strerror(rc));
     }
+}
+
+void cli_joint_gains(const j288_robot_config_joint_t *rj, bool have_kp, double kp, bool have_kd,
+                     double kd, double *out_kp, double *out_kd)
+{
+    *out_kp = have_kp ? kp : (rj != NULL && rj->has_kp ? rj->kp : J288_ROBOT_DEFAULT_KP);
+    *out_kd = have_kd ? kd : (rj != NULL && rj->has_kd ? rj->kd : J288_ROBOT_DEFAULT_KD);
 }
 
 void cli_json_joint_members(cli_json_t *jw, const j288_joint_t *j)

@@ -2,6 +2,7 @@
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "cli_bus.h"
 #include "frameview.h"
@@ -12,8 +13,6 @@
 /* Default gains, output side: gentle (a first try on real hardware should not snap), well
  * inside the wire range (kp 0..2128 N*m/rad, kd 0..21.28 N*m*s/rad on the output side);
  * kd gives a damping ratio near 0.7 on the simulator's rotor (2e-6 kg m^2). */
-#define DEFAULT_KP_OUTPUT         20.0
-#define DEFAULT_KD_OUTPUT         2.5
 #define DEFAULT_RATE_HZ           200.0
 #define DEFAULT_MOVE_SPEED_OUTPUT 1.0 /* rad/s */
 
@@ -447,8 +446,7 @@ static int plan_joint(const drive_args_t *d, drive_plan_t *p)
     const j288_joint_config_t *jc = &d->sel.jc;
     j288_cmd_raw_t probe;
     int rc;
-    p->jkp = d->have_kp ? d->kp : (d->sel.rj != NULL && d->sel.rj->has_kp ? (double)jc->kp : DEFAULT_KP_OUTPUT);
-    p->jkd = d->have_kd ? d->kd : (d->sel.rj != NULL && d->sel.rj->has_kd ? (double)jc->kd : DEFAULT_KD_OUTPUT);
+    cli_joint_gains(d->sel.rj, d->have_kp, d->kp, d->have_kd, d->kd, &p->jkp, &p->jkd);
     p->jspeed = d->have_speed ? d->speed : DEFAULT_MOVE_SPEED_OUTPUT;
     if (d->kind == DRIVE_TORQUE) {
         p->jkp = 0.0;
@@ -461,17 +459,23 @@ static int plan_joint(const drive_args_t *d, drive_plan_t *p)
         return si_error("--kd", p->jkd, rc);
     }
     if (d->kind == DRIVE_MOVE && !cli_joint_pos_allowed(jc, d->pos)) {
-        cli_joint_target_error(&d->j, d->sel.name, "--pos", J288_ERR_LIMIT_POS);
+        cli_joint_target_error(&d->j, d->sel.name, "--pos", d->pos, J288_ERR_LIMIT_POS);
         return -1;
     }
+    if (d->kind == DRIVE_MOVE) {
+        int16_t speed; /* the ramp's feed-forward: within the wire's range, checked now */
+        if ((rc = j288_speed_to_raw((j288_real_t)p->jspeed, J288_SIDE_OUTPUT, &speed)) != J288_OK) {
+            return si_error("--speed", p->jspeed, rc);
+        }
+    }
     if (d->kind == DRIVE_MOVE && jc->max_speed > 0 && !jc->clamp && p->jspeed > (double)jc->max_speed) {
-        cli_joint_target_error(&d->j, d->sel.name, "--speed", J288_ERR_LIMIT_SPEED);
+        cli_joint_target_error(&d->j, d->sel.name, "--speed", p->jspeed, J288_ERR_LIMIT_SPEED);
         return -1;
     }
     if (d->kind == DRIVE_TORQUE) {
         int16_t tau;
         if (jc->max_torque > 0 && !jc->clamp && fabs(d->tau) > (double)jc->max_torque) {
-            cli_joint_target_error(&d->j, d->sel.name, "--tau", J288_ERR_LIMIT_TORQUE);
+            cli_joint_target_error(&d->j, d->sel.name, "--tau", d->tau, J288_ERR_LIMIT_TORQUE);
             return -1;
         }
         if ((rc = j288_torque_to_raw((j288_real_t)d->tau, J288_SIDE_OUTPUT, &tau)) != J288_OK) {
@@ -493,9 +497,18 @@ static int plan_fields(const drive_args_t *d, drive_plan_t *p)
     if (d->side == SIDE_JOINT) {
         return plan_joint(d, p);
     }
+    if (d->sel.rj != NULL && d->sel.rj->has_limits && d->kind != DRIVE_TORQUE) {
+        /* The rotor and output frames count from power-up: a target there cannot be held to
+         * the joint's limits, so a joint that has limits is driven in its own frame. */
+        cli_error("%s: --side %s would bypass its limits [%g, %g]; drive it in the joint frame "
+                  "(the default); nothing sent",
+                  d->sel.name, d->side == SIDE_ROTOR ? "rotor" : "output",
+                  (double)d->sel.jc.pos_min, (double)d->sel.jc.pos_max);
+        return -1;
+    }
     if (d->kind != DRIVE_TORQUE) {
-        double kp = d->have_kp ? d->kp : DEFAULT_KP_OUTPUT;
-        double kd = d->have_kd ? d->kd : DEFAULT_KD_OUTPUT;
+        double kp = d->have_kp ? d->kp : J288_ROBOT_DEFAULT_KP; /* output side */
+        double kd = d->have_kd ? d->kd : J288_ROBOT_DEFAULT_KD;
         j288_side_t gain_side = d->have_kp ? side : J288_SIDE_OUTPUT;
         rc = j288_kp_to_raw((j288_real_t)kp, gain_side, &p->base.kp);
         if (rc != J288_OK) {
@@ -588,7 +601,43 @@ typedef struct {
     bool have_last;
     j288_cmd_raw_t last_cmd;
     double last_target; /* side joint: the latest target position */
+    bool reached;       /* move: the ramp got to --pos */
+    bool progress;      /* a progress line is on the terminal */
+    double shown_s;     /* when it was last redrawn */
 } drive_result_t;
+
+#define PROGRESS_EVERY_S 0.2
+
+/* On a terminal (stderr), one line redrawn in place: how long, where the servo is, the
+ * target. Quiet when stderr is not a terminal (scripts, logs). */
+static void drive_progress(const drive_args_t *d, drive_result_t *r, double t)
+{
+    static const char *const verb[] = {"hold", "move", "torque"};
+    if (!isatty(STDERR_FILENO) || t - r->shown_s < PROGRESS_EVERY_S || !r->have_last) {
+        return;
+    }
+    r->shown_s = t;
+    r->progress = true;
+    if (d->side == SIDE_JOINT) {
+        const j288_joint_state_t *st = j288_joint_state(&d->j);
+        fprintf(stderr, "\r%s %s: %6.1f s  pos %9.4f rad  target %9.4f rad  torque %7.3f N*m ",
+                verb[d->kind], d->sel.name, t, (double)st->pos, r->last_target,
+                (double)st->torque);
+    } else {
+        fprintf(stderr, "\r%s servo %lld: %6.1f s  %lu replies  %lu failed ", verb[d->kind],
+                d->id, t, (unsigned long)r->ok, (unsigned long)r->failed);
+    }
+    fflush(stderr);
+}
+
+/* End the progress line before anything else is printed. */
+static void drive_progress_end(drive_result_t *r)
+{
+    if (r->progress) {
+        fputc('\n', stderr);
+        r->progress = false;
+    }
+}
 
 static void drive_report_json(const drive_args_t *d, const drive_result_t *r, const char *how)
 {
@@ -720,7 +769,8 @@ static int joint_command_at(drive_args_t *d, const drive_plan_t *p, double t,
     joint_setpoint(d, p, t, &tg);
     rc = j288_joint_command(&d->j, &tg, cmd, NULL);
     if (rc != J288_OK) {
-        cli_joint_target_error(&d->j, d->sel.name, "target", rc);
+        drive_progress_end(res);
+        cli_joint_target_error(&d->j, d->sel.name, "target", (double)tg.pos, rc);
         return -1;
     }
     cmd->watchdog = d->watchdog;
@@ -741,8 +791,10 @@ static int drive_step(cli_bus_t *b, drive_args_t *d, const drive_plan_t *p, doub
         if (joint_command_at(d, p, t, res, &cmd) != 0) {
             return J288_ERR_ANGLE_UNKNOWN;
         }
+        res->reached = res->last_target == d->pos;
     } else {
         drive_setpoint(d, p, t, &cmd);
+        res->reached = cmd.pos == p->target_pos;
     }
     res->last_cmd = cmd;
     res->sent++;
@@ -753,6 +805,7 @@ static int drive_step(cli_bus_t *b, drive_args_t *d, const drive_plan_t *p, doub
         if (d->side == SIDE_JOINT) {
             (void)j288_joint_take_reply(&d->j, &txn.reply, &events);
             if ((events & J288_JOINT_EV_BIT(J288_JOINT_EV_ANGLE_LOST)) != 0u) {
+                drive_progress_end(res);
                 cli_error("%s: the joint angle was lost (rotor and output encoder differ by %.4f "
                           "rad: a power cycle or a slipped gear); lock sent",
                           d->sel.name, (double)j288_joint_state(&d->j)->residual);
@@ -768,7 +821,7 @@ static int drive_step(cli_bus_t *b, drive_args_t *d, const drive_plan_t *p, doub
 /* Refresh the command at --rate until --duration or a stop signal; a late cycle never
  * bursts to catch up. Gives up when the device goes away or after FAILS_BEFORE_GIVING_UP
  * failures in a row (then sending lock). */
-static drive_end_t drive_loop(cli_bus_t *b, drive_args_t *d, const drive_plan_t *p,
+static drive_end_t drive_loop_run(cli_bus_t *b, drive_args_t *d, const drive_plan_t *p,
                               drive_result_t *res)
 {
     uint32_t period_us = (uint32_t)lround(1e6 / d->rate_hz);
@@ -783,7 +836,9 @@ static drive_end_t drive_loop(cli_bus_t *b, drive_args_t *d, const drive_plan_t 
             return DRIVE_END_DONE;
         }
         rc = drive_step(b, d, p, t, res);
+        drive_progress(d, res, t);
         if (rc == J288_ERR_OFFLINE) {
+            drive_progress_end(res);
             cli_report_txn_failure(b, (uint8_t)d->id, rc);
             return DRIVE_END_GONE;
         }
@@ -794,6 +849,7 @@ static drive_end_t drive_loop(cli_bus_t *b, drive_args_t *d, const drive_plan_t 
         fails = rc == J288_OK ? 0 : fails + 1;
         if (fails >= FAILS_BEFORE_GIVING_UP) {
             (void)cli_bus_lock_driven(b);
+            drive_progress_end(res);
             cli_error("servo %lld stopped answering (%d commands in a row failed, last: %s); "
                       "lock sent",
                       d->id, fails, j288_strerror(rc));
@@ -806,10 +862,20 @@ static drive_end_t drive_loop(cli_bus_t *b, drive_args_t *d, const drive_plan_t 
             next = now;
         }
         if (cli_bus_sleep_until(b, next) == J288_ERR_OFFLINE) {
+            drive_progress_end(res);
             cli_report_txn_failure(b, (uint8_t)d->id, J288_ERR_OFFLINE);
             return DRIVE_END_GONE;
         }
     }
+}
+
+/* The loop, its progress line ended before whatever comes next is printed. */
+static drive_end_t drive_loop(cli_bus_t *b, drive_args_t *d, const drive_plan_t *p,
+                              drive_result_t *res)
+{
+    drive_end_t end = drive_loop_run(b, d, p, res);
+    drive_progress_end(res);
+    return end;
 }
 
 /* After the loop: lock the servo (unless --keep at the end of --duration), report. Returns
@@ -825,6 +891,13 @@ static int drive_finish(cli_bus_t *b, const drive_args_t *d, const drive_result_
             cli_error("servo %lld did not confirm the lock (a broadcast lock was sent)", d->id);
             return cli_stop_signal != 0 ? cli_signal_exit_code() : CLI_EXIT_FAIL;
         }
+    }
+    if (d->kind == DRIVE_MOVE && end == DRIVE_END_DONE && !res->reached) {
+        /* --duration ended the ramp before --pos: say so, and fail (a script must know). */
+        drive_report(d, res, "cut short by --duration", json);
+        cli_error("the move ended after --duration %g s before reaching --pos %g (%s)",
+                  d->duration_s, d->pos, d->keep ? "last target left in force" : "servo locked");
+        return CLI_EXIT_FAIL;
     }
     drive_report(d, res, end == DRIVE_END_SIGNAL ? "stopped by signal" : "done", json);
     return cli_stop_signal != 0 ? cli_signal_exit_code() : CLI_EXIT_OK;
@@ -859,7 +932,7 @@ static int run_drive(drive_args_t *d, cli_bus_opts_t *o)
     if ((ec = drive_start(&b, d, &plan, &res)) == CLI_EXIT_OK) {
         ec = drive_finish(&b, d, &res, drive_loop(&b, d, &plan, &res), o->json);
     }
-    if (ec == CLI_EXIT_OK && d->keep) {
+    if (d->keep && cli_stop_signal == 0) {
         cli_bus_close_keep(&b); /* --keep: the last command stays in force */
     } else {
         cli_bus_close(&b);

@@ -11,8 +11,6 @@
 #define CAL_DEFAULT_SPEED   0.05  /* rad/s: under half a count per reply at 200 Hz */
 #define CAL_DEFAULT_RATE_HZ 200.0
 #define CAL_LIMIT_MARGIN    0.01  /* rad kept from each limit */
-#define CAL_DEFAULT_KP      20.0  /* N*m/rad */
-#define CAL_DEFAULT_KD      2.5   /* N*m*s/rad */
 #define FAILS_BEFORE_GIVING_UP 25
 #define CAL_SETTLE_S        0.3   /* held at the start pose after the motion, before lock */
 
@@ -297,7 +295,7 @@ static int cal_move(cli_bus_t *b, j288_joint_t *j, j288_cal_t *cal, const cal_pa
         }
         rc = j288_joint_command(j, &t, &cmd, NULL);
         if (rc != J288_OK) {
-            cli_joint_target_error(j, name, "calibration motion", rc);
+            cli_joint_target_error(j, name, "calibration motion to", (double)t.pos, rc);
             return CLI_EXIT_FAIL;
         }
         rc = cli_bus_transfer(b, &cmd, &txn);
@@ -432,8 +430,7 @@ static int cal_run(cli_bus_t *b, const joint_args_t *a, const cli_joint_sel_t *s
         return CLI_EXIT_USAGE;
     }
     path.speed = a->speed;
-    path.kp = a->have_kp ? a->kp : (sel->rj != NULL && sel->rj->has_kp ? sel->rj->kp : CAL_DEFAULT_KP);
-    path.kd = a->have_kd ? a->kd : (sel->rj != NULL && sel->rj->has_kd ? sel->rj->kd : CAL_DEFAULT_KD);
+    cli_joint_gains(sel->rj, a->have_kp, a->kp, a->have_kd, a->kd, &path.kp, &path.kd);
     ec = cal_move(b, &joint, &cal, &path, a, sel->name);
     if (cli_bus_lock_driven(b) != 0 && ec == CLI_EXIT_OK) {
         cli_error("%s did not confirm the lock (a broadcast lock was sent)", sel->name);
@@ -498,6 +495,11 @@ int cli_cmd_calibrate(int argc, char **argv, const cli_global_t *g)
     memset(&r, 0, sizeof r);
     ec = cal_run(&b, &a, &sel, &jc, &r, &eps);
     cli_bus_close(&b);
+    if (cli_stop_signal != 0) {
+        cli_error("%s: calibration interrupted (servo locked); nothing written%s%s", sel.name,
+                  o.config != NULL ? " to " : "", o.config != NULL ? o.config : "");
+        return cli_signal_exit_code();
+    }
     if (ec != CLI_EXIT_OK) {
         return ec;
     }

@@ -317,13 +317,6 @@ static int sweep(cli_bus_t *b, uint32_t timeout_us)
     return rc == J288_ERR_TIMEOUT ? J288_OK : rc;
 }
 
-/* Why the bus failed (the runner's message, without its "bus 'bus': " prefix). */
-static const char *bus_error(const cli_bus_t *b)
-{
-    const char *msg = j288_robot_error(b->robot);
-    const char *colon = strncmp(msg, "bus '", 5) == 0 ? strstr(msg, "': ") : NULL;
-    return colon != NULL ? colon + 3 : msg;
-}
 
 typedef struct {
     uint32_t cycles, missed, skipped, rows;
@@ -620,7 +613,7 @@ static int log_probe(log_run_t *r)
             return cli_signal_exit_code();
         }
         if (rc == J288_ERR_OFFLINE) {
-            cli_error("%s", bus_error(&r->b));
+            cli_error("%s", cli_bus_error(&r->b));
             return CLI_EXIT_FAIL;
         }
     }
@@ -650,7 +643,8 @@ static int log_probe(log_run_t *r)
             }
             if (r->a.motion == MOTION_SWING &&
                 !cli_joint_pos_allowed(&r->sel[id].jc, r->q0[id] + r->a.amp)) {
-                cli_joint_target_error(&r->joint[id], r->sel[id].name, "--swing", J288_ERR_LIMIT_POS);
+                cli_joint_target_error(&r->joint[id], r->sel[id].name, "--swing to",
+                                       r->q0[id] + r->a.amp, J288_ERR_LIMIT_POS);
                 return CLI_EXIT_USAGE;
             }
         }
@@ -671,8 +665,12 @@ static void joint_cycle_command(log_run_t *r, uint8_t id, double t)
     double w = 2.0 * J288_PI / r->a.period_s;
     int rc;
     memset(&tg, 0, sizeof tg);
-    tg.kp = (j288_real_t)(r->a.have_kp ? r->a.kp : (r->sel[id].rj != NULL && r->sel[id].rj->has_kp ? r->sel[id].rj->kp : 20.0));
-    tg.kd = (j288_real_t)(r->a.have_kd ? r->a.kd : (r->sel[id].rj != NULL && r->sel[id].rj->has_kd ? r->sel[id].rj->kd : 2.5));
+    {
+        double kp, kd;
+        cli_joint_gains(r->sel[id].rj, r->a.have_kp, r->a.kp, r->a.have_kd, r->a.kd, &kp, &kd);
+        tg.kp = (j288_real_t)kp;
+        tg.kd = (j288_real_t)kd;
+    }
     tg.pos = (j288_real_t)r->q0[id];
     if (r->a.motion == MOTION_SWING) {
         tg.pos = (j288_real_t)(r->q0[id] + r->a.amp * 0.5 * (1.0 - cos(w * t)));
@@ -686,7 +684,7 @@ static void joint_cycle_command(log_run_t *r, uint8_t id, double t)
             j288_sched_set_cmd(r->s, &cmd);
             return;
         }
-        cli_joint_target_error(&r->joint[id], r->sel[id].name, "target", rc);
+        cli_joint_target_error(&r->joint[id], r->sel[id].name, "target", (double)tg.pos, rc);
         r->lost = (uint16_t)(r->lost | (1u << id));
     }
     cli_lock_cmd(id, &cmd);
@@ -812,7 +810,7 @@ static bool run_ends(const log_run_t *r, int rc, log_end_t *end)
         return true;
     }
     if (rc == J288_ERR_OFFLINE) {
-        cli_error("%s", bus_error(&r->b));
+        cli_error("%s", cli_bus_error(&r->b));
         *end = LOG_FAILED;
         return true;
     }

@@ -9,17 +9,19 @@
 
 #include "args.h"
 #include "cli.h"
+#include "json.h"
 
 static const char plot_help[] =
-    "usage: j288 plot FILE.csv --png OUT.png\n"
+    "usage: j288 plot FILE.csv --png OUT.png [--json]\n"
     "\n"
     "Draw position (with the commanded position dashed), speed and torque against time,\n"
-    "one line per servo, from a CSV written by `j288 log`, using gnuplot, in the frame the\n"
-    "log was written in (the joint frame unless log was given --side rotor or output).\n"
+    "one line per servo, from a CSV written by `j288 log` (either form: servos by --id, or\n"
+    "a robot config's joints), using gnuplot, in the frame the log was written in (the\n"
+    "joint frame unless log was given --side rotor or output). --json: the result as JSON.\n"
     "Exit status: 0 PNG written; 1 unreadable CSV or gnuplot failed; 2 bad arguments;\n"
     "3 gnuplot is not installed (install the Debian package gnuplot-nox).\n";
 
-enum { OPT_PNG };
+enum { OPT_PNG, OPT_JSON };
 
 /* gnuplot on PATH? */
 static bool have_program(const char *name)
@@ -208,7 +210,9 @@ static int write_script(FILE *gp, const char *csv, const char *png, uint32_t ids
 
 int cli_cmd_plot(int argc, char **argv, const cli_global_t *g)
 {
-    static const cli_opt_t opts[] = {{"--png", true, OPT_PNG}, {NULL, false, 0}};
+    static const cli_opt_t opts[] = {
+        {"--png", true, OPT_PNG}, {"--json", false, OPT_JSON}, {NULL, false, 0}};
+    bool json = false;
     const char *csv = NULL, *png = NULL, *v;
     char errfile[] = "/tmp/j288-plot.XXXXXX";
     char command[128];
@@ -233,6 +237,8 @@ int cli_cmd_plot(int argc, char **argv, const cli_global_t *g)
         }
         if (key == OPT_PNG) {
             png = v;
+        } else if (key == OPT_JSON) {
+            json = true;
         } else if (csv == NULL) {
             csv = v;
         } else {
@@ -301,6 +307,18 @@ int cli_cmd_plot(int argc, char **argv, const cli_global_t *g)
                   first_err);
         return CLI_EXIT_FAIL;
     }
-    printf("plotted %lu rows (servos %s) from %s to %s\n", rows, idlist, csv, png);
+    if (json) {
+        cli_json_t j;
+        cli_json_init(&j, stdout);
+        cli_json_begin_object(&j, NULL);
+        cli_json_uint(&j, "rows", rows);
+        cli_json_str(&j, "servos", idlist);
+        cli_json_str(&j, "csv", csv);
+        cli_json_str(&j, "png", png);
+        cli_json_end_object(&j);
+        cli_json_newline(&j);
+    } else {
+        printf("plotted %lu rows (servos %s) from %s to %s\n", rows, idlist, csv, png);
+    }
     return CLI_EXIT_OK;
 }

@@ -319,15 +319,25 @@ static int hold_all(j288_robot_t *r, robot_run_t *run)
     for (j = 0; j < j288_robot_njoints(r); j++) {
         j288_robot_state_t st;
         int rc = j288_robot_hold(r, j);
+        (void)j288_robot_read(r, j, &st);
+        if (rc == J288_ERR_LIMIT_POS) {
+            j288_joint_config_t jc;
+            (void)j288_robot_joint_config(r, j, &jc);
+            cli_error("joint %s: at %g rad, beyond its limits [%g, %g] by more than %g rad: "
+                      "nothing held; move it inside by hand",
+                      j288_robot_joint_name(r, j), st.pos, (double)jc.pos_min,
+                      (double)jc.pos_max, J288_ROBOT_HOLD_BEYOND_MAX);
+            return CLI_EXIT_USAGE;
+        }
         if (rc != J288_OK) {
             cli_error("joint %s: %s", j288_robot_joint_name(r, j), j288_strerror(rc));
-            return -1;
+            return CLI_EXIT_FAIL;
         }
         (void)j288_robot_read(r, j, &st);
         run->hold_pos[j] = st.pos;
     }
     run->held = true;
-    return 0;
+    return CLI_EXIT_OK;
 }
 
 /* stop: every bus on its own, so that a bus that cannot be opened does not keep the
@@ -463,8 +473,11 @@ int cli_cmd_robot(int argc, char **argv, const cli_global_t *g)
             return finish(&robot, CLI_EXIT_FAIL);
         }
     }
-    if ((a.hold || strcmp(cmd, "hold") == 0) && hold_all(&robot, &run) != 0)
-        return finish(&robot, CLI_EXIT_FAIL);
+    if (a.hold || strcmp(cmd, "hold") == 0) {
+        int held = hold_all(&robot, &run);
+        if (held != CLI_EXIT_OK)
+            return finish(&robot, held);
+    }
 
     /* log and hold: cycles at the rate; the statistics restart here (the start's cycles). */
     period_us = (a.rate_hz > 0.0) ? (uint32_t)(1e6 / a.rate_hz + 0.5) : 0u;
@@ -495,7 +508,7 @@ int cli_cmd_robot(int argc, char **argv, const cli_global_t *g)
             cli_error("%s", j288_robot_error(&robot));
         if (rc != J288_ERR_ABORTED || cli_stop_signal != 0) {
             double secs = (double)(j288_linux_now_us() - t0) * 1e-6;
-            if (a.json && strcmp(cmd, "log") == 0) {
+            if (a.json) {
                 cli_json_t jw;
                 cli_json_init(&jw, stdout);
                 cli_json_begin_object(&jw, NULL);
