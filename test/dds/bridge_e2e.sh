@@ -4,9 +4,9 @@
 # Checked: rt/joint_states carries the config's names and the simulator's true angles (0.002
 # rad); a rt/joint_command moves a joint there; silence holds it (the timeout, stderr and
 # diagnostics), or locks it (--on-timeout lock); each bad input (unknown name, arrays of
-# different lengths, a joint named twice, no values, NaN, infinity, outside the limits) is
-# refused with nothing sent, reported once however often it comes; a namespace moves the
-# topics; a servo watchdog trip is reported; Ctrl-C locks every bus; with --stop-on-bus-loss
+# different lengths, a joint named twice, no values, NaN, infinity, outside the limits; more
+# names than joints as its real cause) is refused with nothing sent, reported once however
+# often it comes; a namespace moves the topics; a servo watchdog trip is reported; Ctrl-C locks every bus; with --stop-on-bus-loss
 # a frozen bus locks all; bad options and a config too big for unitree mode are refused
 # before anything is opened.
 # Every wait polls and is bounded; no check depends on the machine's speed (replies get a
@@ -67,6 +67,20 @@ bad() {
     near "$before" "$after" 0.002 || { echo "leg0_3 moved: $before -> $after"; return 1; }
 }
 t_unknown_name() { bad leg0_3,leg9_9 'unknown joint name' 1,1 - -; }
+t_too_many_names() {
+    # more names than the robot can have joints (65 > J288_ROBOT_MAX_JOINTS), the first
+    # unknown: refused as an unknown name (counted: diagnostics then say 20), not reported as
+    # a joint named twice
+    local names=leg9_8 speeds=0 i
+    for i in $(seq 1 64); do names="$names,leg9_8"; speeds="$speeds,0"; done
+    "$PEER" command --count 10 --hz 100 "$names" - "$speeds" - || return 1
+    for i in $(seq 1 50); do
+        "$PEER" diag >"$SIM_DIR/diag" && grep -q "^j288-dds: bridge|unknown joint name=20$" "$SIM_DIR/diag" && break
+        sleep 0.1
+    done
+    grep -q "^j288-dds: bridge|unknown joint name=20$" "$SIM_DIR/diag" || { echo "not counted as unknown names"; return 1; }
+    ! grep -q 'joint named twice' "$SIM_DIR/bridge.err" || { echo "reported as a joint named twice"; return 1; }
+}
 t_lengths_differ() { bad leg0_3 'array lengths differ' 1,2 - -; }
 t_named_twice() { bad leg0_3,leg0_3 'joint named twice' 1,1 - -; }
 t_no_values() { bad leg0_3 'no joint or no values' - - -; }
@@ -80,7 +94,7 @@ t_infinity() {
 t_outside_limits() { bad leg0_3 "target outside the joint's limits" 4.0 - -; }
 t_refusals_in_diagnostics() {
     "$PEER" diag >"$SIM_DIR/diag" || return 1
-    grep -q "^j288-dds: bridge|unknown joint name=10$" "$SIM_DIR/diag" &&
+    grep -q "^j288-dds: bridge|unknown joint name=20$" "$SIM_DIR/diag" &&
         grep -q "^j288-dds: bridge|NaN or infinite value=30$" "$SIM_DIR/diag" &&
         grep -q '^j288-dds: bus leg1|sweeps=' "$SIM_DIR/diag" &&
         grep -q '^j288-dds: joint leg0_1|winding_temp_c=' "$SIM_DIR/diag"
@@ -159,6 +173,7 @@ e2e_check states_are_the_truth t_states_are_the_truth
 e2e_check command_moves_a_joint t_command_moves_a_joint
 e2e_check silence_holds t_silence_holds
 e2e_check unknown_name t_unknown_name
+e2e_check too_many_names t_too_many_names
 e2e_check lengths_differ t_lengths_differ
 e2e_check named_twice t_named_twice
 e2e_check no_values t_no_values

@@ -35,7 +35,7 @@
 #include "sensor_msgs.h"
 #include "unitree_go.h"
 
-#define MAXN 64
+#define MAXN 80 /* more than J288_ROBOT_MAX_JOINTS: the bridge must refuse that too */
 
 static dds_domainid_t domain;
 static const char *ns;

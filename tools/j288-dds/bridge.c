@@ -101,25 +101,28 @@ static bool check_command(bridge_t *b, const sensor_msgs_msg_dds__JointState_ *m
         bridge_refuse(b, BRIDGE_CAUSE_LENGTHS, detail);
         return false;
     }
-    if (n > J288_ROBOT_MAX_JOINTS) {
-        bridge_refuse(b, BRIDGE_CAUSE_DUPLICATE, "more names than the robot has joints");
-        return false;
-    }
+    /* No count check up front: more names than joints means an unknown name or a joint
+     * named twice, and that is what gets reported. With at most J288_ROBOT_MAX_JOINTS
+     * distinct joints, the name at index J288_ROBOT_MAX_JOINTS is refused before it would
+     * be stored. */
     for (i = 0; i < n; i++) {
         const char *name = m->name._buffer[i] != NULL ? m->name._buffer[i] : "";
-        idx[i] = j288_robot_find_joint(b->robot, name);
-        if (idx[i] < 0) {
+        int j = j288_robot_find_joint(b->robot, name);
+        if (j < 0) {
             snprintf(detail, sizeof detail, "'%.64s'", name);
             bridge_refuse(b, BRIDGE_CAUSE_UNKNOWN, detail);
             return false;
         }
         for (k = 0; k < i; k++) {
-            if (idx[k] == idx[i]) {
+            if (idx[k] == j) {
                 snprintf(detail, sizeof detail, "'%.64s'", name);
                 bridge_refuse(b, BRIDGE_CAUSE_DUPLICATE, detail);
                 return false;
             }
         }
+        if (i >= J288_ROBOT_MAX_JOINTS) /* unreachable (above); kept so idx[] cannot overflow */
+            return false;
+        idx[i] = j;
     }
     return true;
 }
