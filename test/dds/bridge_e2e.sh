@@ -6,9 +6,10 @@
 # diagnostics), or locks it (--on-timeout lock); each bad input (unknown name, arrays of
 # different lengths, a joint named twice, no values, NaN, infinity, outside the limits; more
 # names than joints as its real cause) is refused with nothing sent, reported once however
-# often it comes; a namespace moves the topics; a servo watchdog trip is reported; Ctrl-C locks every bus; with --stop-on-bus-loss
-# a frozen bus locks all; bad options and a config too big for unitree mode are refused
-# before anything is opened.
+# often it comes; a namespace moves the topics; a servo watchdog trip is reported; Ctrl-C
+# locks every bus; with --stop-on-bus-loss a frozen bus locks all; bad options and a config
+# too big for unitree mode are refused before anything is opened; the harness's truth()
+# fails on a simulator that never answers.
 # Every wait polls and is bounded; no check depends on the machine's speed (replies get a
 # 250 ms margin: the simulators may run under valgrind, make test-valgrind).
 set -u
@@ -26,7 +27,7 @@ t_states_are_the_truth() {
     for k in 0 1; do
         for j in 1 2 3; do
             got=$(awk -v n="leg${k}_$j" '$1 == n { print $2 }' "$SIM_DIR/states")
-            want=$(truth $k $j)
+            want=$(truth $k $j) || return 1
             [ -n "$got" ] && near "$got" "$want" 0.002 || { echo "leg${k}_$j: published $got, true $want"; return 1; }
         done
     done
@@ -39,15 +40,17 @@ t_command_moves_a_joint() {
     wait_err 'joint leg0_2: no command for 100 ms' || return 1
     sleep 0.3 # held: at rest
     "$PEER" states >"$SIM_DIR/states" || return 1
-    near "$(awk '$1 == "leg0_2" { print $2 }' "$SIM_DIR/states")" "$(truth 0 2)" 0.002 ||
-        { echo "leg0_2 published $(awk '$1 == "leg0_2" { print $2 }' "$SIM_DIR/states"), true $(truth 0 2)"; return 1; }
+    local got want
+    got=$(awk '$1 == "leg0_2" { print $2 }' "$SIM_DIR/states")
+    want=$(truth 0 2) || return 1
+    near "$got" "$want" 0.002 || { echo "leg0_2 published $got, true $want"; return 1; }
 }
 t_silence_holds() {
     local a b
-    a=$(truth 1 1)
+    a=$(truth 1 1) || return 1
     "$PEER" command --for 1 --hz 50 leg1_1 - 0.8 - || return 1
     wait_err 'joint leg1_1: no command for 100 ms: holding where it is' || return 1
-    b=$(truth 1 1)
+    b=$(truth 1 1) || return 1
     near "$a" "$b" 0.1 && { echo "the speed command did not move leg1_1 ($a -> $b)"; return 1; }
     sleep 0.5 # it was moving: let the hold bring it to rest
     still 1 1 || return 1
@@ -58,12 +61,12 @@ t_silence_holds() {
 # bad NAME CAUSE POS VEL EFF: sent 10 times, refused, reported once, leg0_3 does not move.
 bad() {
     local before after
-    before=$(truth 0 3)
+    before=$(truth 0 3) || return 1
     "$PEER" command --count 10 --hz 100 "$1" "$3" "$4" "$5" || return 1
     wait_err "command refused: $2" || return 1
     sleep 0.2
     reported_once "$2" || return 1
-    after=$(truth 0 3)
+    after=$(truth 0 3) || return 1
     near "$before" "$after" 0.002 || { echo "leg0_3 moved: $before -> $after"; return 1; }
 }
 t_unknown_name() { bad leg0_3,leg9_9 'unknown joint name' 1,1 - -; }
@@ -166,6 +169,16 @@ t_bad_options() {
     grep -q -- '--unitree: 21 joints, LowCmd_ has 20 motors' "$SIM_DIR/err" || return 1
     "$DDS" --help | grep -q 'rt/\[NS/\]joint_command'
 }
+t_stale_truth_fails() {
+    # the harness itself: a simulator that never rewrites its truth file fails the check
+    # (within truth's 8 s) instead of handing over the stale angle
+    local rc
+    kill -STOP "$SIM_PID_1"
+    truth 1 1 >/dev/null 2>&1; rc=$?
+    kill -CONT "$SIM_PID_1"
+    [ $rc -ne 0 ] || { echo "truth returned 0 for a stale file"; return 1; }
+    truth 1 1 >/dev/null
+}
 
 start_bridge || exit 1
 e2e_check bad_options t_bad_options
@@ -185,4 +198,5 @@ e2e_check watchdog_trip_reported t_watchdog_trip_reported
 e2e_check ctrl_c_locks_every_bus t_ctrl_c_locks_every_bus
 e2e_check timeout_locks t_timeout_locks
 e2e_check bus_loss_locks_all t_bus_loss_locks_all
+e2e_check stale_truth_fails t_stale_truth_fails
 e2e_summary
