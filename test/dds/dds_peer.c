@@ -164,7 +164,7 @@ typedef struct {
 typedef struct {
     uint8_t mode;
     float q, dq, ddq, tau_est, q_raw, dq_raw, ddq_raw;
-    int8_t temperature;
+    uint8_t temperature;
     uint32_t lost, reserve[2];
 } raw_motor_state;
 
@@ -173,12 +173,12 @@ typedef struct {
     uint32_t sn[2], version[2];
     uint16_t bandwidth;
     float quaternion[4], gyroscope[3], accelerometer[3], rpy[3];
-    int8_t imu_temperature;
+    uint8_t imu_temperature;
     raw_motor_state motor[20];
     uint8_t version_high, version_low, status, soc;
     int32_t current;
     uint16_t cycle;
-    int8_t bq_ntc[2], mcu_ntc[2];
+    uint8_t bq_ntc[2], mcu_ntc[2];
     uint16_t cell_vol[15];
     int16_t foot_force[4], foot_force_est[4];
     uint32_t tick;
@@ -317,9 +317,9 @@ static int cmd_lowstate(double timeout_s)
     if (read_one(&unitree_go_msg_dds__LowState__desc, "lowstate", timeout_s, &m) != 0)
         return 1;
     for (i = 0; i < 20; i++)
-        printf("motor %u %.6f %.6f %.6f %d %u\n", i, (double)m.motor_state[i].q,
+        printf("motor %u %.6f %.6f %.6f %u %u\n", i, (double)m.motor_state[i].q,
                (double)m.motor_state[i].dq, (double)m.motor_state[i].tau_est,
-               (int)m.motor_state[i].temperature, (unsigned)m.motor_state[i].mode);
+               (unsigned)m.motor_state[i].temperature, (unsigned)m.motor_state[i].mode);
     printf("power_v %.2f\ncrc %s %08lx %08lx\n", (double)m.power_v, lowstate_crc(&m) == m.crc ? "ok" : "bad", (unsigned long)m.crc, (unsigned long)lowstate_crc(&m));
     return 0;
 }

@@ -289,9 +289,10 @@ void bridge_fill_joint_state(bridge_t *b, sensor_msgs_msg_dds__JointState_ *m)
     m->velocity._length = m->velocity._maximum = m->effort._length = m->effort._maximum = n;
 }
 
-static int8_t temp_i8(double c)
+/* unitree_sdk2's uint8: below 0 deg C reads 0, not 200-something (docs/dds.md). */
+static uint8_t temp_u8(double c)
 {
-    return (int8_t)(c > 127.0 ? 127 : c < -128.0 ? -128 : lround(c));
+    return (uint8_t)(c > 255.0 ? 255 : c < 0.0 ? 0 : lround(c));
 }
 
 void bridge_fill_lowstate(bridge_t *b, unitree_go_msg_dds__LowState_ *m, uint32_t tick_ms)
@@ -313,7 +314,7 @@ void bridge_fill_lowstate(bridge_t *b, unitree_go_msg_dds__LowState_ *m, uint32_
         s->q = (float)st.pos;
         s->dq = (float)st.speed;
         s->tau_est = (float)st.torque;
-        s->temperature = temp_i8(st.winding_temp_c);
+        s->temperature = temp_u8(st.winding_temp_c);
         s->lost = js.stale_cycles;
         if (st.online) {
             volts += st.voltage_v;
