@@ -9,7 +9,7 @@
 # often it comes; a namespace moves the topics; a servo watchdog trip is reported; Ctrl-C
 # locks every bus; with --stop-on-bus-loss a frozen bus locks all; bad options and a config
 # too big for unitree mode are refused before anything is opened; the harness's truth()
-# fails on a simulator that never answers.
+# fails on a simulator that never answers; a frozen reliable reader stalls nothing.
 # Every wait polls and is bounded; no check depends on the machine's speed (replies get a
 # 250 ms margin: the simulators may run under valgrind, make test-valgrind).
 set -u
@@ -32,6 +32,25 @@ t_states_are_the_truth() {
         done
     done
     grep -q '^stamp [1-9]' "$SIM_DIR/states"
+}
+t_frozen_reader_does_not_stall() {
+    # a reliable joint_states reader that matched, took one sample and then froze (SIGSTOP:
+    # it neither takes nor acknowledges): another reader still gets the state, and the bridge
+    # loop still runs: a command moves a joint
+    local slow i got
+    "$PEER" listen --for 120 --freeze >/dev/null & slow=$!
+    for i in $(seq 1 150); do
+        [ "$(awk '{ print $3 }' /proc/$slow/stat 2>/dev/null)" = T ] && break
+        sleep 0.1
+    done
+    [ "$(awk '{ print $3 }' /proc/$slow/stat 2>/dev/null)" = T ] || { kill $slow; echo "the reader did not freeze"; return 1; }
+    got=$("$PEER" listen --for 2)
+    "$PEER" command --for 20 --hz 50 leg1_3 0.3 - - & local p=$!
+    wait_truth 1 3 0.3 20; i=$?
+    kill $p 2>/dev/null; wait $p 2>/dev/null
+    kill -CONT $slow; kill $slow; wait $slow 2>/dev/null
+    [ $i -eq 0 ] || return 1
+    [ "${got#samples }" -gt 0 ] || { echo "no state while a reader is frozen: $got"; return 1; }
 }
 t_command_moves_a_joint() {
     "$PEER" command --for 30 --hz 50 leg0_2 0.5 - - & local p=$!
@@ -183,6 +202,7 @@ t_stale_truth_fails() {
 start_bridge || exit 1
 e2e_check bad_options t_bad_options
 e2e_check states_are_the_truth t_states_are_the_truth
+e2e_check frozen_reader_does_not_stall t_frozen_reader_does_not_stall
 e2e_check command_moves_a_joint t_command_moves_a_joint
 e2e_check silence_holds t_silence_holds
 e2e_check unknown_name t_unknown_name
