@@ -1,7 +1,8 @@
 # The DDS bridge (tools/j288-dds, docs/dds.md) and its tests, built when Cyclone DDS is there
 # (Debian: cyclonedds-dev cyclonedds-tools, i.e. libddsc, its pkg-config file and idlc).
 #   make dds           $(DDS_BIN): build/bin/j288-dds (also built by `make` when found)
-#   test/dds/*.sh      golden XCDR1 bytes and the unitree crc, and the bridge end to end, each
+#   test/dds/*.sh      the namespace guard, golden XCDR1 bytes and the unitree crc, and the
+#                      bridge end to end, each
 #                      in a private network namespace (TEST_SCRIPTS)
 #   make test-dds      those tests alone (CI's test-dds step)
 #   make bench-dds     cycles/s with and without DDS, command-to-wire latency, DDS's CPU share
@@ -22,7 +23,7 @@ DDS_LIBS := $(shell pkg-config --libs CycloneDDS 2>/dev/null)
 DDS_TOOL_OBJ := $(addprefix $(OBJ)/tools/j288-dds/,bridge.o diag.o unitree_crc.o)
 DDS_TEST_PEER := $(BUILD)/test/dds_peer
 DDS_GOLDEN := $(BUILD)/test/dds_golden
-DDS_TESTS := test/dds/golden.sh test/dds/bridge_e2e.sh test/dds/unitree_e2e.sh
+DDS_TESTS := test/dds/netns_guard.sh test/dds/golden.sh test/dds/bridge_e2e.sh test/dds/unitree_e2e.sh
 
 ifeq ($(DDS_FOUND),yes)
 # idlc writes NAME.c and NAME.h; the .c stands for both.

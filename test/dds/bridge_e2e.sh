@@ -4,11 +4,12 @@
 # Checked: rt/joint_states carries the config's names and the simulator's true angles (0.002
 # rad); a rt/joint_command moves a joint there; silence holds it (the timeout, stderr and
 # diagnostics), or locks it (--on-timeout lock); each bad input (unknown name, arrays of
-# different lengths, a joint named twice, no values, NaN, infinity, outside the limits) is
-# refused with nothing sent, reported once however often it comes; a namespace moves the
-# topics; a servo watchdog trip is reported; Ctrl-C locks every bus; with --stop-on-bus-loss
-# a frozen bus locks all; bad options and a config too big for unitree mode are refused
-# before anything is opened.
+# different lengths, a joint named twice, no values, NaN, infinity, outside the limits; more
+# names than joints as its real cause) is refused with nothing sent, reported once however
+# often it comes; a namespace moves the topics; a servo watchdog trip is reported; Ctrl-C
+# locks every bus; with --stop-on-bus-loss a frozen bus locks all; bad options and a config
+# too big for unitree mode are refused before anything is opened; the harness's truth()
+# fails on a simulator that never answers; a frozen reliable reader stalls nothing.
 # Every wait polls and is bounded; no check depends on the machine's speed (replies get a
 # 250 ms margin: the simulators may run under valgrind, make test-valgrind).
 set -u
@@ -26,11 +27,30 @@ t_states_are_the_truth() {
     for k in 0 1; do
         for j in 1 2 3; do
             got=$(awk -v n="leg${k}_$j" '$1 == n { print $2 }' "$SIM_DIR/states")
-            want=$(truth $k $j)
+            want=$(truth $k $j) || return 1
             [ -n "$got" ] && near "$got" "$want" 0.002 || { echo "leg${k}_$j: published $got, true $want"; return 1; }
         done
     done
     grep -q '^stamp [1-9]' "$SIM_DIR/states"
+}
+t_frozen_reader_does_not_stall() {
+    # a reliable joint_states reader that matched, took one sample and then froze (SIGSTOP:
+    # it neither takes nor acknowledges): another reader still gets the state, and the bridge
+    # loop still runs: a command moves a joint
+    local slow i got
+    "$PEER" listen --for 120 --freeze >/dev/null & slow=$!
+    for i in $(seq 1 150); do
+        [ "$(awk '{ print $3 }' /proc/$slow/stat 2>/dev/null)" = T ] && break
+        sleep 0.1
+    done
+    [ "$(awk '{ print $3 }' /proc/$slow/stat 2>/dev/null)" = T ] || { kill $slow; echo "the reader did not freeze"; return 1; }
+    got=$("$PEER" listen --for 2)
+    "$PEER" command --for 20 --hz 50 leg1_3 0.3 - - & local p=$!
+    wait_truth 1 3 0.3 20; i=$?
+    kill $p 2>/dev/null; wait $p 2>/dev/null
+    kill -CONT $slow; kill $slow; wait $slow 2>/dev/null
+    [ $i -eq 0 ] || return 1
+    [ "${got#samples }" -gt 0 ] || { echo "no state while a reader is frozen: $got"; return 1; }
 }
 t_command_moves_a_joint() {
     "$PEER" command --for 30 --hz 50 leg0_2 0.5 - - & local p=$!
@@ -39,15 +59,17 @@ t_command_moves_a_joint() {
     wait_err 'joint leg0_2: no command for 100 ms' || return 1
     sleep 0.3 # held: at rest
     "$PEER" states >"$SIM_DIR/states" || return 1
-    near "$(awk '$1 == "leg0_2" { print $2 }' "$SIM_DIR/states")" "$(truth 0 2)" 0.002 ||
-        { echo "leg0_2 published $(awk '$1 == "leg0_2" { print $2 }' "$SIM_DIR/states"), true $(truth 0 2)"; return 1; }
+    local got want
+    got=$(awk '$1 == "leg0_2" { print $2 }' "$SIM_DIR/states")
+    want=$(truth 0 2) || return 1
+    near "$got" "$want" 0.002 || { echo "leg0_2 published $got, true $want"; return 1; }
 }
 t_silence_holds() {
     local a b
-    a=$(truth 1 1)
+    a=$(truth 1 1) || return 1
     "$PEER" command --for 1 --hz 50 leg1_1 - 0.8 - || return 1
     wait_err 'joint leg1_1: no command for 100 ms: holding where it is' || return 1
-    b=$(truth 1 1)
+    b=$(truth 1 1) || return 1
     near "$a" "$b" 0.1 && { echo "the speed command did not move leg1_1 ($a -> $b)"; return 1; }
     sleep 0.5 # it was moving: let the hold bring it to rest
     still 1 1 || return 1
@@ -58,15 +80,29 @@ t_silence_holds() {
 # bad NAME CAUSE POS VEL EFF: sent 10 times, refused, reported once, leg0_3 does not move.
 bad() {
     local before after
-    before=$(truth 0 3)
+    before=$(truth 0 3) || return 1
     "$PEER" command --count 10 --hz 100 "$1" "$3" "$4" "$5" || return 1
     wait_err "command refused: $2" || return 1
     sleep 0.2
     reported_once "$2" || return 1
-    after=$(truth 0 3)
+    after=$(truth 0 3) || return 1
     near "$before" "$after" 0.002 || { echo "leg0_3 moved: $before -> $after"; return 1; }
 }
 t_unknown_name() { bad leg0_3,leg9_9 'unknown joint name' 1,1 - -; }
+t_too_many_names() {
+    # more names than the robot can have joints (65 > J288_ROBOT_MAX_JOINTS), the first
+    # unknown: refused as an unknown name (counted: diagnostics then say 20), not reported as
+    # a joint named twice
+    local names=leg9_8 speeds=0 i
+    for i in $(seq 1 64); do names="$names,leg9_8"; speeds="$speeds,0"; done
+    "$PEER" command --count 10 --hz 100 "$names" - "$speeds" - || return 1
+    for i in $(seq 1 50); do
+        "$PEER" diag >"$SIM_DIR/diag" && grep -q "^j288-dds: bridge|unknown joint name=20$" "$SIM_DIR/diag" && break
+        sleep 0.1
+    done
+    grep -q "^j288-dds: bridge|unknown joint name=20$" "$SIM_DIR/diag" || { echo "not counted as unknown names"; return 1; }
+    ! grep -q 'joint named twice' "$SIM_DIR/bridge.err" || { echo "reported as a joint named twice"; return 1; }
+}
 t_lengths_differ() { bad leg0_3 'array lengths differ' 1,2 - -; }
 t_named_twice() { bad leg0_3,leg0_3 'joint named twice' 1,1 - -; }
 t_no_values() { bad leg0_3 'no joint or no values' - - -; }
@@ -80,7 +116,7 @@ t_infinity() {
 t_outside_limits() { bad leg0_3 "target outside the joint's limits" 4.0 - -; }
 t_refusals_in_diagnostics() {
     "$PEER" diag >"$SIM_DIR/diag" || return 1
-    grep -q "^j288-dds: bridge|unknown joint name=10$" "$SIM_DIR/diag" &&
+    grep -q "^j288-dds: bridge|unknown joint name=20$" "$SIM_DIR/diag" &&
         grep -q "^j288-dds: bridge|NaN or infinite value=30$" "$SIM_DIR/diag" &&
         grep -q '^j288-dds: bus leg1|sweeps=' "$SIM_DIR/diag" &&
         grep -q '^j288-dds: joint leg0_1|winding_temp_c=' "$SIM_DIR/diag"
@@ -152,13 +188,25 @@ t_bad_options() {
     grep -q -- '--unitree: 21 joints, LowCmd_ has 20 motors' "$SIM_DIR/err" || return 1
     "$DDS" --help | grep -q 'rt/\[NS/\]joint_command'
 }
+t_stale_truth_fails() {
+    # the harness itself: a simulator that never rewrites its truth file fails the check
+    # (within truth's 8 s) instead of handing over the stale angle
+    local rc
+    kill -STOP "$SIM_PID_1"
+    truth 1 1 >/dev/null 2>&1; rc=$?
+    kill -CONT "$SIM_PID_1"
+    [ $rc -ne 0 ] || { echo "truth returned 0 for a stale file"; return 1; }
+    truth 1 1 >/dev/null
+}
 
 start_bridge || exit 1
 e2e_check bad_options t_bad_options
 e2e_check states_are_the_truth t_states_are_the_truth
+e2e_check frozen_reader_does_not_stall t_frozen_reader_does_not_stall
 e2e_check command_moves_a_joint t_command_moves_a_joint
 e2e_check silence_holds t_silence_holds
 e2e_check unknown_name t_unknown_name
+e2e_check too_many_names t_too_many_names
 e2e_check lengths_differ t_lengths_differ
 e2e_check named_twice t_named_twice
 e2e_check no_values t_no_values
@@ -170,4 +218,5 @@ e2e_check watchdog_trip_reported t_watchdog_trip_reported
 e2e_check ctrl_c_locks_every_bus t_ctrl_c_locks_every_bus
 e2e_check timeout_locks t_timeout_locks
 e2e_check bus_loss_locks_all t_bus_loss_locks_all
+e2e_check stale_truth_fails t_stale_truth_fails
 e2e_summary

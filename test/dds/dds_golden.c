@@ -140,14 +140,14 @@ static void low_state(unitree_go_msg_dds__LowState_ *m)
     memcpy(m->imu_state.gyroscope, imu + 4, 3 * sizeof(float));
     memcpy(m->imu_state.accelerometer, imu + 7, 3 * sizeof(float));
     memcpy(m->imu_state.rpy, imu + 10, 3 * sizeof(float));
-    m->imu_state.temperature = -7;
+    m->imu_state.temperature = 249; /* -7 as unitree_ros2's int8 reads it */
     for (i = 0; i < 20u; i++) {
         unitree_go_msg_dds__MotorState_ *s = &m->motor_state[i];
         s->mode = (uint8_t)(i % 2u);
         s->q = 0.5f * (float)i;
         s->dq = -0.25f * (float)i;
         s->tau_est = 1.5f;
-        s->temperature = (int8_t)(30 + i);
+        s->temperature = (uint8_t)(30 + i);
         s->lost = 3u * i;
     }
     m->bms_state.version_high = 1;
@@ -156,10 +156,10 @@ static void low_state(unitree_go_msg_dds__LowState_ *m)
     m->bms_state.soc = 80;
     m->bms_state.current = -1500;
     m->bms_state.cycle = 42;
-    m->bms_state.bq_ntc[0] = -3;
+    m->bms_state.bq_ntc[0] = 253;
     m->bms_state.bq_ntc[1] = 4;
     m->bms_state.mcu_ntc[0] = 5;
-    m->bms_state.mcu_ntc[1] = -6;
+    m->bms_state.mcu_ntc[1] = 250;
     for (i = 0; i < 15u; i++)
         m->bms_state.cell_vol[i] = (uint16_t)(3700u + i);
     m->foot_force[0] = 10;

@@ -16,13 +16,17 @@
  *                             motors, then 'crc ok' or 'crc bad'
  *   lowcmd [--for S | --count N] [--hz H] [--bad-crc] MOTOR MODE Q DQ TAU KP KD
  *                             rt/lowcmd for one motor (the others mode 0), crc set (or wrong)
- *   listen [--for S]          read rt/joint_states for S seconds: 'samples N'
+ *   listen [--for S] [--freeze]
+ *                             read rt/joint_states for S seconds: 'samples N'; --freeze:
+ *                             stop itself (SIGSTOP) after the first sample, a matched
+ *                             reliable reader that neither takes nor acknowledges
  *   latency [--count N] [--hz H] NAME A B
  *                             commands for joint NAME alternating between positions A and B,
  *                             printing 'sent T_NS POS' for each (CLOCK_MONOTONIC at dds_write)
  * Exit 0 on success, 1 when nothing came within the timeout (default 10 s), 2 on bad usage.
  */
 #include <math.h>
+#include <signal.h>
 #include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -35,7 +39,7 @@
 #include "sensor_msgs.h"
 #include "unitree_go.h"
 
-#define MAXN 64
+#define MAXN 80 /* more than J288_ROBOT_MAX_JOINTS: the bridge must refuse that too */
 
 static dds_domainid_t domain;
 static const char *ns;
@@ -101,7 +105,7 @@ static int cmd_states(double timeout_s)
     return 0;
 }
 
-static int cmd_listen(double seconds)
+static int cmd_listen(double seconds, int freeze)
 {
     dds_entity_t pp = dds_create_participant(domain, NULL, NULL);
     dds_entity_t tp = make_topic(pp, &sensor_msgs_msg_dds__JointState__desc, "joint_states");
@@ -120,6 +124,8 @@ static int cmd_listen(double seconds)
         if (k > 0) {
             n += k;
             dds_return_loan(r, ptrs, k);
+            if (freeze)
+                raise(SIGSTOP); /* the test resumes (or kills) it */
         } else {
             dds_sleepfor(DDS_USECS(500));
         }
@@ -164,7 +170,7 @@ typedef struct {
 typedef struct {
     uint8_t mode;
     float q, dq, ddq, tau_est, q_raw, dq_raw, ddq_raw;
-    int8_t temperature;
+    uint8_t temperature;
     uint32_t lost, reserve[2];
 } raw_motor_state;
 
@@ -173,12 +179,12 @@ typedef struct {
     uint32_t sn[2], version[2];
     uint16_t bandwidth;
     float quaternion[4], gyroscope[3], accelerometer[3], rpy[3];
-    int8_t imu_temperature;
+    uint8_t imu_temperature;
     raw_motor_state motor[20];
     uint8_t version_high, version_low, status, soc;
     int32_t current;
     uint16_t cycle;
-    int8_t bq_ntc[2], mcu_ntc[2];
+    uint8_t bq_ntc[2], mcu_ntc[2];
     uint16_t cell_vol[15];
     int16_t foot_force[4], foot_force_est[4];
     uint32_t tick;
@@ -317,9 +323,9 @@ static int cmd_lowstate(double timeout_s)
     if (read_one(&unitree_go_msg_dds__LowState__desc, "lowstate", timeout_s, &m) != 0)
         return 1;
     for (i = 0; i < 20; i++)
-        printf("motor %u %.6f %.6f %.6f %d %u\n", i, (double)m.motor_state[i].q,
+        printf("motor %u %.6f %.6f %.6f %u %u\n", i, (double)m.motor_state[i].q,
                (double)m.motor_state[i].dq, (double)m.motor_state[i].tau_est,
-               (int)m.motor_state[i].temperature, (unsigned)m.motor_state[i].mode);
+               (unsigned)m.motor_state[i].temperature, (unsigned)m.motor_state[i].mode);
     printf("power_v %.2f\ncrc %s %08lx %08lx\n", (double)m.power_v, lowstate_crc(&m) == m.crc ? "ok" : "bad", (unsigned long)m.crc, (unsigned long)lowstate_crc(&m));
     return 0;
 }
@@ -480,7 +486,7 @@ static int cmd_latency(int count, double hz, char **argv)
 int main(int argc, char **argv)
 {
     double timeout_s = 10.0, seconds = 0.0, hz = 100.0;
-    int i = 1, bad_crc = 0, count = 0; /* latency: 100 when not given */
+    int i = 1, bad_crc = 0, freeze = 0, count = 0; /* latency: 100 when not given */
     const char *cmd;
     const char *env = getenv("DDS_DOMAIN");
     if (env != NULL)
@@ -503,6 +509,10 @@ int main(int argc, char **argv)
             bad_crc = 1;
             continue;
         }
+        if (strcmp(argv[i], "--freeze") == 0) {
+            freeze = 1;
+            continue;
+        }
         if (i + 1 >= argc)
             return 2;
         if (strcmp(argv[i], "--timeout") == 0)
@@ -521,7 +531,7 @@ int main(int argc, char **argv)
     if (strcmp(cmd, "states") == 0)
         return cmd_states(timeout_s);
     if (strcmp(cmd, "listen") == 0)
-        return cmd_listen(seconds);
+        return cmd_listen(seconds, freeze);
     if (strcmp(cmd, "diag") == 0)
         return cmd_diag(timeout_s);
     if (strcmp(cmd, "lowstate") == 0)

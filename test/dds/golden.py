@@ -104,16 +104,16 @@ def lowcmd_crc():
 
 
 # The LowState sample (the same in dds_golden.c): unitree's C struct LowState, 1180 bytes.
-LOWSTATE_FMT = ('<4B4IH2x' + '13fb3x' + 'B3x7fb3x3I' * 20 + '4BiH4b15H'
+LOWSTATE_FMT = ('<4B4IH2x' + '13fB3x' + 'B3x7fB3x3I' * 20 + '4BiH4B15H'
                 + '8hI40BB3xfBB2x2f4H2I')
 
 
 def lowstate_values():
     v = [0xFE, 0xEF, 0xFF, 0, 5, 6, 7, 8, 0x4321]
-    v += [1.0, 0.0, 0.0, 0.0, 0.5, -0.5, 0.25, 0.0, 0.0, 9.75, 0.125, -0.125, 3.0, -7]
+    v += [1.0, 0.0, 0.0, 0.0, 0.5, -0.5, 0.25, 0.0, 0.0, 9.75, 0.125, -0.125, 3.0, 249]
     for i in range(20):
         v += [i % 2, 0.5 * i, -0.25 * i, 0.0, 1.5, 0.0, 0.0, 0.0, 30 + i, i * 3, 0, 0]
-    v += [1, 2, 3, 80, -1500, 42, -3, 4, 5, -6] + [3700 + k for k in range(15)]
+    v += [1, 2, 3, 80, -1500, 42, 253, 4, 5, 250] + [3700 + k for k in range(15)]
     v += [10, -20, 30, -40, 1, 2, 3, 4, 123456] + [k for k in range(40)]
     v += [0x5A, 0.75, 33, 34, 24.5, -1.25, 100, 200, 300, 400, 0xCAFEF00D, 0]
     return v

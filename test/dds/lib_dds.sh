@@ -8,9 +8,27 @@
 
 DDS_DOMAIN=${DDS_DOMAIN:-87}
 
+# dds_private_netns: true when this process is in a network namespace of its own with
+# nothing but lo (read from the system, never from the environment: an inherited variable
+# would have the root user's `ip link` act on the host's lo). /proc/net is the caller's
+# namespace's; /proc/1/ns/net may be unreadable inside a user namespace, and is then skipped.
+dds_private_netns() {
+    local self init
+    [ "$(awk -F: 'NR > 2 { gsub(/ /, "", $1); print $1 }' /proc/net/dev)" = lo ] || return 1
+    self=$(readlink /proc/self/ns/net 2>/dev/null)
+    init=$(readlink /proc/1/ns/net 2>/dev/null)
+    [ -n "$self" ] && [ "$self" != "$init" ]
+}
+
 # dds_netns "$0" "$@": call first thing; returns inside the namespace.
 dds_netns() {
-    if [ "${J288_DDS_NETNS:-}" != 1 ]; then
+    if ! dds_private_netns; then
+        # unshare execs in place: J288_DDS_NETNS holding our own pid means this process ran
+        # unshare already (an inherited value holds another's pid and is ignored)
+        if [ "${J288_DDS_NETNS:-}" = $$ ]; then
+            echo "error: $1: not in a private network namespace after unshare -rn" >&2
+            exit 1
+        fi
         if ! unshare -rn true 2>/dev/null; then
             if [ "${CI:-}" = true ]; then
                 echo "error: unshare -rn fails here (CI=true: a failure): user namespaces needed" >&2
@@ -19,7 +37,7 @@ dds_netns() {
             echo "notice: skipping $1: unshare -rn (user namespaces) not available" >&2
             exit 0
         fi
-        J288_DDS_NETNS=1 exec unshare -rn bash "$@"
+        J288_DDS_NETNS=$$ exec unshare -rn bash "$@"
     fi
     # multicast on lo: the namespace is ours alone, and Cyclone's discovery then runs as usual
     ip link set lo up multicast on 2>/dev/null || { echo "cannot bring lo up in the namespace"; exit 1; }
@@ -53,17 +71,23 @@ near() {
 }
 
 # truth K ID: servo ID's true output angle on simulator K (asks for it with SIGWINCH and waits
-# until the truth file is rewritten).
+# until the truth file is rewritten, up to 8 s). Fails (a message, no angle) when the file is
+# not rewritten: a stale angle would let a check pass on old data. Callers check its status.
 truth() {
     local f=$SIM_DIR/truth.$1 seq pid i
     eval "pid=\$SIM_PID_$1"
     seq=$(sed -n '1s/.*seq=\([0-9]*\).*/\1/p' "$f" 2>/dev/null)
     kill -s WINCH "$pid"
     for i in $(seq 1 400); do
-        [ "$(sed -n '1s/.*seq=\([0-9]*\).*/\1/p' "$f" 2>/dev/null)" != "$seq" ] && break
+        if [ "$(sed -n '1s/.*seq=\([0-9]*\).*/\1/p' "$f" 2>/dev/null)" != "$seq" ]; then
+            awk -v id="$2" '$1 == "id=" id { sub("theta=", "", $2); print $2; found = 1 }
+                END { exit !found }' "$f"
+            return
+        fi
         sleep 0.02
     done
-    awk -v id="$2" '$1 == "id=" id { sub("theta=", "", $2); print $2 }' "$f"
+    echo "simulator $1 did not rewrite $f in 8 s" >&2
+    return 1
 }
 
 # start_bridge OPTIONS...: j288-dds on $SIM_DIR/robot.yaml (stderr in $SIM_DIR/bridge.err), once
@@ -118,7 +142,7 @@ reported_once() {
 wait_truth() {
     local i t near_before=0
     for i in $(seq 1 $((${4:-20} * 5))); do
-        t=$(truth "$1" "$2")
+        t=$(truth "$1" "$2") || return 1
         if near "$t" "$3" 0.01; then
             [ $near_before = 1 ] && return 0
             near_before=1
@@ -133,7 +157,7 @@ wait_truth() {
 # still K ID: servo ID of simulator K does not move over half a second (0.005 rad).
 still() {
     local a b
-    a=$(truth "$1" "$2"); sleep 0.5; b=$(truth "$1" "$2")
+    a=$(truth "$1" "$2") && sleep 0.5 && b=$(truth "$1" "$2") || return 1
     near "$a" "$b" 0.005 || { echo "servo $2 on simulator $1 moved: $a -> $b"; return 1; }
 }
 

@@ -21,7 +21,7 @@ t_lowstate_is_the_truth() {
     local m got want
     for m in 0 1 2; do
         got=$(awk -v m=$m '$1 == "motor" && $2 == m { print $3 }' "$SIM_DIR/ls")
-        want=$(truth 0 $((m + 1)))
+        want=$(truth 0 $((m + 1))) || return 1
         near "$got" "$want" 0.002 || { echo "motor $m: published $got, true $want"; return 1; }
     done
     [ "$(awk '$1 == "motor" && $2 >= 3 && ($3 != 0 || $6 != 0)' "$SIM_DIR/ls" | wc -l)" -eq 0 ] ||
@@ -43,12 +43,12 @@ t_silence_holds() {
 # bad_lowcmd CAUSE ARGS...: sent 10 times, refused, reported once, motor 2 does not move.
 bad_lowcmd() {
     local cause=$1 before after; shift
-    before=$(truth 0 3)
+    before=$(truth 0 3) || return 1
     "$PEER" lowcmd --count 10 --hz 100 "$@" || return 1
     wait_err "command refused: $cause" || return 1
     sleep 0.2
     reported_once "$cause" || return 1
-    after=$(truth 0 3)
+    after=$(truth 0 3) || return 1
     near "$before" "$after" 0.002 || { echo "motor 2 moved: $before -> $after"; return 1; }
 }
 t_bad_crc() { bad_lowcmd 'bad crc' --bad-crc 2 1 1.0 0 0 20 1; }

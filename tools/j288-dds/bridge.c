@@ -101,25 +101,28 @@ static bool check_command(bridge_t *b, const sensor_msgs_msg_dds__JointState_ *m
         bridge_refuse(b, BRIDGE_CAUSE_LENGTHS, detail);
         return false;
     }
-    if (n > J288_ROBOT_MAX_JOINTS) {
-        bridge_refuse(b, BRIDGE_CAUSE_DUPLICATE, "more names than the robot has joints");
-        return false;
-    }
+    /* No count check up front: more names than joints means an unknown name or a joint
+     * named twice, and that is what gets reported. With at most J288_ROBOT_MAX_JOINTS
+     * distinct joints, the name at index J288_ROBOT_MAX_JOINTS is refused before it would
+     * be stored. */
     for (i = 0; i < n; i++) {
         const char *name = m->name._buffer[i] != NULL ? m->name._buffer[i] : "";
-        idx[i] = j288_robot_find_joint(b->robot, name);
-        if (idx[i] < 0) {
+        int j = j288_robot_find_joint(b->robot, name);
+        if (j < 0) {
             snprintf(detail, sizeof detail, "'%.64s'", name);
             bridge_refuse(b, BRIDGE_CAUSE_UNKNOWN, detail);
             return false;
         }
         for (k = 0; k < i; k++) {
-            if (idx[k] == idx[i]) {
+            if (idx[k] == j) {
                 snprintf(detail, sizeof detail, "'%.64s'", name);
                 bridge_refuse(b, BRIDGE_CAUSE_DUPLICATE, detail);
                 return false;
             }
         }
+        if (i >= J288_ROBOT_MAX_JOINTS) /* unreachable (above); kept so idx[] cannot overflow */
+            return false;
+        idx[i] = j;
     }
     return true;
 }
@@ -286,9 +289,10 @@ void bridge_fill_joint_state(bridge_t *b, sensor_msgs_msg_dds__JointState_ *m)
     m->velocity._length = m->velocity._maximum = m->effort._length = m->effort._maximum = n;
 }
 
-static int8_t temp_i8(double c)
+/* unitree_sdk2's uint8: below 0 deg C reads 0, not 200-something (docs/dds.md). */
+static uint8_t temp_u8(double c)
 {
-    return (int8_t)(c > 127.0 ? 127 : c < -128.0 ? -128 : lround(c));
+    return (uint8_t)(c > 255.0 ? 255 : c < 0.0 ? 0 : lround(c));
 }
 
 void bridge_fill_lowstate(bridge_t *b, unitree_go_msg_dds__LowState_ *m, uint32_t tick_ms)
@@ -310,7 +314,7 @@ void bridge_fill_lowstate(bridge_t *b, unitree_go_msg_dds__LowState_ *m, uint32_
         s->q = (float)st.pos;
         s->dq = (float)st.speed;
         s->tau_est = (float)st.torque;
-        s->temperature = temp_i8(st.winding_temp_c);
+        s->temperature = temp_u8(st.winding_temp_c);
         s->lost = js.stale_cycles;
         if (st.online) {
             volts += st.voltage_v;

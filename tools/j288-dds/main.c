@@ -241,13 +241,17 @@ static dds_entity_t topic(dds_entity_t pp, const dds_topic_descriptor_t *desc, c
 
 /* Reliable keep-last-1 writers (they match reliable and best-effort readers alike, so ROS 2's
  * default and sensor-data subscribers both see the state); a best-effort reader keeping the
- * latest 32 commands (it matches every writer; commands are periodic, the newest counts). */
+ * latest 32 commands (it matches every writer; commands are periodic, the newest counts).
+ * The writers never block the loop: keep-last 1 already replaces an unacknowledged sample
+ * (a frozen reliable reader measured no slower, docs/dds.md), and a max blocking time of 0
+ * makes it a guarantee: a write that would wait fails at once and the next cycle's sample
+ * takes its place. */
 static int dds_open(dds_io_t *io, const options_t *o)
 {
     dds_qos_t *wq = dds_create_qos(), *rq = dds_create_qos();
     dds_entity_t st, dg, cm;
     int rc = 0;
-    dds_qset_reliability(wq, DDS_RELIABILITY_RELIABLE, DDS_MSECS(100));
+    dds_qset_reliability(wq, DDS_RELIABILITY_RELIABLE, 0);
     dds_qset_history(wq, DDS_HISTORY_KEEP_LAST, 1);
     dds_qset_reliability(rq, DDS_RELIABILITY_BEST_EFFORT, 0);
     dds_qset_history(rq, DDS_HISTORY_KEEP_LAST, TAKE_MAX);

@@ -125,7 +125,7 @@ void j288_dds_pack_lowstate(const unitree_go_msg_dds__LowState_ *m,
     put_f32s(&p, imu->gyroscope, 3u);
     put_f32s(&p, imu->accelerometer, 3u);
     put_f32s(&p, imu->rpy, 3u);
-    put_u8(&p, (uint8_t)imu->temperature);
+    put_u8(&p, imu->temperature);
     for (i = 0; i < 20u; i++) {
         const unitree_go_msg_dds__MotorState_ *s = &m->motor_state[i];
         align(&p, 4u);
@@ -137,7 +137,7 @@ void j288_dds_pack_lowstate(const unitree_go_msg_dds__LowState_ *m,
         put_f32(&p, s->q_raw);
         put_f32(&p, s->dq_raw);
         put_f32(&p, s->ddq_raw);
-        put_u8(&p, (uint8_t)s->temperature);
+        put_u8(&p, s->temperature);
         put_u32(&p, s->lost);
         put_u32(&p, s->reserve[0]);
         put_u32(&p, s->reserve[1]);
@@ -149,10 +149,10 @@ void j288_dds_pack_lowstate(const unitree_go_msg_dds__LowState_ *m,
     put_u8(&p, bms->soc);
     put_u32(&p, (uint32_t)bms->current);
     put_u16(&p, bms->cycle);
-    put_u8(&p, (uint8_t)bms->bq_ntc[0]);
-    put_u8(&p, (uint8_t)bms->bq_ntc[1]);
-    put_u8(&p, (uint8_t)bms->mcu_ntc[0]);
-    put_u8(&p, (uint8_t)bms->mcu_ntc[1]);
+    put_u8(&p, bms->bq_ntc[0]);
+    put_u8(&p, bms->bq_ntc[1]);
+    put_u8(&p, bms->mcu_ntc[0]);
+    put_u8(&p, bms->mcu_ntc[1]);
     put_u16s(&p, bms->cell_vol, 15u);
     align(&p, 4u); /* end of BmsState (size 44) */
     put_i16s(&p, m->foot_force, 4u);
