@@ -133,8 +133,9 @@ HOST_TESTS += $(CLI_TEST) $(foreach v,$(CODEC_CRC_VARIANTS),$(CODEC_CRC_TEST_NAM
     $(FUZZ_REPLAY_TESTS) $(LINUX_PORT_TEST) $(CONFIG_TEST) $(SIM_MODEL_TEST) $(STM32_TEST)
 TEST_SCRIPTS += test/e2e/cli_offline.sh test/e2e/cli_bus.sh tools/vectors/check-drift.sh \
     test/e2e/sim_cli.sh test/e2e/example_linux.sh test/abi/check-abi.sh
-# The joint frame end to end against the simulator's truth (the tool, the config, the sim).
-TEST_SCRIPTS += test/e2e/joint_sim.sh
+# The joint frame end to end against the simulator's truth (the tool, the config, the sim),
+# in three scripts that run side by side (test/e2e/lib_joint.sh).
+TEST_SCRIPTS += test/e2e/joint_seed.sh test/e2e/joint_range.sh test/e2e/joint_refuse.sh
 # The scripts' own process helpers (whom they signal, what their cleanup removes).
 TEST_SCRIPTS += test/e2e/lib_sim_check.sh
 TEST_DEPS += $(J288_BIN) $(SIM_BIN) $(EXAMPLE_LINUX) $(LIB_A)

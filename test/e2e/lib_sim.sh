@@ -56,7 +56,7 @@ stop_sim() {
 # wait_exit PID [SECONDS]: wait up to SECONDS (default 30) for PID to exit, returning as soon
 # as it does; its exit status, or 124 on time-out.
 wait_exit() {
-    for _ in $(seq 1 $((${2:-30} * 20))); do
+    for _ in $(seq 1 $(e2e_scaled $((${2:-30} * 20)))); do
         if ! kill -0 "$1" 2>/dev/null; then wait "$1"; return $?; fi
         sleep 0.05
     done
@@ -73,7 +73,7 @@ sim_start_linked() {
         >"$SIM_DIR/$name.out" 2>"$SIM_DIR/$name.err" &
     SIM_PID=$!
     SIM_PIDS+=("$SIM_PID")
-    for _ in $(seq 1 600); do
+    for _ in $(seq 1 "$(e2e_scaled 600)"); do
         [ -L "$DEV" ] && [ -s "$SIM_DIR/$name.out" ] && return 0
         sleep 0.05
     done
@@ -92,7 +92,7 @@ start_sims() {
         eval "SIM_PID_$k=$!"
     done
     for k in $(seq 0 $((n - 1))); do
-        for _ in $(seq 1 600); do [ -s "$SIM_DIR/pty.$k" ] && break; sleep 0.05; done
+        for _ in $(seq 1 "$(e2e_scaled 600)"); do [ -s "$SIM_DIR/pty.$k" ] && break; sleep 0.05; done
     done
 }
 
