@@ -17,7 +17,10 @@ WARN := -Wall -Wextra -Wpedantic -Wconversion -Wshadow -Werror
 CSTD := -std=c99
 OPT ?= -O2 -g
 CPPFLAGS_LIB := -Ilib/include
-CFLAGS_COMMON := $(CSTD) $(WARN) $(OPT) $(EXTRA_CFLAGS)
+# Every compile writes its object's header dependencies beside it (X.d, included below): touching
+# a header rebuilds the objects that include it, and only those.
+DEPFLAGS := -MMD -MP
+CFLAGS_COMMON := $(CSTD) $(WARN) $(OPT) $(DEPFLAGS) $(EXTRA_CFLAGS)
 LDFLAGS_COMMON := $(EXTRA_LDFLAGS)
 
 BIN := $(BUILD)/bin
@@ -44,7 +47,7 @@ SIM_BIN := $(BIN)/j288-sim
 UNITY := $(BUILD)/unity
 UNITY_OBJ := $(OBJ)/unity/unity.o
 UNITY_DEFS := -DUNITY_INCLUDE_DOUBLE -DUNITY_SUPPORT_64
-UNITY_CFLAGS := -std=c99 -O1 -g -I$(UNITY) $(UNITY_DEFS) $(EXTRA_CFLAGS)
+UNITY_CFLAGS := -std=c99 -O1 -g -I$(UNITY) $(UNITY_DEFS) $(DEPFLAGS) $(EXTRA_CFLAGS)
 
 # Shared test helpers, linked into every host unit test.
 TEST_SUPPORT_SRC := $(sort $(wildcard test/support/*.c))
@@ -75,9 +78,12 @@ include mk/robot.mk mk/release.mk mk/python.mk
 
 all: $(ALL_TARGETS)
 
+# The header dependencies of every object built so far (DEPFLAGS).
+-include $(shell find $(BUILD) -name '*.d' 2>/dev/null)
+
 lib: $(LIB_A)
 
-$(OBJ)/lib/%.o: lib/%.c $(LIB_HDR)
+$(OBJ)/lib/%.o: lib/%.c
 	@mkdir -p $(@D)
 	$(CC) $(CPPFLAGS_LIB) $(CFLAGS_COMMON) -c $< -o $@
 
@@ -95,7 +101,7 @@ $(UNITY_OBJ): $(UNITY)/unity.c
 	@mkdir -p $(@D)
 	$(CC) $(UNITY_CFLAGS) -c $< -o $@
 
-$(OBJ)/test/%.o: test/%.c $(TEST_HDR) $(UNITY)/unity.c
+$(OBJ)/test/%.o: test/%.c $(UNITY)/unity.c
 	@mkdir -p $(@D)
 	$(CC) $(TEST_CPPFLAGS) $(CFLAGS_COMMON) -c $< -o $@
 
@@ -104,7 +110,7 @@ $(BUILD)/test/%: $(OBJ)/test/unit/%.o $(TEST_SUPPORT_OBJ) $(UNITY_OBJ) $(LIB_A)
 	$(CC) $(CFLAGS_COMMON) $^ -o $@ $(LDFLAGS_COMMON) -lm
 
 # $(call RUN_TESTS,tests...): the runner, with what the test scripts expect to find.
-TEST_ENV = BUILD=$(BUILD) BIN=$(BIN) CC="$(CC)" J288_CFLAGS="$(CFLAGS_COMMON)" \
+TEST_ENV = BUILD=$(BUILD) BIN=$(BIN) CC="$(CC)" J288_CFLAGS="$(filter-out $(DEPFLAGS),$(CFLAGS_COMMON))" \
     J288_LDFLAGS="$(LDFLAGS_COMMON)"
 RUN_TESTS = $(TEST_ENV) bash scripts/run-tests.sh $(1)
 

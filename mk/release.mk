@@ -15,7 +15,7 @@ SO_REAL := $(BUILD)/lib/libj288.so.$(J288_VERSION)
 SO_SRC := $(LIB_SRC) port/linux/j288_linux.c host/j288_robot.c host/j288_robot_config.c
 SO_OBJ := $(SO_SRC:%.c=$(OBJ)/pic/%.o)
 
-$(OBJ)/pic/%.o: %.c $(LIB_HDR) $(ROBOT_HDR) $(YAML_ENV)
+$(OBJ)/pic/%.o: %.c $(YAML_ENV)
 	@mkdir -p $(@D)
 	$(CC) -fPIC $(HOST_CPPFLAGS) $(call yaml_var,YAML_CFLAGS) $(CFLAGS_COMMON) -c $< -o $@
 

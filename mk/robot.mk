@@ -3,14 +3,13 @@
 #   test/linux/test_robot.c   several j288-sim buses from one loop (HOST_TESTS)
 #   test/e2e/cli_robot.sh     j288 --config FILE log|status|hold|stop (TEST_SCRIPTS)
 ROBOT_OBJ := $(OBJ)/host/j288_robot.o
-ROBOT_HDR := host/j288_robot.h host/j288_robot_config.h port/linux/j288_linux.h
 
-$(ROBOT_OBJ): host/j288_robot.c $(ROBOT_HDR) $(LIB_HDR)
+$(ROBOT_OBJ): host/j288_robot.c
 	@mkdir -p $(@D)
 	$(CC) $(HOST_CPPFLAGS) $(CFLAGS_COMMON) -c $< -o $@
 
 ROBOT_TEST := $(BUILD)/test/test_robot
-$(OBJ)/test/linux/test_robot.o: test/linux/test_robot.c $(ROBOT_HDR) $(TEST_HDR) $(UNITY)/unity.c
+$(OBJ)/test/linux/test_robot.o: test/linux/test_robot.c $(UNITY)/unity.c
 	@mkdir -p $(@D)
 	$(CC) $(TEST_CPPFLAGS) -Iport/linux -Ihost -DJ288_SIM_DEFAULT='"$(SIM_BIN)"' $(CFLAGS_COMMON) -c $< -o $@
 
@@ -24,7 +23,6 @@ ALL_TARGETS += $(ROBOT_TEST)
 TEST_DEPS += $(SIM_BIN)
 
 # The j288 tool's robot commands (tools/j288/cmd_robot.c) use the runner and the config reader.
-$(OBJ)/tools/j288/cmd_robot.o: $(ROBOT_HDR)
 $(J288_BIN): $(ROBOT_OBJ) $(CONFIG_OBJ)
 # (the archives again after them: the tool's link rule lists its own prerequisites first)
 $(J288_BIN): LDFLAGS_COMMON += $(LINUX_A) $(LIB_A) $(call yaml_var,YAML_LIBS)

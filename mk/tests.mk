@@ -12,13 +12,12 @@
 
 # ---- the j288 tool's helpers -----------------------------------------------------------------
 CLI_TEST := $(BUILD)/test/test_cli_helpers
-$(OBJ)/test/cli/%.o: test/cli/%.c $(J288_HDR) $(TEST_HDR) $(UNITY)/unity.c
+$(OBJ)/test/cli/%.o: test/cli/%.c $(UNITY)/unity.c
 	@mkdir -p $(@D)
 	$(CC) $(TEST_CPPFLAGS) -Itools/j288 $(TOOL_CPPFLAGS) $(CFLAGS_COMMON) -c $< -o $@
 
 # The captured error stream both tool tests check (test/cli/cli_capture.c).
 CLI_CAPTURE_OBJ := $(OBJ)/test/cli/cli_capture.o
-$(CLI_CAPTURE_OBJ) $(OBJ)/test/cli/test_cli_helpers.o $(OBJ)/test/cli/test_cli_joint.o: test/cli/cli_capture.h
 
 $(CLI_TEST): $(OBJ)/test/cli/test_cli_helpers.o $(CLI_CAPTURE_OBJ) \
     $(addprefix $(OBJ)/tools/j288/,args.o hexparse.o json.o frameview.o report.o) $(UNITY_OBJ) $(LIB_A)
@@ -27,8 +26,7 @@ $(CLI_TEST): $(OBJ)/test/cli/test_cli_helpers.o $(CLI_CAPTURE_OBJ) \
 
 # The tool's robot config and joint selection (cli_joint.c), with the bus plumbing it calls.
 CLI_JOINT_TEST := $(BUILD)/test/test_cli_joint
-$(OBJ)/test/cli/test_cli_joint.o: test/cli/test_cli_joint.c $(J288_HDR) $(TEST_HDR) $(UNITY)/unity.c \
-    host/j288_robot_config.h $(YAML_ENV)
+$(OBJ)/test/cli/test_cli_joint.o: test/cli/test_cli_joint.c $(UNITY)/unity.c $(YAML_ENV)
 	@mkdir -p $(@D)
 	$(CC) $(TEST_CPPFLAGS) -Itools/j288 $(TOOL_CPPFLAGS) $(call yaml_var,YAML_CFLAGS) $(CFLAGS_COMMON) -c $< -o $@
 
@@ -67,11 +65,11 @@ FUZZ_REPLAY_TESTS := $(FUZZ_NAMES:%=$(BUILD)/test/fuzz_replay_%)
 FUZZ_EXTRA_cli := tools/j288/hexparse.c tools/j288/args.c
 FUZZ_CPPFLAGS_cli := -Itools/j288 $(TOOL_CPPFLAGS)
 
-$(OBJ)/test/fuzz/replay_%.o: test/fuzz/replay_main.c test/fuzz/fuzz_common.h
+$(OBJ)/test/fuzz/replay_%.o: test/fuzz/replay_main.c
 	@mkdir -p $(@D)
 	$(CC) -Itest/fuzz -DFUZZ_CORPUS_DIR='"test/fuzz/corpus/$*"' $(CFLAGS_COMMON) -c $< -o $@
 
-$(OBJ)/test/fuzz/fuzz_%.o: test/fuzz/fuzz_%.c $(TEST_HDR) $(wildcard test/fuzz/*.h)
+$(OBJ)/test/fuzz/fuzz_%.o: test/fuzz/fuzz_%.c
 	@mkdir -p $(@D)
 	$(CC) $(CPPFLAGS_LIB) -Itest/fuzz -Itest/support $(FUZZ_CPPFLAGS_$*) $(CFLAGS_COMMON) -c $< -o $@
 
@@ -82,21 +80,19 @@ $(foreach n,$(FUZZ_NAMES),$(eval $(BUILD)/test/fuzz_replay_$(n): $(FUZZ_EXTRA_$(
 
 # ---- the Linux port, the simulator's model, the STM32 port -----------------------------------
 LINUX_PORT_TEST := $(BUILD)/test/test_linux_port
-$(OBJ)/test/linux/%.o: test/linux/%.c port/linux/j288_linux.h $(TEST_HDR) $(UNITY)/unity.c
+$(OBJ)/test/linux/%.o: test/linux/%.c $(UNITY)/unity.c
 	@mkdir -p $(@D)
 	$(CC) $(TEST_CPPFLAGS) -Iport/linux -Ihost -DJ288_SIM_DEFAULT='"$(SIM_BIN)"' $(CFLAGS_COMMON) -c $< -o $@
 
 # j288-sim as a child process, for the tests that drive it (test/linux/sim_process.c).
 SIM_PROCESS_OBJ := $(OBJ)/test/linux/sim_process.o
-$(SIM_PROCESS_OBJ) $(OBJ)/test/linux/test_linux_port.o $(OBJ)/test/linux/test_robot.o: test/linux/sim_process.h
 
 $(LINUX_PORT_TEST): $(OBJ)/test/linux/test_linux_port.o $(SIM_PROCESS_OBJ) $(UNITY_OBJ) $(LINUX_A) $(LIB_A)
 	@mkdir -p $(@D)
 	$(CC) $(CFLAGS_COMMON) $^ -o $@ $(LDFLAGS_COMMON) -lm
 
 CONFIG_TEST := $(BUILD)/test/test_robot_config
-$(OBJ)/test/linux/test_robot_config.o: test/linux/test_robot_config.c host/j288_robot_config.h \
-    $(TEST_HDR) $(UNITY)/unity.c $(YAML_ENV)
+$(OBJ)/test/linux/test_robot_config.o: test/linux/test_robot_config.c $(UNITY)/unity.c $(YAML_ENV)
 	@mkdir -p $(@D)
 	$(CC) $(TEST_CPPFLAGS) -Iport/linux -Ihost $(call yaml_var,YAML_CFLAGS) $(CFLAGS_COMMON) -c $< -o $@
 
@@ -105,7 +101,7 @@ $(CONFIG_TEST): $(OBJ)/test/linux/test_robot_config.o $(CONFIG_OBJ) $(UNITY_OBJ)
 	$(CC) $(CFLAGS_COMMON) $^ -o $@ $(LDFLAGS_COMMON) $(call yaml_var,YAML_LIBS) -lm
 
 SIM_MODEL_TEST := $(BUILD)/test/test_sim_model
-$(OBJ)/test/sim/%.o: test/sim/%.c tools/j288-sim/servo_model.h $(TEST_HDR) $(UNITY)/unity.c
+$(OBJ)/test/sim/%.o: test/sim/%.c $(UNITY)/unity.c
 	@mkdir -p $(@D)
 	$(CC) $(TEST_CPPFLAGS) -Itools/j288-sim $(CFLAGS_COMMON) -c $< -o $@
 
@@ -116,10 +112,9 @@ $(SIM_MODEL_TEST): $(OBJ)/test/sim/test_sim_model.o $(SIM_MODEL_OBJ) $(UNITY_OBJ
 # Built with the D-cache maintenance on and a 32-byte receive buffer (a reply then crosses the
 # half-transfer point), so that both paths are exercised; the target tests use the same.
 STM32_TEST_DEFS := -DJ288_STM32_DCACHE=1 -DJ288_STM32_RX_BUF_SIZE=32u
-STM32_HDRS := $(wildcard port/stm32_hal/*.h test/stm32/*.h test/stm32/stub/*.h) $(TEST_HDR)
 STM32_TEST := $(BUILD)/test/test_stm32_port
 STM32_TEST_SRC := port/stm32_hal/j288_stm32.c test/stm32/fake_hal.c test/stm32/test_stm32_port.c
-$(OBJ)/stm32host/%.o: %.c $(STM32_HDRS) $(UNITY)/unity.c
+$(OBJ)/stm32host/%.o: %.c $(UNITY)/unity.c
 	@mkdir -p $(@D)
 	$(CC) $(TEST_CPPFLAGS) -Iport/stm32_hal -Itest/stm32/stub -Itest/stm32 $(STM32_TEST_DEFS) \
 	    $(CFLAGS_COMMON) -c $< -o $@

@@ -10,7 +10,7 @@
 
 LINUX_CPPFLAGS := $(CPPFLAGS_LIB) -Iport/linux
 HOST_CPPFLAGS := $(LINUX_CPPFLAGS) -Ihost
-$(OBJ)/port/linux/%.o: port/linux/%.c port/linux/j288_linux.h $(LIB_HDR)
+$(OBJ)/port/linux/%.o: port/linux/%.c
 	@mkdir -p $(@D)
 	$(CC) $(LINUX_CPPFLAGS) $(CFLAGS_COMMON) -c $< -o $@
 
@@ -22,9 +22,7 @@ $(LINUX_A): $(OBJ)/port/linux/j288_linux.o
 # The tools are POSIX programs (signals, realpath, popen for gnuplot); lib/ stays pure C99.
 TOOL_CPPFLAGS := $(HOST_CPPFLAGS) -D_XOPEN_SOURCE=700
 J288_SRC := $(sort $(wildcard tools/j288/*.c))
-J288_HDR := $(wildcard tools/j288/*.h)
-$(OBJ)/tools/j288/%.o: tools/j288/%.c $(J288_HDR) $(LIB_HDR) port/linux/j288_linux.h \
-    host/j288_robot_config.h
+$(OBJ)/tools/j288/%.o: tools/j288/%.c
 	@mkdir -p $(@D)
 	$(CC) $(TOOL_CPPFLAGS) $(CFLAGS_COMMON) -c $< -o $@
 
@@ -34,7 +32,7 @@ $(J288_BIN): $(J288_SRC:%.c=$(OBJ)/%.o) $(OBJ)/host/j288_robot_config.o $(LINUX_
 
 # The simulator: servo_model.c (servos and bus, no I/O) and sim_main.c (the pty front end).
 SIM_MODEL_OBJ := $(OBJ)/tools/j288-sim/servo_model.o
-$(OBJ)/tools/j288-sim/%.o: tools/j288-sim/%.c tools/j288-sim/servo_model.h $(LIB_HDR)
+$(OBJ)/tools/j288-sim/%.o: tools/j288-sim/%.c
 	@mkdir -p $(@D)
 	$(CC) $(CPPFLAGS_LIB) -Itools/j288-sim $(CFLAGS_COMMON) -c $< -o $@
 
@@ -53,12 +51,12 @@ CONFIG_OBJ := $(OBJ)/host/j288_robot_config.o
 $(YAML_ENV):
 	bash scripts/libyaml.sh $(BUILD)/libyaml "$(CC)"
 
-$(CONFIG_OBJ): host/j288_robot_config.c host/j288_robot_config.h $(YAML_ENV)
+$(CONFIG_OBJ): host/j288_robot_config.c $(YAML_ENV)
 	@mkdir -p $(@D)
 	$(CC) $(HOST_CPPFLAGS) $(call yaml_var,YAML_CFLAGS) $(CFLAGS_COMMON) -c $< -o $@
 
 EXAMPLE_LINUX := $(BIN)/linux-status
-$(OBJ)/examples/linux/%.o: examples/linux/%.c port/linux/j288_linux.h $(LIB_HDR)
+$(OBJ)/examples/linux/%.o: examples/linux/%.c
 	@mkdir -p $(@D)
 	$(CC) $(TOOL_CPPFLAGS) $(CFLAGS_COMMON) -c $< -o $@
 
