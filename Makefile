@@ -1,7 +1,7 @@
 # j288 - the build and the test suite (GNU Make; CMake in CMakeLists.txt serves consumers).
 #   make            library, tools, example and host tests into build/
 #   make test       every host test          make demo      the CLI against the simulator
-#   make install    PREFIX=/usr/local, DESTDIR honoured
+#   make install    PREFIX=/usr/local, DESTDIR honoured (CMake's install)  make uninstall
 #   make help       the other targets
 # This file holds what every area shares; mk/*.mk add an area each, mk/cpu/*.mk a CPU each.
 
@@ -67,7 +67,7 @@ TEST_SCRIPTS :=
 TEST_DEPS :=
 ALL_TARGETS := $(LIB_A) $(UNIT_TESTS)
 
-.PHONY: all lib test unit-tests unity clean help install
+.PHONY: all lib test unit-tests unity clean help install uninstall
 .DEFAULT_GOAL := all
 .SECONDARY:
 
@@ -121,22 +121,26 @@ test: $(HOST_TESTS) $(TEST_DEPS)
 	$(call RUN_TESTS,$(HOST_TESTS) $(TEST_SCRIPTS))
 
 # ---- install ---------------------------------------------------------------------------------
-# The static library, the public headers, the CMake package config (the same files
-# `cmake --install` writes, from cmake/*.in) and the two tools.
+# CMake owns the install (cmake/j288_install.cmake): `make install` configures, builds and
+# installs a CMake tree in $(CMAKE_BUILD) for PREFIX, honouring DESTDIR, and keeps the list of
+# what it wrote (CMake's manifest with DESTDIR in front) in $(INSTALLED); `make uninstall`
+# removes exactly those files, then the j288 directories they leave empty.
 PREFIX ?= /usr/local
-BINDIR ?= $(PREFIX)/bin
-LIBDIR ?= $(PREFIX)/lib
-INCLUDEDIR ?= $(PREFIX)/include
+CMAKE_BUILD := $(BUILD)/cmake
+INSTALLED := $(CMAKE_BUILD)/installed.txt
 J288_VERSION := $(shell sed -n 's/.*J288_VERSION_STRING "\(.*\)"/\1/p' lib/include/j288/j288.h)
 
-install: $(LIB_A) $(J288_BIN) $(SIM_BIN)
-	install -d $(DESTDIR)$(LIBDIR) $(DESTDIR)$(INCLUDEDIR)/j288 $(DESTDIR)$(BINDIR)
-	install -m 644 $(LIB_A) $(DESTDIR)$(LIBDIR)/
-	install -m 644 $(wildcard lib/include/j288/*.h) $(DESTDIR)$(INCLUDEDIR)/j288/
-	install -m 755 $(J288_BIN) $(SIM_BIN) $(DESTDIR)$(BINDIR)/
-	bash scripts/cmake-config.sh $(DESTDIR)$(LIBDIR)/cmake/j288 $(J288_VERSION) \
-	    $(patsubst $(PREFIX)/%,%,$(LIBDIR)) $(patsubst $(PREFIX)/%,%,$(INCLUDEDIR))
-	@# (mk/release.mk adds the shared library, j288.pc, the port headers, the Python package)
+install:
+	@$(call REQUIRE,cmake,cmake); \
+	 cmake -S . -B $(CMAKE_BUILD) -DCMAKE_INSTALL_PREFIX=$(PREFIX) $(CMAKE_FLAGS) >/dev/null && \
+	 cmake --build $(CMAKE_BUILD) -j2 && DESTDIR=$(DESTDIR) cmake --install $(CMAKE_BUILD) && \
+	 sed 's|^|$(DESTDIR)|' $(CMAKE_BUILD)/install_manifest.txt >$(INSTALLED)
+
+uninstall:
+	@[ -f $(INSTALLED) ] || { echo "uninstall: $(INSTALLED) missing: nothing installed from here"; exit 1; }
+	tr '\n' '\0' <$(INSTALLED) | xargs -0 rm -f
+	sed -n 's|^\(.*/j288\)/[^/]*$$|\1|p' $(INSTALLED) | sort -u | xargs -r rmdir --ignore-fail-on-non-empty
+	rm $(INSTALLED)
 
 clean:
 	rm -rf $(BUILD)
@@ -145,8 +149,9 @@ help:
 	@echo "make                build library, tools, example and host tests into $(BUILD)/"
 	@echo "make test           every host test (fetches Unity on first use)"
 	@echo "make demo           the CLI against the built-in servo simulator"
-	@echo "make install        static and shared library, headers, CMake package, j288.pc, j288,"
-	@echo "                    j288-sim, Python package (PREFIX, DESTDIR)"
+	@echo "make install        cmake --install: libraries, headers, CMake package, j288.pc, j288,"
+	@echo "                    j288-sim, man pages, completion, Python package (PREFIX, DESTDIR)"
+	@echo "make uninstall      removes what make install installed"
 	@echo "make shared python  libj288.so; and a copy in python/j288 (the Python package in place)"
 	@echo "make arm            lib/ for each Cortex-M, size table, STM32 example, port template"
 	@echo "make firmware       STM32 firmware per board against ST's HAL (bash scripts/fetch-st.sh first)"

@@ -133,6 +133,8 @@ TEST_SCRIPTS += test/e2e/cli_offline.sh test/e2e/cli_bus.sh tools/vectors/check-
 TEST_SCRIPTS += test/e2e/joint_seed.sh test/e2e/joint_range.sh test/e2e/joint_refuse.sh
 # The scripts' own process helpers (whom they signal, what their cleanup removes).
 TEST_SCRIPTS += test/e2e/lib_sim_check.sh
+# The bash completion (tools/completion/j288.bash) against the tools' --help.
+TEST_SCRIPTS += test/e2e/completion.sh
 TEST_DEPS += $(J288_BIN) $(SIM_BIN) $(EXAMPLE_LINUX) $(LIB_A)
 ALL_TARGETS += $(CLI_TEST) $(FUZZ_REPLAY_TESTS) $(LINUX_PORT_TEST) $(CONFIG_TEST) $(SIM_MODEL_TEST) \
     $(STM32_TEST)

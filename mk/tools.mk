@@ -41,15 +41,21 @@ $(SIM_BIN): $(SIM_MODEL_OBJ) $(OBJ)/tools/j288-sim/sim_main.o $(LIB_A)
 	$(CC) $(CFLAGS_COMMON) $^ -o $@ $(LDFLAGS_COMMON) -lm
 
 # The robot config reader (host/j288_robot_config.c, not in the archive: it needs
-# libyaml). scripts/libyaml.sh finds libyaml (the system's, else Debian's package fetched into
-# $(BUILD)/libyaml) and writes the flags into $(YAML_ENV); without it the reader builds as
-# stubs that say so. Users: $(CONFIG_OBJ), and $(call yaml_var,YAML_LIBS) in a recipe.
+# libyaml). pkg-config's yaml-0.1 (Debian's libyaml-dev), checked to link with $(CC), gives the
+# flags written into $(YAML_ENV); without it the reader builds as stubs that say so. Users:
+# $(CONFIG_OBJ), and $(call yaml_var,YAML_LIBS) in a recipe. Delete the file to look again.
 YAML_ENV := $(BUILD)/libyaml/libyaml.env
 yaml_var = $$(sed -n 's/^$(1)=//p' $(YAML_ENV))
 CONFIG_OBJ := $(OBJ)/host/j288_robot_config.o
 
 $(YAML_ENV):
-	bash scripts/libyaml.sh $(BUILD)/libyaml "$(CC)"
+	@mkdir -p $(@D)
+	@if c=$$(pkg-config --cflags yaml-0.1 2>/dev/null) && l=$$(pkg-config --libs yaml-0.1) && \
+	    printf '#include <yaml.h>\nint main(void) { yaml_parser_t p; return !yaml_parser_initialize(&p); }\n' | \
+	    $(CC) $(EXTRA_CFLAGS) $$c -x c - -x none $(EXTRA_LDFLAGS) $$l -o $(@D)/probe 2>/dev/null; then \
+	    printf 'YAML_CFLAGS=-DJ288_HAVE_LIBYAML %s\nYAML_LIBS=%s\n' "$$c" "$$l" >$@; \
+	else printf 'YAML_CFLAGS=\nYAML_LIBS=\n' >$@; \
+	    echo "libyaml: not found: building without robot config support (install libyaml-dev)"; fi
 
 $(CONFIG_OBJ): host/j288_robot_config.c $(YAML_ENV)
 	@mkdir -p $(@D)
