@@ -26,7 +26,10 @@ packages=(
     # RISC-V (mk/cpu/rv32imac.mk): test-target and bench-bus-target on RV32 under QEMU
     gcc-riscv64-unknown-elf picolibc-riscv64-unknown-elf qemu-system-misc
     python3-pytest python3-numpy    # scripts/python-test.sh (make test: the Python package)
-    pkg-config                      # scripts/check-consumers.sh (a pkg-config consumer)
+    pkg-config                      # libyaml's flags (mk/tools.mk); check-consumers.sh's consumer
+    help2man                        # the man pages of j288 and j288-sim (cmake/j288_tools.cmake)
+    python3-venv python3-setuptools python3-wheel python3-build  # make pip-check (no network)
+    debhelper dpkg-dev fakeroot lintian  # make deb, make deb-check (debian/)
 )
 
 missing=()

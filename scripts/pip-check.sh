@@ -1,0 +1,50 @@
+#!/usr/bin/env bash
+# usage: [BUILD=build] scripts/pip-check.sh   (make pip-check; CI step pip)
+# The Python package as pip installs it, without network (Debian's setuptools and wheel, hence
+# --system-site-packages): a fresh virtual environment, `pip install --no-build-isolation .`,
+# then from outside the tree `import j288` (the venv's copy, with the libj288.so built into it,
+# the header's version) scanning j288-sim's servos, the pytest suite against that installed
+# package (J288_LIB unset, python/ not on the path), and a wheel from `python3 -m build`
+# holding the library.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+missing=
+for m in venv:python3-venv build:python3-build pytest:python3-pytest wheel:python3-wheel; do
+    /usr/bin/python3 -c "import ${m%%:*}" 2>/dev/null || missing+=" ${m##*:}"
+done
+if [ -n "$missing" ]; then
+    echo "notice: skipping the pip check; install with: apt-get install -y --no-install-recommends$missing" >&2
+    [ "${CI:-}" != true ] || exit 1
+    exit 0
+fi
+BUILD=${BUILD:-build}
+root=$BUILD/pip
+rm -rf "$root" && mkdir -p "$root" && root=$(cd "$root" && pwd)
+sim=$(cd "${BIN:-$BUILD/bin}" && pwd)/j288-sim
+version=$(sed -n 's/.*J288_VERSION_STRING "\(.*\)"/\1/p' lib/include/j288/j288.h)
+quiet() { "$@" >"$root/last.log" 2>&1 || { cat "$root/last.log" >&2; return 1; }; }
+
+/usr/bin/python3 -m venv --system-site-packages "$root/v"
+quiet "$root/v/bin/pip" install --no-build-isolation --no-index .
+site=$("$root/v/bin/python" -c 'import sysconfig; print(sysconfig.get_paths()["purelib"])')
+out=$(cd / && env -u J288_LIB -u PYTHONPATH "$root/v/bin/python" -c 'import j288; print(j288.__file__, j288.__version__)')
+[ "$out" = "$site/j288/__init__.py $version" ] || { echo "pip-check: imported '$out'" >&2; exit 1; }
+echo "pip install: $out"
+
+timeout 60 "$sim" --ids 1,2,3 --link "$root/bus" --quiet --exit-after 60 >"$root/sim.out" 2>"$root/sim.err" &
+sim_pid=$!
+trap 'kill $sim_pid 2>/dev/null; wait $sim_pid 2>/dev/null' EXIT
+for _ in $(seq 1 600); do [ -s "$root/sim.out" ] && break; sleep 0.05; done
+out=$(cd / && env -u J288_LIB "$root/v/bin/python" -c \
+    'import sys, j288; print(sorted(j288.Bus(sys.argv[1], margin_us=250000).scan()))' "$root/bus")
+[ "$out" = "[1, 2, 3]" ] || { echo "pip-check: scan printed '$out'" >&2; exit 1; }
+echo "installed package scans j288-sim: $out"
+
+# pytest from its own directory, so that only the installed package can be imported.
+(cd python/tests && env -u J288_LIB PYTHONPATH= J288_SIM="$sim" PYTHONDONTWRITEBYTECODE=1 \
+    "$root/v/bin/python" -m pytest -q -p no:cacheprovider --import-mode=append . | tail -n 1)
+
+quiet /usr/bin/python3 -m build --wheel --no-isolation --outdir "$root/dist" .
+whl=$(ls "$root"/dist/j288-"$version"-*.whl)
+unzip -l "$whl" | grep -q ' j288/libj288.so$' || { echo "pip-check: $whl lacks libj288.so" >&2; exit 1; }
+echo "wheel: $(basename "$whl") with j288/libj288.so"
