@@ -30,3 +30,11 @@ $(SO_LIB): $(SO_REAL)
 
 shared: $(SO_LIB)
 ALL_TARGETS += $(SO_LIB)
+
+# The Debian packages (debian/, scripts/deb.sh): make deb builds them into $(BUILD)/deb and runs
+# lintian; make deb-check also installs them with apt, checks them and purges them.
+.PHONY: deb deb-check
+deb:
+	BUILD=$(BUILD) bash scripts/deb.sh build
+deb-check:
+	BUILD=$(BUILD) bash scripts/deb.sh check
