@@ -121,15 +121,12 @@ test: $(HOST_TESTS) $(TEST_DEPS)
 	$(call RUN_TESTS,$(HOST_TESTS) $(TEST_SCRIPTS))
 
 # ---- install ---------------------------------------------------------------------------------
-# CMake owns the install (cmake/j288_install.cmake): `make install` configures, builds and
-# installs a CMake tree in $(CMAKE_BUILD) for PREFIX, honouring DESTDIR, and keeps the list of
-# what it wrote (CMake's manifest with DESTDIR in front) in $(INSTALLED); `make uninstall`
-# removes exactly those files, then the j288 directories they leave empty.
+# CMake's install (cmake/j288_install.cmake) from a tree in $(CMAKE_BUILD), for PREFIX, under
+# DESTDIR; `make uninstall` removes the files it listed (in $(INSTALLED), with DESTDIR), then
+# the j288 directories they leave empty.
 PREFIX ?= /usr/local
 CMAKE_BUILD := $(BUILD)/cmake
 INSTALLED := $(CMAKE_BUILD)/installed.txt
-J288_VERSION := $(shell sed -n 's/.*J288_VERSION_STRING "\(.*\)"/\1/p' lib/include/j288/j288.h)
-
 install:
 	@$(call REQUIRE,cmake,cmake); \
 	 cmake -S . -B $(CMAKE_BUILD) -DCMAKE_INSTALL_PREFIX=$(PREFIX) $(CMAKE_FLAGS) >/dev/null && \

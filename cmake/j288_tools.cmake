@@ -72,20 +72,15 @@ endforeach()
 
 # Man pages from the tools' --help and --version (Debian's help2man), when it is there.
 find_program(J288_HELP2MAN help2man)
-set(J288_MAN_PAGES "")
+function(j288_man target name what)
+    add_custom_command(OUTPUT "${name}.1" COMMAND "${J288_HELP2MAN}" --no-info --name "${what}"
+        --output "${PROJECT_BINARY_DIR}/${name}.1" "$<TARGET_FILE:${target}>" DEPENDS ${target} VERBATIM)
+    add_custom_target(${target}_man ALL DEPENDS "${name}.1")
+endfunction()
 if(J288_HELP2MAN)
-    foreach(t j288_cli:j288:Unitree\ J288/S288\ servo\ bus\ tool j288_sim:j288-sim:simulated\ J288\ servo\ bus)
-        string(REPLACE ":" ";" t "${t}")
-        list(GET t 0 target)
-        list(GET t 1 name)
-        list(GET t 2 what)
-        add_custom_command(OUTPUT "${PROJECT_BINARY_DIR}/${name}.1"
-            COMMAND "${J288_HELP2MAN}" --no-info --section 1 --name "${what}"
-                    --output "${PROJECT_BINARY_DIR}/${name}.1" "$<TARGET_FILE:${target}>"
-            DEPENDS ${target} VERBATIM)
-        list(APPEND J288_MAN_PAGES "${PROJECT_BINARY_DIR}/${name}.1")
-    endforeach()
-    add_custom_target(j288_man ALL DEPENDS ${J288_MAN_PAGES})
+    j288_man(j288_cli j288 "Unitree J288/S288 servo bus tool")
+    j288_man(j288_sim j288-sim "simulated J288 servo bus")
+    set(J288_MAN_PAGES "${PROJECT_BINARY_DIR}/j288.1" "${PROJECT_BINARY_DIR}/j288-sim.1")
 else()
     message(STATUS "j288: help2man not found (Debian: help2man): no man pages")
 endif()

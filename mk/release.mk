@@ -3,10 +3,9 @@
 #                  multi-bus runner, position-independent, linked with libyaml (what the Python
 #                  package loads; C programs may link it too)
 #   make shared    that
-# The one version: J288_VERSION_STRING in lib/include/j288/j288.h (Makefile's J288_VERSION).
+# The one version: J288_VERSION_STRING in lib/include/j288/j288.h ($(J288_VERSION)).
 .PHONY: shared
 
-# (read here as well: the Makefile's own definition comes after the fragments)
 J288_VERSION := $(shell sed -n 's/.*J288_VERSION_STRING "\(.*\)"/\1/p' lib/include/j288/j288.h)
 J288_VERSION_MAJOR := $(word 1,$(subst ., ,$(J288_VERSION)))
 SO_NAME := libj288.so.$(J288_VERSION_MAJOR)

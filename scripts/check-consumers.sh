@@ -99,16 +99,16 @@ installed_python() {
     done
 }
 
-quiet cmake -S . -B "$root/host" -DCMAKE_BUILD_TYPE=RelWithDebInfo
-quiet cmake --build "$root/host" -j "$jobs"
-quiet cmake --install "$root/host" --prefix "$root/cmake-prefix"
-installed "$root/cmake-prefix" lib
-installed_python "$root/cmake-prefix"
-# make install with Debian's prefix (the libraries in the multiarch directory), then uninstall.
+# make install with Debian's prefix (the libraries in the multiarch directory), the same tree
+# installed with cmake --install --prefix elsewhere, then make uninstall.
 mk=(make -j"$jobs" BUILD="$root/make" PREFIX=/usr DESTDIR="$root/make-destdir")
 quiet "${mk[@]}" install
-installed "$root/make-destdir/usr" "lib/$(gcc -print-multiarch 2>/dev/null || echo .)"
+libdir=lib/$(gcc -print-multiarch 2>/dev/null || echo .)
+installed "$root/make-destdir/usr" "$libdir"
 installed_python "$root/make-destdir/usr"
+quiet cmake --install "$root/make/cmake" --prefix "$root/cmake-prefix"
+installed "$root/cmake-prefix" "$libdir"
+installed_python "$root/cmake-prefix"
 quiet "${mk[@]}" uninstall
 left=$(cd "$root/make-destdir" && find . ! -type d -o -name j288)
 [ -z "$left" ] || { echo "check-consumers: make uninstall left: $left" >&2; exit 1; }

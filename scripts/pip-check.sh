@@ -8,15 +8,9 @@
 # holding the library.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-missing=
-for m in venv:python3-venv build:python3-build pytest:python3-pytest wheel:python3-wheel; do
-    /usr/bin/python3 -c "import ${m%%:*}" 2>/dev/null || missing+=" ${m##*:}"
-done
-if [ -n "$missing" ]; then
-    echo "notice: skipping the pip check; install with: apt-get install -y --no-install-recommends$missing" >&2
-    [ "${CI:-}" != true ] || exit 1
-    exit 0
-fi
+/usr/bin/python3 -c 'import venv, build, pytest, wheel, setuptools' 2>/dev/null ||
+    bash scripts/need.sh python3-build-modules python3-venv python3-build python3-pytest \
+        python3-wheel python3-setuptools || exit $(($? == 1 ? 0 : 1))
 BUILD=${BUILD:-build}
 root=$BUILD/pip
 rm -rf "$root" && mkdir -p "$root" && root=$(cd "$root" && pwd)
@@ -46,5 +40,5 @@ echo "installed package scans j288-sim: $out"
 
 quiet /usr/bin/python3 -m build --wheel --no-isolation --outdir "$root/dist" .
 whl=$(ls "$root"/dist/j288-"$version"-*.whl)
-unzip -l "$whl" | grep -q ' j288/libj288.so$' || { echo "pip-check: $whl lacks libj288.so" >&2; exit 1; }
+grep -q ' j288/libj288.so$' <<<"$(unzip -l "$whl")" || { echo "pip-check: $whl lacks libj288.so" >&2; exit 1; }
 echo "wheel: $(basename "$whl") with j288/libj288.so"

@@ -40,7 +40,7 @@ report_ready() { # every finished test from $next on, in order
             failed=$((failed + 1))
             failed_names+=("$name")
             echo "FAIL  $name  (exit $rc, $secs) ${summary}"
-            grep -E ':FAIL|FAIL:|Error|error|Assert' "$log" | head -n 30 | sed 's/^/      /'
+            grep -E -B4 ':FAIL|FAIL:|Error|error|Assert' "$log" | head -n 40 | sed 's/^/      /' # with the reason before
             [ "$rc" -eq 124 ] && echo "      timed out after ${per_test_timeout}s"
             tail -n 15 "$log" | sed 's/^/    | /'
         fi
