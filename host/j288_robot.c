@@ -1,22 +1,21 @@
 /*
- * j288_robot.c - the multi-bus runner (see j288_robot.h for the contract).
+ * j288_robot.c - the host layer's runner (see j288_robot.h for the contract).
  *
- * The runner belongs to the Linux port: it reads the port object's descriptor and timer
- * (lp.fd, lp.timer_*) to put every bus into one ppoll(), and lets the port's own wait()
- * (with a deadline of now) read a ready device, so that reading, flushing and the
- * vanished-device handling stay in one place (j288_linux.c).
+ * Every bus is driven from one loop: poll each bus, then sleep in j288_host_wait() over all
+ * of their devices (the one OS-specific call, host/j288_host_wait.c) until bytes come or the
+ * earliest port deadline (j288_linux_next_deadline()), then let each ready port service
+ * itself (j288_linux_service()), so that reading, flushing and the vanished-device handling
+ * stay in the port. Cycles, single transactions (j288_robot_transfer()), idle waits and the
+ * stop all go through that loop.
  */
-#define _GNU_SOURCE 1 /* ppoll */
-
 #include "j288_robot.h"
 
-#include <errno.h>
-#include <poll.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <string.h>
 #include <sys/stat.h>
-#include <time.h>
+
+#include "j288_host_wait.h"
 
 /* While a transaction is pending, wake at least this often to let each bus check its reply
  * deadline (the port's timer gives the exact time when it is armed). */
@@ -51,6 +50,11 @@ static void emit(j288_robot_t *r, const j288_robot_event_t *ev)
 static void emit_bus(j288_robot_t *r, j288_robot_event_kind_t kind, unsigned bus)
 {
     j288_robot_event_t ev;
+    if (r->opt.stop_on_bus_loss && !r->bus_lost &&
+        (kind == J288_ROBOT_EV_BUS_DOWN || kind == J288_ROBOT_EV_BUS_GONE)) {
+        r->bus_lost = true;
+        r->lost_bus = bus;
+    }
     memset(&ev, 0, sizeof ev);
     ev.kind = kind;
     ev.bus = bus;
@@ -90,12 +94,56 @@ static void on_joint_event(void *user, const j288_joint_event_t *jev)
     emit(b->robot, &ev);
 }
 
+/* A lock command: no torque, watchdog bit 0 (the watchdog policy in j288_robot.h). */
+static void lock_cmd(uint8_t id, j288_cmd_raw_t *cmd)
+{
+    memset(cmd, 0, sizeof *cmd);
+    cmd->id = id;
+    cmd->status = J288_MODE_LOCK;
+    cmd->watchdog = false;
+}
+
+/* Clear servo id's watchdog trip (its next command goes out with the bit 0) and report it. */
+static void clear_trip(j288_robot_bus_t *b, uint8_t id, double why)
+{
+    j288_robot_event_t ev = servo_on_bus(b, J288_ROBOT_EV_WATCHDOG, id);
+    (void)j288_sched_clear_watchdog(&b->sched, id);
+    b->robot->wd_cleared++;
+    ev.value = why;
+    emit(b->robot, &ev);
+}
+
+/* The watchdog policy on a cycle's reply: a trip reported, or lock-mode replies to FOC
+ * commands twice in a row (once could be a command set while the previous one was on the
+ * wire), is cleared and reported. */
+static void watch_reply(j288_robot_bus_t *b, uint8_t id, const j288_slot_t *slot)
+{
+    bool ignored = slot->cmd.status == J288_MODE_FOC && slot->reply.status == J288_MODE_LOCK;
+    if (slot->reply.watchdog_tripped && !slot->clear_watchdog) {
+        b->lock_under_foc[id] = 0;
+        clear_trip(b, id, 1.0);
+    } else if (ignored && !slot->clear_watchdog && ++b->lock_under_foc[id] >= 2u) {
+        b->lock_under_foc[id] = 0;
+        clear_trip(b, id, 2.0);
+    } else if (!ignored) {
+        b->lock_under_foc[id] = 0;
+    }
+}
+
 static void on_reply(void *user, uint8_t id, const j288_slot_t *slot)
 {
     j288_robot_bus_t *b = user;
     b->swept_ok = true;
+    if (id >= J288_MAX_SERVOS)
+        return;
+    watch_reply(b, id, slot);
     j288_joint_bus_on_reply(&b->jb, id, slot);
-    if (id < J288_MAX_SERVOS && b->joint_of[id] >= 0)
+    if (slot->cmd.status == J288_MODE_LOCK && slot->cmd.watchdog) {
+        j288_cmd_raw_t lock; /* the joint layer's safe lock (angle lost): bit 0 as every lock */
+        lock_cmd(id, &lock);
+        (void)j288_sched_set_cmd(&b->sched, &lock);
+    }
+    if (b->joint_of[id] >= 0)
         b->robot->fresh_at[b->joint_of[id]] = b->robot->cycle;
 }
 
@@ -132,14 +180,11 @@ static void on_sweep(void *user, uint32_t sweep, uint32_t now_us)
 
 static void reset_robot(j288_robot_t *r, const j288_robot_options_t *opt)
 {
-    unsigned i;
     memset(r, 0, sizeof *r);
     if (opt != NULL)
         r->opt = *opt;
     if (r->opt.down_after == 0u)
         r->opt.down_after = J288_ROBOT_DEFAULT_DOWN_AFTER;
-    for (i = 0; i < J288_ROBOT_MAX_BUSES; i++)
-        r->bus[i].lp.fd = -1;
     r->cycle = 1;
 }
 
@@ -210,7 +255,7 @@ static int check_same_device(j288_robot_t *r, unsigned i, const char *port)
     if (stat(port, &si) != 0)
         return J288_OK;
     for (k = 0; k < i; k++) {
-        if (fstat(r->bus[k].lp.fd, &sk) == 0 && si.st_rdev == sk.st_rdev &&
+        if (fstat(j288_linux_fd(&r->bus[k].lp), &sk) == 0 && si.st_rdev == sk.st_rdev &&
             si.st_ino == sk.st_ino && si.st_dev == sk.st_dev) {
             set_err(r, "buses '%s' and '%s' are the same device", r->bus[k].name,
                     r->bus[i].name);
@@ -225,6 +270,7 @@ static int open_bus(j288_robot_t *r, unsigned i, const char *name, const char *p
 {
     j288_robot_bus_t *b = &r->bus[i];
     j288_linux_options_t lo;
+    j288_bus_config_t bc;
     j288_sched_config_t sc;
     uint32_t baud = r->opt.baud;
     int rc;
@@ -233,6 +279,7 @@ static int open_bus(j288_robot_t *r, unsigned i, const char *name, const char *p
     memset(&lo, 0, sizeof lo);
     lo.margin_us = r->opt.margin_us;
     lo.no_low_latency = r->opt.no_low_latency;
+    lo.echo = r->opt.echo;
     if (cb != NULL) {
         if (cb->has_baud)
             baud = cb->baud;
@@ -256,7 +303,9 @@ static int open_bus(j288_robot_t *r, unsigned i, const char *name, const char *p
     }
     b->open = true;
     b->stats.up = true;
-    rc = j288_linux_bus_init(&b->lp, &b->bus, NULL);
+    j288_linux_bus_config(&b->lp, &bc);
+    bc.retries = r->opt.retries;
+    rc = j288_linux_bus_init(&b->lp, &b->bus, &bc);
     if (rc == J288_OK) {
         memset(&sc, 0, sizeof sc);
         sc.on_event = on_servo_event;
@@ -279,11 +328,20 @@ static int add_joint(j288_robot_t *r, const j288_robot_config_joint_t *cj, unsig
     j288_joint_config_t jc;
     int rc;
     j288_robot_config_joint_config(cj, &jc);
+    if (!cj->has_kp)
+        jc.kp = (j288_real_t)J288_ROBOT_DEFAULT_KP;
+    if (!cj->has_kd)
+        jc.kd = (j288_real_t)J288_ROBOT_DEFAULT_KD;
     rc = j288_joint_init(&r->joint[j], &jc);
     if (rc == J288_OK)
         rc = j288_joint_bus_add(&b->jb, &r->joint[j]);
     if (rc == J288_OK)
         rc = j288_sched_enable(&b->sched, cj->id, true);
+    if (rc == J288_OK) {
+        j288_cmd_raw_t lock; /* the start-up reads: lock, bit 0 (clears an earlier trip) */
+        lock_cmd(cj->id, &lock);
+        rc = j288_sched_set_cmd(&b->sched, &lock);
+    }
     if (rc != J288_OK) {
         set_err(r, "joint '%s': %s", cj->name, j288_strerror(rc));
         return (rc == J288_ERR_NULL) ? rc : J288_ERR_BAD_CONFIG;
@@ -385,6 +443,12 @@ void j288_robot_close(j288_robot_t *r)
     close_buses(r);
 }
 
+void j288_robot_close_keep(j288_robot_t *r)
+{
+    if (r != NULL)
+        close_buses(r);
+}
+
 void j288_robot_set_stop_flag(j288_robot_t *r, const volatile sig_atomic_t *flag)
 {
     if (r != NULL)
@@ -421,51 +485,39 @@ static bool bus_pending(const j288_robot_bus_t *b)
     return j288_sched_busy(&b->sched) || !j288_bus_is_idle(&b->bus);
 }
 
-/* Sleep in one ppoll over every live bus until bytes come, a bus's timer is due, or
- * until_us; then let each ready port read its device. */
+/* Sleep over every live bus until bytes come, a port's deadline is due (while a transaction
+ * is pending, at least every SLICE_US), or until_us; then let each ready port read its device. */
 static void wait_all(j288_robot_t *r, uint32_t now, uint32_t until_us)
 {
-    struct pollfd pfd[J288_ROBOT_MAX_BUSES];
-    unsigned who[J288_ROBOT_MAX_BUSES];
-    nfds_t n = 0;
+    j288_linux_t *ports[J288_ROBOT_MAX_BUSES];
+    bool ready[J288_ROBOT_MAX_BUSES];
+    unsigned n = 0, i;
     int32_t left = us_until(until_us, now);
-    struct timespec ts;
-    unsigned i;
-    int rc;
 
-    if (left < 0)
-        left = 0;
     for (i = 0; i < r->nbuses; i++) {
         j288_robot_bus_t *b = &r->bus[i];
+        uint32_t at;
         if (!bus_live(b))
             continue;
-        if (bus_pending(b)) {
-            if (left > (int32_t)SLICE_US)
-                left = (int32_t)SLICE_US;
-            if (b->lp.timer_armed && us_until(b->lp.timer_us, now) < left)
-                left = us_until(b->lp.timer_us, now);
+        if (bus_pending(b) && left > (int32_t)SLICE_US)
+            left = (int32_t)SLICE_US;
+        if (j288_linux_next_deadline(&b->lp, &at) && us_until(at, now) <= 0) {
+            (void)j288_linux_service(&b->lp); /* due now: deliver it rather than sleep 0 */
+            left = 0;
+        } else if (j288_linux_next_deadline(&b->lp, &at) && us_until(at, now) < left) {
+            left = us_until(at, now);
         }
-        pfd[n].fd = b->lp.fd;
-        pfd[n].events = POLLIN;
-        pfd[n].revents = 0;
-        who[n] = i;
-        n++;
+        ports[n++] = &b->lp;
     }
     if (r->stop_flag != NULL && left > (int32_t)STOP_SLICE_US)
         left = (int32_t)STOP_SLICE_US;
     if (left < 0)
         left = 0;
-    ts.tv_sec = (time_t)((uint32_t)left / 1000000u);
-    ts.tv_nsec = (long)((uint32_t)left % 1000000u) * 1000L;
-    rc = ppoll(pfd, n, &ts, NULL);
-    if (rc <= 0)
+    if (j288_host_wait(ports, n, (uint32_t)left, ready) == 0u)
         return; /* timeout, or a signal: the caller looks at its flags */
-    for (i = 0; i < (unsigned)n; i++) {
-        if (pfd[i].revents != 0) {
-            j288_linux_t *lp = &r->bus[who[i]].lp;
-            /* A deadline of now: the port reads what is there (or finds the device gone). */
-            (void)j288_linux_port.wait(lp, j288_linux_now_us());
-        }
+    for (i = 0; i < n; i++) {
+        if (ready[i])
+            (void)j288_linux_service(ports[i]);
     }
 }
 
@@ -529,9 +581,23 @@ static void finish_cycle(j288_robot_t *r, uint32_t start, j288_robot_cycle_t *in
     info->fresh = fresh;
     info->joints = r->njoints;
     info->complete = fresh == r->njoints;
+    info->watchdog = r->wd_cleared;
+    r->wd_cleared = 0;
     r->cycle++;
     if (r->opt.on_cycle != NULL)
         r->opt.on_cycle(r->opt.user, r, info);
+}
+
+/* stop_on_bus_loss: a bus went down or vanished in this cycle; stop them all. */
+static int stop_on_loss(j288_robot_t *r)
+{
+    unsigned lost = r->lost_bus;
+    bool gone = r->bus[lost].stats.gone;
+    r->bus_lost = false;
+    (void)j288_robot_stop(r);
+    set_err(r, "bus '%s' %s: every bus stopped (stop on bus loss)", r->bus[lost].name,
+            gone ? "vanished" : "stopped answering");
+    return J288_ERR_OFFLINE;
 }
 
 int j288_robot_cycle(j288_robot_t *r, uint32_t timeout_us, j288_robot_cycle_t *info)
@@ -564,6 +630,8 @@ int j288_robot_cycle(j288_robot_t *r, uint32_t timeout_us, j288_robot_cycle_t *i
         wait_all(r, now, until);
     }
     finish_cycle(r, start, info);
+    if (r->bus_lost)
+        return stop_on_loss(r);
     if (!any_live(r))
         return J288_ERR_OFFLINE;
     return info->complete ? J288_OK : J288_ERR_TIMEOUT;
@@ -645,10 +713,17 @@ int j288_robot_stop(j288_robot_t *r)
     start = j288_linux_now_us();
     bound = stop_bound_us(r);
     for (i = 0; i < r->nbuses; i++) {
-        if (bus_live(&r->bus[i]))
+        if (bus_live(&r->bus[i])) {
+            uint8_t id;
             (void)j288_sched_estop(&r->bus[i].sched, start);
-        else if (r->bus[i].open)
+            for (id = 0; id < J288_MAX_SERVOS; id++) {
+                j288_cmd_raw_t lock; /* estop keeps each slot's bit: the policy wants 0 */
+                lock_cmd(id, &lock);
+                (void)j288_sched_set_cmd(&r->bus[i].sched, &lock);
+            }
+        } else if (r->bus[i].open) {
             rc = J288_ERR_OFFLINE;
+        }
     }
     r->driven = false;
     for (;;) {
@@ -875,11 +950,13 @@ int j288_robot_hold(j288_robot_t *r, unsigned joint)
 
 int j288_robot_lock(j288_robot_t *r, unsigned joint)
 {
+    j288_cmd_raw_t lock;
     if (r == NULL)
         return J288_ERR_NULL;
     if (joint >= r->njoints)
         return J288_ERR_BAD_ARG;
-    return j288_joint_bus_lock(&r->bus[r->joint_bus[joint]].jb, &r->joint[joint]);
+    lock_cmd(r->joint[joint].cfg.id, &lock);
+    return j288_sched_set_cmd(&r->bus[r->joint_bus[joint]].sched, &lock);
 }
 
 /* ---- statistics ------------------------------------------------------------------------------ */
@@ -944,28 +1021,135 @@ static void servo_from_reply(const j288_txn_t *txn, j288_robot_servo_t *out)
     out->latency_us = txn->latency_us;
 }
 
-int j288_robot_exchange(j288_robot_t *r, unsigned bus, uint8_t id, const j288_robot_target_t *foc,
-                        j288_robot_servo_t *out)
-{
-    j288_cmd_raw_t cmd;
+typedef struct {
+    bool done;
     j288_txn_t txn;
+} txn_wait_t;
+
+static void txn_done(void *user, const j288_txn_t *txn)
+{
+    txn_wait_t *w = user;
+    w->txn = *txn;
+    w->done = true;
+}
+
+/* One submit, driven by the runner's loop until it ends (its retries and reply budgets, the
+ * guard: bounded as a stop is). */
+static int run_txn(j288_robot_t *r, j288_robot_bus_t *b, const j288_cmd_raw_t *cmd,
+                   j288_txn_t *out)
+{
+    txn_wait_t w;
+    uint32_t start = j288_linux_now_us(), bound = stop_bound_us(r);
+    int rc;
+    memset(&w, 0, sizeof w);
+    rc = j288_bus_submit(&b->bus, cmd, start, txn_done, &w);
+    if (rc != J288_OK)
+        return rc;
+    for (;;) {
+        uint32_t now = j288_linux_now_us();
+        poll_all(r, now);
+        if (w.done)
+            break;
+        if (!bus_live(b))
+            return J288_ERR_OFFLINE;
+        if (now - start >= bound) {
+            set_err(r, "bus '%s': the transaction did not end within %u ms", b->name,
+                    (unsigned)(bound / 1000u));
+            return J288_ERR_TIMEOUT;
+        }
+        wait_all(r, now, start + bound);
+    }
+    if (out != NULL)
+        *out = w.txn;
+    if (w.txn.result == J288_ERR_OFFLINE || !bus_live(b))
+        return J288_ERR_OFFLINE;
+    return w.txn.result;
+}
+
+/* Servo id's joint for servo-level use (all-zero configuration), set up on first use. */
+static j288_joint_t *servo_joint(j288_robot_bus_t *b, uint8_t id)
+{
+    if ((b->servo_joint_on & (1u << id)) == 0u) {
+        j288_joint_config_t jc;
+        memset(&jc, 0, sizeof jc);
+        jc.id = id;
+        (void)j288_joint_init(&b->servo_joint[id], &jc); /* valid: defaults and an id 0-14 */
+        b->servo_joint_on = (uint16_t)(b->servo_joint_on | (1u << id));
+    }
+    return &b->servo_joint[id];
+}
+
+static void joint_into_servo(const j288_joint_t *j, j288_robot_servo_t *out)
+{
+    const j288_joint_state_t *st = j288_joint_state(j);
+    out->joint_known = st->known;
+    out->joint_pos = st->known ? (double)st->pos : 0.0;
+    out->joint_speed = (double)st->speed;
+    out->joint_torque = (double)st->torque;
+}
+
+/* Whether a reply to an FOC command shows a servo that did not take it: a trip reported, or
+ * lock mode. */
+static bool foc_ignored(const j288_cmd_raw_t *cmd, const j288_reply_raw_t *reply)
+{
+    return cmd->status == J288_MODE_FOC &&
+           (reply->watchdog_tripped || reply->status == J288_MODE_LOCK);
+}
+
+int j288_robot_transfer(j288_robot_t *r, unsigned bus, const j288_cmd_raw_t *cmd,
+                        j288_txn_t *txn, bool *wd_cleared)
+{
+    j288_cmd_raw_t c;
+    j288_txn_t t;
     j288_robot_bus_t *b;
     int rc;
-    if (r == NULL)
+    if (wd_cleared != NULL)
+        *wd_cleared = false;
+    if (r == NULL || cmd == NULL)
         return J288_ERR_NULL;
     if (bus >= r->nbuses)
         return J288_ERR_BAD_ARG;
-    if (id >= J288_MAX_SERVOS)
+    if (cmd->id >= J288_MAX_SERVOS)
         return J288_ERR_BAD_ID;
     b = &r->bus[bus];
     if (!bus_live(b))
         return J288_ERR_OFFLINE;
     if (j288_sched_busy(&b->sched))
         return J288_ERR_BUSY;
-    memset(&cmd, 0, sizeof cmd);
-    cmd.id = id;
-    cmd.status = J288_MODE_LOCK;
-    cmd.watchdog = true;
+    c = *cmd;
+    if (c.status == J288_MODE_LOCK)
+        c.watchdog = false;
+    else
+        r->driven = true; /* it may reach the servo even if its reply does not reach us */
+    rc = run_txn(r, b, &c, &t);
+    if (rc == J288_OK && foc_ignored(&c, &t.reply)) {
+        j288_robot_event_t ev = servo_on_bus(b, J288_ROBOT_EV_WATCHDOG, c.id);
+        ev.value = t.reply.watchdog_tripped ? 1.0 : 2.0;
+        c.watchdog = false; /* clears the trip; the servo takes this very command */
+        rc = run_txn(r, b, &c, &t);
+        if (wd_cleared != NULL)
+            *wd_cleared = true;
+        emit(r, &ev);
+    }
+    if (rc == J288_OK)
+        (void)j288_joint_take_reply(servo_joint(b, c.id), &t.reply, NULL);
+    if (txn != NULL)
+        *txn = t;
+    return rc;
+}
+
+int j288_robot_exchange(j288_robot_t *r, unsigned bus, uint8_t id, const j288_robot_target_t *foc,
+                        j288_robot_servo_t *out)
+{
+    j288_cmd_raw_t cmd;
+    j288_txn_t txn;
+    bool cleared = false;
+    int rc;
+    if (r == NULL)
+        return J288_ERR_NULL;
+    if (id >= J288_MAX_SERVOS)
+        return J288_ERR_BAD_ID;
+    lock_cmd(id, &cmd);
     if (foc != NULL) {
         j288_cmd_si_t si;
         memset(&si, 0, sizeof si);
@@ -981,20 +1165,96 @@ int j288_robot_exchange(j288_robot_t *r, unsigned bus, uint8_t id, const j288_ro
         if (rc != J288_OK)
             return rc;
     }
-    /* From here the command may reach the servo even if its reply does not reach us. */
-    if (foc != NULL)
-        r->driven = true;
-    rc = j288_bus_transfer_blocking(&b->bus, &cmd, &txn);
-    if (j288_linux_offline(&b->lp) && !b->stats.gone) {
-        b->stats.gone = true;
-        b->stats.up = false;
-        set_err(r, "bus '%s': %s", b->name, j288_linux_error(&b->lp));
-        emit_bus(r, J288_ROBOT_EV_BUS_GONE, bus);
-        return J288_ERR_OFFLINE;
-    }
-    if (rc == J288_OK && out != NULL)
+    rc = j288_robot_transfer(r, bus, &cmd, &txn, &cleared);
+    if (rc == J288_OK && out != NULL) {
         servo_from_reply(&txn, out);
+        out->watchdog_cleared = cleared;
+        joint_into_servo(servo_joint(&r->bus[bus], id), out);
+    }
     return rc;
+}
+
+int j288_robot_exchange_joint(j288_robot_t *r, unsigned bus, uint8_t id,
+                              const j288_robot_target_t *foc, j288_robot_servo_t *out)
+{
+    j288_robot_servo_t local;
+    const j288_joint_t *j;
+    j288_joint_target_t jt;
+    j288_cmd_raw_t cmd;
+    j288_txn_t txn;
+    bool cleared = false;
+    unsigned n;
+    int rc = J288_OK;
+    if (r == NULL)
+        return J288_ERR_NULL;
+    if (bus >= r->nbuses)
+        return J288_ERR_BAD_ARG;
+    if (id >= J288_MAX_SERVOS)
+        return J288_ERR_BAD_ID;
+    if (out == NULL)
+        out = &local;
+    j = servo_joint(&r->bus[bus], id);
+    /* The start-up reads: locks until the angle is known (a silent servo: its first error). */
+    for (n = 0; n < J288_ROBOT_ACQUIRE_TRIES && !j288_joint_state(j)->known; n++) {
+        rc = j288_robot_exchange(r, bus, id, NULL, out);
+        if (rc == J288_ERR_OFFLINE || (rc != J288_OK && n == 0u))
+            return rc;
+    }
+    if (!j288_joint_state(j)->known)
+        return j288_joint_state(j)->cal_mismatch ? J288_ERR_CAL_MISMATCH : J288_ERR_ANGLE_UNKNOWN;
+    if (foc == NULL) {
+        lock_cmd(id, &cmd);
+    } else {
+        jt.pos = (j288_real_t)foc->pos;
+        jt.speed = (j288_real_t)foc->speed;
+        jt.torque = (j288_real_t)foc->torque;
+        jt.kp = (j288_real_t)foc->kp;
+        jt.kd = (j288_real_t)foc->kd;
+        rc = j288_joint_command(j, &jt, &cmd, NULL); /* watchdog bit 1 */
+        if (rc != J288_OK)
+            return rc;
+    }
+    rc = j288_robot_transfer(r, bus, &cmd, &txn, &cleared);
+    if (rc == J288_OK) {
+        servo_from_reply(&txn, out);
+        out->watchdog_cleared = cleared;
+        joint_into_servo(j, out);
+    }
+    return rc;
+}
+
+int j288_robot_idle(j288_robot_t *r, uint32_t until_us)
+{
+    if (r == NULL)
+        return J288_ERR_NULL;
+    for (;;) {
+        uint32_t now = j288_linux_now_us();
+        poll_all(r, now);
+        if (!any_live(r))
+            return J288_ERR_OFFLINE;
+        if (stop_requested(r))
+            return J288_ERR_ABORTED;
+        if (us_until(until_us, now) <= 0)
+            return J288_OK;
+        wait_all(r, now, until_us);
+    }
+}
+
+const char *j288_robot_notices(const j288_robot_t *r, unsigned bus)
+{
+    if (r == NULL || bus >= r->nbuses || !r->bus[bus].open)
+        return "";
+    return j288_linux_notices(&r->bus[bus].lp);
+}
+
+j288_sched_t *j288_robot_bus_sched(j288_robot_t *r, unsigned bus)
+{
+    return (r == NULL || bus >= r->nbuses) ? NULL : &r->bus[bus].sched;
+}
+
+const j288_bus_t *j288_robot_bus_engine(const j288_robot_t *r, unsigned bus)
+{
+    return (r == NULL || bus >= r->nbuses) ? NULL : &r->bus[bus].bus;
 }
 
 const char *j288_robot_error(const j288_robot_t *r) { return (r == NULL) ? "no robot" : r->err; }

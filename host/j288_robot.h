@@ -1,6 +1,22 @@
 /*
- * j288_robot.h - several buses from one loop: the joints of a robot config, one thread, one
- * ppoll() over every bus's device.
+ * j288_robot.h - the host layer: several buses from one loop, the joints of a robot config,
+ * one thread, one wait over every bus's device (host/j288_host_wait.h). Every host front end
+ * (the j288 tool's bus commands, the Python package, a DDS bridge) drives servos through it:
+ * one loop, one stop path, one watchdog policy.
+ *
+ * Watchdog policy (the servo's 1 s communication watchdog; the manual: a servo whose watchdog
+ * tripped stays locked and ignores commands until one comes with the watchdog bit 0):
+ * - moving (FOC) commands go out with the watchdog bit 1: a host that stops talking for 1 s
+ *   leaves its servos locked;
+ * - every lock goes out with the bit 0 (the start-up reads that find a joint's angle, a
+ *   joint's lock, j288_robot_exchange()/j288_robot_transfer() locks such as scan and status,
+ *   the stop's broadcast lock and the slots it leaves at lock): a locked servo needs no
+ *   watchdog, and the bit 0 clears a trip an earlier session left, so a stopped bus takes the
+ *   next session's commands;
+ * - a reply reporting a trip, or a servo answering in lock mode to FOC commands (twice in a
+ *   row in cycles, once for j288_robot_transfer()), is cleared by the runner (the next command
+ *   to it goes out with the bit 0) and reported: a J288_ROBOT_EV_WATCHDOG event, the cycle's
+ *   `watchdog` count, the servo reply's watchdog_cleared. Never a silent success.
  *
  * A cycle starts a scheduler sweep on every bus at once and completes whichever bus answers
  * first; it ends when every bus that answers has finished its sweep, and calls on_cycle once,
@@ -29,7 +45,8 @@
  * J288_ERR_ABORTED. j288_robot_close() stops first if any target was sent since the last stop.
  *
  * Joints: each joint of the config becomes a j288_joint_t (lib/joint.h) bound to its bus's
- * scheduler, in the config's order (joint index 0 .. njoints-1). A joint's angle is unknown
+ * scheduler, in the config's order (joint index 0 .. njoints-1); a joint whose config gives no
+ * kp (kd) gets J288_ROBOT_DEFAULT_KP (_KD). A joint's angle is unknown
  * until its first replies (joint.h); until then targets are refused (J288_ERR_ANGLE_UNKNOWN)
  * and the joint is held at lock.
  *
@@ -69,13 +86,21 @@ extern "C" {
 #define J288_ROBOT_STOP_TIMEOUT_US 200000u       /* bound on flushing the stop frames, beyond
                                                     the buses' own reply budgets */
 #define J288_ROBOT_MSG_LEN 512u
+/* The gains of a joint whose config gives none (j288_robot_hold(), j288_robot_set_targets()
+ * without gains, the j288 tool's hold and move): gentle, well inside the wire range, a
+ * damping ratio near 0.7 on the simulator's rotor. Joint frame. */
+#define J288_ROBOT_DEFAULT_KP 20.0  /* N*m/rad */
+#define J288_ROBOT_DEFAULT_KD 2.5   /* N*m*s/rad */
 
 typedef enum {
     J288_ROBOT_EV_SERVO = 0, /* a scheduler event on a joint's servo: servo_ev */
     J288_ROBOT_EV_JOINT,     /* a joint-layer event: joint_kind, value */
     J288_ROBOT_EV_BUS_DOWN,  /* no reply in down_after sweeps: cycles go on without it */
     J288_ROBOT_EV_BUS_UP,    /* a down bus answers again */
-    J288_ROBOT_EV_BUS_GONE   /* its device vanished: left out from now on */
+    J288_ROBOT_EV_BUS_GONE,  /* its device vanished: left out from now on */
+    J288_ROBOT_EV_WATCHDOG   /* a servo's watchdog had tripped (value 1: the reply said so;
+                                2: it answered FOC commands in lock mode); cleared by the
+                                runner: see the watchdog policy at the top */
 } j288_robot_event_kind_t;
 
 typedef struct {
@@ -96,6 +121,7 @@ typedef struct {
     unsigned fresh;       /* joints with a new reply in this cycle */
     unsigned joints;      /* joints in all */
     bool complete;        /* fresh == joints */
+    unsigned watchdog;    /* servos found tripped in this cycle (and cleared) */
 } j288_robot_cycle_t;
 
 typedef struct j288_robot j288_robot_t;
@@ -112,6 +138,11 @@ typedef struct {
     j288_robot_event_fn on_event; /* may be NULL */
     j288_robot_cycle_fn on_cycle; /* may be NULL; called at the end of every cycle */
     void *user;
+    bool stop_on_bus_loss; /* a bus that goes down or vanishes stops every bus: the cycle
+                              (and run) returns J288_ERR_OFFLINE after j288_robot_stop(), for
+                              robots where half the joints holding is worse than all locked */
+    bool echo;             /* for buses that give none: the adapter hears its own transmit */
+    uint8_t retries;       /* re-sends of a failed transaction (0-3; bus.h's retries) */
 } j288_robot_options_t;
 
 typedef struct {
@@ -172,6 +203,15 @@ typedef struct {
     uint32_t faults;
     uint8_t warnings;
     uint32_t latency_us;
+    bool watchdog_cleared; /* the servo had tripped its watchdog: the command was sent again
+                              with the bit 0 (clearing it), and this is that reply */
+    /* The joint frame of servo-level use (j288_robot_exchange_joint()): the library's joint
+     * with the all-zero configuration, the absolute output angle wrapped to [-pi, pi), as
+     * `j288 status --id N` without --config (its joint_pos). Fed by every exchange. */
+    bool joint_known;   /* joint_pos is valid (after the start's replies) */
+    double joint_pos;   /* rad */
+    double joint_speed; /* rad/s */
+    double joint_torque; /* N*m */
 } j288_robot_servo_t;
 
 typedef struct {
@@ -185,6 +225,9 @@ typedef struct {
     int joint_of[J288_MAX_SERVOS]; /* joint index per id, or -1 */
     bool open;
     bool swept_ok;       /* the sweep in progress had a good reply */
+    uint8_t lock_under_foc[J288_MAX_SERVOS]; /* replies in lock mode to FOC commands in a row */
+    j288_joint_t servo_joint[J288_MAX_SERVOS]; /* servo level's joint frame (exchanges) */
+    uint16_t servo_joint_on;                   /* bit id: servo_joint[id] initialised */
     uint8_t empty_run;   /* consecutive sweeps without a reply */
     uint32_t sweep_start_us;
     j288_robot_bus_stats_t stats;
@@ -203,6 +246,9 @@ struct j288_robot {
     j288_robot_joint_stats_t jstats[J288_ROBOT_MAX_JOINTS];
     uint32_t cycle;      /* the cycle in progress (cycles completed + 1) */
     bool driven;         /* a target went out since the last stop */
+    bool bus_lost;       /* stop_on_bus_loss: a bus went down or vanished */
+    unsigned lost_bus;   /* which one (the first) */
+    unsigned wd_cleared; /* watchdog trips cleared in the cycle in progress */
     const volatile sig_atomic_t *stop_flag;
     j288_robot_stats_t stats;
     char err[J288_ROBOT_MSG_LEN];
@@ -231,15 +277,21 @@ int j288_robot_open_port(j288_robot_t *r, const char *port, const j288_robot_opt
  * or failed robot, and twice. */
 void j288_robot_close(j288_robot_t *r);
 
+/* Close without that stop: the servos keep their last command (with the watchdog bit 1 they
+ * lock themselves 1 s later). For a front end's explicit "leave it running" (j288 --keep), or
+ * after it confirmed every lock itself. */
+void j288_robot_close_keep(j288_robot_t *r);
+
 /* Let cycles return J288_ERR_ABORTED (after j288_robot_stop()) once *flag is non-zero. */
 void j288_robot_set_stop_flag(j288_robot_t *r, const volatile sig_atomic_t *flag);
 
 /*
  * One cycle: start a sweep on every bus (a down bus's sweep only if its previous one ended),
- * drive them all from one ppoll() until every bus that is up has finished, then call on_cycle.
+ * drive them all from one loop until every bus that is up has finished, then call on_cycle.
  * timeout_us bounds the cycle (0: 1 s). Returns J288_OK when every joint got fresh state,
  * J288_ERR_TIMEOUT when some did not (*info says how many; a cycle cut by the timeout leaves
- * the remaining sweeps running into the next cycle), J288_ERR_OFFLINE when every bus is gone,
+ * the remaining sweeps running into the next cycle), J288_ERR_OFFLINE when every bus is gone
+ * (with stop_on_bus_loss: when one went down or vanished; every bus is then stopped),
  * J288_ERR_ABORTED after a stop on the stop flag, J288_ERR_NULL. info may be NULL.
  */
 int j288_robot_cycle(j288_robot_t *r, uint32_t timeout_us, j288_robot_cycle_t *info);
@@ -248,7 +300,7 @@ int j288_robot_cycle(j288_robot_t *r, uint32_t timeout_us, j288_robot_cycle_t *i
  * Cycles until ncycles are done (0: no limit) or duration_us has passed (0: no limit), one
  * every period_us (0: back to back; a late cycle starts at once, the schedule is not caught
  * up). Returns J288_OK, or J288_ERR_ABORTED (stop flag: every bus stopped), J288_ERR_OFFLINE
- * (every bus gone), J288_ERR_NULL. Incomplete cycles do not end the run.
+ * (every bus gone, or with stop_on_bus_loss one lost: every bus stopped), J288_ERR_NULL. Incomplete cycles do not end the run.
  */
 int j288_robot_run(j288_robot_t *r, uint32_t period_us, uint32_t ncycles, uint32_t duration_us);
 
@@ -284,8 +336,9 @@ int j288_robot_read_all(const j288_robot_t *r, size_t n, double *pos, double *sp
 int j288_robot_set_target(j288_robot_t *r, unsigned joint, const j288_robot_target_t *t);
 
 /* Every joint at once from arrays of n (>= njoints) entries; speed, torque, kp, kd may be
- * NULL (0, 0, and each joint's configured gains). All targets are checked before any is set:
- * on an error nothing changes and *bad (may be NULL) gets the failing joint's index. */
+ * NULL (0, 0, and each joint's configured gains, J288_ROBOT_DEFAULT_KP/_KD where none). All
+ * targets are checked before any is set: on an error nothing changes and *bad (may be NULL)
+ * gets the failing joint's index. */
 int j288_robot_set_targets(j288_robot_t *r, size_t n, const double *pos, const double *speed,
                            const double *torque, const double *kp, const double *kd,
                            unsigned *bad);
@@ -295,8 +348,9 @@ int j288_robot_set_targets(j288_robot_t *r, size_t n, const double *pos, const d
  * its range, and must still be holdable; the first command pulls it in by at most this. */
 #define J288_ROBOT_HOLD_BEYOND_MAX 0.05
 
-/* Hold the joint where it is (its configured gains), or put it at lock. A joint beyond its
- * limits by at most J288_ROBOT_HOLD_BEYOND_MAX is held at the nearest limit. Errors:
+/* Hold the joint where it is (its configured gains, else J288_ROBOT_DEFAULT_KP/_KD), or put
+ * it at lock (watchdog bit 0). A joint beyond its limits by at most J288_ROBOT_HOLD_BEYOND_MAX
+ * is held at the nearest limit. Errors:
  * J288_ERR_NULL, J288_ERR_BAD_ARG; hold: J288_ERR_ANGLE_UNKNOWN, J288_ERR_LIMIT_POS (farther
  * beyond its limits: nothing changes). */
 int j288_robot_hold(j288_robot_t *r, unsigned joint);
@@ -311,13 +365,55 @@ int j288_robot_joint_stats(const j288_robot_t *r, unsigned joint, j288_robot_joi
 
 /* ---- servo level, outside cycles */
 
-/* One transaction with servo id (0-14) on a bus: foc NULL sends lock, else an FOC command
- * from an output-side SI target (j288_cmd_from_si()'s checks); the watchdog bit is on. out
- * (may be NULL) gets the reply. Not while a cycle's sweep runs on that bus. Errors:
+/* One transaction with servo id (0-14) on a bus: foc NULL sends lock (watchdog bit 0), else
+ * an FOC command from an output-side SI target (j288_cmd_from_si()'s checks; watchdog bit 1),
+ * as j288_robot_transfer() (its watchdog policy, out->watchdog_cleared). out (may be NULL)
+ * gets the reply. Not while a cycle's sweep runs on that bus. Errors:
  * J288_ERR_NULL, J288_ERR_BAD_ARG (bus), J288_ERR_BUSY, the encoder's and the bus's results
  * (J288_ERR_TIMEOUT: no servo answered, ...), J288_ERR_OFFLINE. */
 int j288_robot_exchange(j288_robot_t *r, unsigned bus, uint8_t id, const j288_robot_target_t *foc,
                         j288_robot_servo_t *out);
+
+/* The same in the joint frame (see j288_robot_servo_t's joint_* members): foc NULL sends lock,
+ * else an FOC command from a joint-frame target (the joint layer's checks: J288_ERR_LIMIT_POS
+ * beyond [-pi, pi], ...). A servo whose angle is not known yet is first sent locks (watchdog
+ * bit 0) until it is, bounded (J288_ROBOT_ACQUIRE_TRIES): the start-up reads. Errors: those of
+ * j288_robot_exchange(), J288_ERR_ANGLE_UNKNOWN / J288_ERR_CAL_MISMATCH (the angle could not
+ * be found: encoder fault), the joint layer's. */
+#define J288_ROBOT_ACQUIRE_TRIES 40u
+int j288_robot_exchange_joint(j288_robot_t *r, unsigned bus, uint8_t id,
+                              const j288_robot_target_t *foc, j288_robot_servo_t *out);
+
+/* One transaction of a raw command on a bus, outside cycles, through the runner's loop (the
+ * same waits, vanished-device handling and watchdog policy as cycles): a lock goes out with
+ * the watchdog bit 0 whatever cmd says; an FOC command whose reply reports a trip, or comes
+ * in lock mode, is sent once more with the bit 0 (clearing the trip) and *wd_cleared (may be
+ * NULL) is set, with a J288_ROBOT_EV_WATCHDOG event; txn (may be NULL) gets the final
+ * transaction. A command other than lock marks the robot driven (close then stops). Not
+ * while a cycle's sweep runs on that bus. Errors: J288_ERR_NULL, J288_ERR_BAD_ARG (bus),
+ * J288_ERR_BAD_ID (broadcast: use j288_robot_stop()), J288_ERR_BUSY, the bus's results
+ * (J288_ERR_TIMEOUT: no reply, ...), J288_ERR_OFFLINE. */
+int j288_robot_transfer(j288_robot_t *r, unsigned bus, const j288_cmd_raw_t *cmd,
+                        j288_txn_t *txn, bool *wd_cleared);
+
+/* Serve every bus (background sweeps, the port's events) without starting anything until
+ * until_us (a j288_linux_now_us() time, at most 35 minutes ahead): a front end's pause
+ * between commands. J288_OK, J288_ERR_ABORTED (the stop flag: nothing is sent, the caller
+ * stops), J288_ERR_OFFLINE (every bus is gone), J288_ERR_NULL. */
+int j288_robot_idle(j288_robot_t *r, uint32_t until_us);
+
+/* The port's notices from open (low latency refused, latency timer advice: zero or more
+ * lines, each ending in '\n'), "" when none or for a bad index. Never NULL. */
+const char *j288_robot_notices(const j288_robot_t *r, unsigned bus);
+
+/* A bus's scheduler, for a front end without joints (j288 log --id): it may enable slots and
+ * set their commands (j288_sched_enable(), j288_sched_set_cmd(), j288_sched_slot()) for
+ * j288_robot_cycle() to sweep, under the same watchdog policy; it must not start sweeps, poll
+ * or stop it itself. And the bus engine, for its counters and reply budget (j288_bus_stats(),
+ * j288_bus_parser_stats(), j288_bus_reply_budget_us()); never submit to it. NULL for a bad
+ * index. */
+j288_sched_t *j288_robot_bus_sched(j288_robot_t *r, unsigned bus);
+const j288_bus_t *j288_robot_bus_engine(const j288_robot_t *r, unsigned bus);
 
 /* The latest error, one line ("" if none). Never NULL. */
 const char *j288_robot_error(const j288_robot_t *r);

@@ -2,9 +2,11 @@
 #   $(ROBOT_OBJ)       the runner; link with $(CONFIG_OBJ), $(LINUX_A), $(LIB_A) and the yaml libs
 #   test/linux/test_robot.c   several j288-sim buses from one loop (HOST_TESTS)
 #   test/e2e/cli_robot.sh     j288 --config FILE log|status|hold|stop (TEST_SCRIPTS)
-ROBOT_OBJ := $(OBJ)/host/j288_robot.o
+#   test/e2e/host_stack.sh    a second session after a stop, every front end (TEST_SCRIPTS)
+# (the runner, and its one OS-specific call, the wait over every bus: host/j288_host_wait.c)
+ROBOT_OBJ := $(OBJ)/host/j288_robot.o $(OBJ)/host/j288_host_wait.o
 
-$(ROBOT_OBJ): host/j288_robot.c
+$(ROBOT_OBJ): $(OBJ)/host/%.o: host/%.c
 	@mkdir -p $(@D)
 	$(CC) $(HOST_CPPFLAGS) $(CFLAGS_COMMON) -c $< -o $@
 
@@ -22,9 +24,12 @@ HOST_TESTS += $(ROBOT_TEST)
 ALL_TARGETS += $(ROBOT_TEST)
 TEST_DEPS += $(SIM_BIN)
 
-# The j288 tool's robot commands (tools/j288/cmd_robot.c) use the runner and the config reader.
+# The j288 tool's bus commands use the runner (cli_bus.h includes it) and the config reader.
 $(J288_BIN): $(ROBOT_OBJ) $(CONFIG_OBJ)
 # (the archives again after them: the tool's link rule lists its own prerequisites first)
 $(J288_BIN): LDFLAGS_COMMON += $(LINUX_A) $(LIB_A) $(call yaml_var,YAML_LIBS)
 TEST_SCRIPTS += test/e2e/cli_robot.sh
 TEST_DEPS += $(J288_BIN)
+# One host stack: a second session after every form of stop holds a loaded joint (the CLI's
+# forms and Python's; the Python ones use the shared library, which python.mk adds).
+TEST_SCRIPTS += test/e2e/host_stack.sh

@@ -31,7 +31,8 @@ $(OBJ)/test/cli/test_cli_joint.o: test/cli/test_cli_joint.c $(UNITY)/unity.c $(Y
 	$(CC) $(TEST_CPPFLAGS) -Itools/j288 $(TOOL_CPPFLAGS) $(call yaml_var,YAML_CFLAGS) $(CFLAGS_COMMON) -c $< -o $@
 
 $(CLI_JOINT_TEST): $(OBJ)/test/cli/test_cli_joint.o $(CLI_CAPTURE_OBJ) \
-    $(addprefix $(OBJ)/tools/j288/,cli_joint.o cli_bus.o args.o json.o report.o) $(CONFIG_OBJ) \
+    $(addprefix $(OBJ)/tools/j288/,cli_joint.o cli_bus.o args.o json.o report.o) \
+    $(OBJ)/host/j288_robot.o $(OBJ)/host/j288_host_wait.o $(CONFIG_OBJ) \
     $(UNITY_OBJ) $(LINUX_A) $(LIB_A)
 	@mkdir -p $(@D)
 	$(CC) $(CFLAGS_COMMON) $^ -o $@ $(LDFLAGS_COMMON) $(call yaml_var,YAML_LIBS) -lm

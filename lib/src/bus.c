@@ -387,7 +387,10 @@ J288_NOINLINE static void send_estop(j288_bus_t *bus, uint32_t now)
 {
     j288_cmd_raw_t stop;
 
-    j288_cmd_lock(&stop, J288_BROADCAST_ID, true);
+    /* Watchdog bit 0: a locked servo needs no watchdog, and the bit 0 clears a trip, so a
+     * stopped bus takes the next session's commands (the manual: a trip is cleared only by a
+     * command with the bit 0). */
+    j288_cmd_lock(&stop, J288_BROADCAST_ID, false);
     (void)j288_cmd_encode(&stop, bus->tx_buf, &bus->crc); /* constant, valid fields */
     bus->tx_frame = bus->tx_buf;
     bus->estop_pending = false;

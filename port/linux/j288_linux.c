@@ -683,6 +683,41 @@ int j288_linux_sweep(j288_linux_t *lp, j288_sched_t *s, uint32_t timeout_us)
     return j288_linux_run(lp, s, now + timeout_us, J288_LINUX_RUN_UNTIL_IDLE);
 }
 
+/* ---- for a multi-port loop ------------------------------------------------------------------ */
+
+int j288_linux_fd(const j288_linux_t *lp)
+{
+    return (lp == NULL || lp->gone) ? -1 : lp->fd;
+}
+
+bool j288_linux_next_deadline(const j288_linux_t *lp, uint32_t *at_us)
+{
+    bool any = false;
+    uint32_t now = j288_linux_now_us(), at = 0;
+    if (lp == NULL || at_us == NULL)
+        return false;
+    if (lp->timer_armed) {
+        at = lp->timer_us;
+        any = true;
+    }
+    if (lp->idle_pending) {
+        uint32_t idle_at = lp->last_rx_us + lp->opt.idle_us;
+        if (!any || us_until(idle_at, now) < us_until(at, now))
+            at = idle_at;
+        any = true;
+    }
+    if (any)
+        *at_us = at;
+    return any;
+}
+
+int j288_linux_service(j288_linux_t *lp)
+{
+    if (lp == NULL)
+        return J288_ERR_NULL;
+    return port_wait(lp, j288_linux_now_us());
+}
+
 /* ---- inspection --------------------------------------------------------------------------------
  */
 

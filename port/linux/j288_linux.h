@@ -164,6 +164,24 @@ int j288_linux_run(j288_linux_t *lp, j288_sched_t *s, uint32_t until_us, unsigne
  * error, or j288_linux_run()'s (J288_ERR_TIMEOUT, _ABORTED, _OFFLINE). Thread only. */
 int j288_linux_sweep(j288_linux_t *lp, j288_sched_t *s, uint32_t timeout_us);
 
+/* ---- for a loop that waits on several ports at once (the host layer's j288_host_wait()) ---
+ * Such a loop sleeps in one call over every port's descriptor, then lets each port that has
+ * bytes (or a due event) service itself; the port's reading, flushing and vanished-device
+ * handling stay here. Thread only. */
+
+/* The device's descriptor, to wait on for input; -1 when closed or gone. */
+int j288_linux_fd(const j288_linux_t *lp);
+
+/* The earliest time (j288_linux_now_us() clock) at which the port has an event to deliver to
+ * its bus (the bus's reply deadline, the line-idle report): true and *at_us set, or false
+ * when none is pending (or lp/at_us is NULL). A loop must not sleep past it. */
+bool j288_linux_next_deadline(const j288_linux_t *lp, uint32_t *at_us);
+
+/* Read what the device has and deliver the events that are due, without sleeping: the
+ * port's wait() with a deadline of now. J288_OK, J288_ERR_OFFLINE (the device vanished:
+ * reported to the bus, j288_linux_error() says why), J288_ERR_NULL. */
+int j288_linux_service(j288_linux_t *lp);
+
 /* The last error, one line without a trailing newline ("" if none). Never NULL. */
 const char *j288_linux_error(const j288_linux_t *lp);
 

@@ -16,7 +16,10 @@ from __future__ import annotations
 
 import ctypes
 import ctypes.util
+import numbers
 import os
+import signal
+import threading
 from ctypes import (POINTER, Structure, c_bool, c_char_p, c_double, c_int, c_size_t, c_uint,
                     c_uint8, c_uint32, c_void_p)
 from typing import Optional, TypeVar
@@ -39,7 +42,9 @@ class ServoReply(Structure):
                 ("pos", c_double), ("speed", c_double), ("torque", c_double),
                 ("out_pos", c_double), ("case_temp_c", c_double),
                 ("winding_temp_c", c_double), ("voltage_v", c_double),
-                ("faults", c_uint32), ("warnings", c_uint8), ("latency_us", c_uint32)]
+                ("faults", c_uint32), ("warnings", c_uint8), ("latency_us", c_uint32),
+                ("watchdog_cleared", c_bool), ("joint_known", c_bool), ("joint_pos", c_double),
+                ("joint_speed", c_double), ("joint_torque", c_double)]
 
 
 class JointState(Structure):
@@ -56,7 +61,8 @@ class CycleInfo(Structure):
     """j288_robot_cycle_t."""
 
     _fields_ = [("cycle", c_uint32), ("start_us", c_uint32), ("duration_us", c_uint32),
-                ("fresh", c_uint), ("joints", c_uint), ("complete", c_bool)]
+                ("fresh", c_uint), ("joints", c_uint), ("complete", c_bool),
+                ("watchdog", c_uint)]
 
 
 class RobotStats(Structure):
@@ -93,7 +99,8 @@ class Options(Structure):
 
     _fields_ = [("port", c_char_p), ("baud", c_uint32), ("margin_us", c_uint32),
                 ("down_after", c_uint8), ("no_low_latency", c_bool),
-                ("on_event", c_void_p), ("on_cycle", c_void_p), ("user", c_void_p)]
+                ("on_event", c_void_p), ("on_cycle", c_void_p), ("user", c_void_p),
+                ("stop_on_bus_loss", c_bool), ("echo", c_bool), ("retries", c_uint8)]
 
 
 def _find() -> str:
@@ -149,6 +156,8 @@ def _bind(lib: ctypes.CDLL) -> None:
         "j288_robot_bus_stats": (c_int, [robot, c_uint, P(BusStats)]),
         "j288_robot_joint_stats": (c_int, [robot, c_uint, P(JointStats)]),
         "j288_robot_exchange": (c_int, [robot, c_uint, c_uint8, P(Target), P(ServoReply)]),
+        "j288_robot_exchange_joint": (c_int, [robot, c_uint, c_uint8, P(Target),
+                                              P(ServoReply)]),
         "j288_robot_error": (c_char_p, [robot]),
     }
     for name, (res, args) in protos.items():
@@ -179,6 +188,42 @@ def error_text(robot: Optional[ctypes.Array]) -> str:
 
 
 _H = TypeVar("_H", bound="Handle")
+
+
+class Terminated(SystemExit):
+    """SIGTERM inside a Bus or Robot with block: the block's exit stopped the servos; the
+    process then ends with status 143, as the j288 tool does."""
+
+    def __init__(self) -> None:
+        super().__init__(143)
+
+
+def _raise_on_sigterm(signum: int, frame: object) -> None:
+    raise Terminated()
+
+
+def path_arg(value: object, what: str) -> bytes:
+    """A str or os.PathLike as bytes for the C side; TypeError otherwise."""
+    if isinstance(value, (str, bytes, os.PathLike)):
+        return os.fsencode(value)
+    raise TypeError(f"{what} must be a path (str or os.PathLike), not {type(value).__name__}")
+
+
+def int_arg(value: object, what: str, lo: int, hi: int) -> int:
+    """An int in [lo, hi]; TypeError for another type (bool and float included), ValueError
+    outside the range."""
+    if isinstance(value, bool) or not isinstance(value, numbers.Integral):
+        raise TypeError(f"{what} must be an int, not {type(value).__name__} ({value!r})")
+    if not lo <= int(value) <= hi:
+        raise ValueError(f"{what} {value} outside {lo}-{hi}")
+    return int(value)
+
+
+def real_arg(value: object, what: str) -> float:
+    """A real number (int or float, not bool) as float; TypeError otherwise."""
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        raise TypeError(f"{what} must be a number, not {type(value).__name__} ({value!r})")
+    return float(value)
 
 
 class Handle:
@@ -212,6 +257,13 @@ class Handle:
             self._r = None
 
     def __enter__(self: _H) -> _H:
+        # SIGTERM as Ctrl-C: an exception in the with block, so that __exit__ stops the
+        # servos (the default action would end the process with the servos still driven).
+        # Only in the main thread, and only over the default action.
+        self._old_term = None
+        if (threading.current_thread() is threading.main_thread()
+                and signal.getsignal(signal.SIGTERM) == signal.SIG_DFL):
+            self._old_term = signal.signal(signal.SIGTERM, _raise_on_sigterm)
         return self
 
     def __exit__(self, *exc: object) -> None:
@@ -220,6 +272,9 @@ class Handle:
                 LIB.j288_robot_stop(self._r)
         finally:
             self.close()
+            if getattr(self, "_old_term", None) is not None:
+                signal.signal(signal.SIGTERM, self._old_term)
+                self._old_term = None
 
     def __del__(self) -> None:
         try:

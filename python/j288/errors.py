@@ -76,6 +76,18 @@ class NoReplyError(J288Error):
     """J288_ERR_TIMEOUT: no reply in time (no servo with that id, or a bus not answering)."""
 
 
+class WatchdogError(Exception):
+    """A servo had tripped its 1 s watchdog (its host was silent): the host layer sent the
+    command again with the watchdog bit 0, which cleared the trip, and the servo took it.
+    Never a silent success: catch it to go on. .status is the reply (a ServoStatus)."""
+
+    def __init__(self, status: object) -> None:
+        self.status = status
+        sid = getattr(status, "id", "?")
+        super().__init__(f"servo {sid} had tripped its watchdog (no command for 1 s): cleared, "
+                         "and the command sent again")
+
+
 def error_for(code: int, detail: str = "", what: str = "") -> J288Error:
     """The exception for a result code."""
     if code == -39:

@@ -3,13 +3,14 @@
 from __future__ import annotations
 
 import ctypes
+import os
 import time
 from dataclasses import dataclass
 from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
 
 from . import _native
 from ._native import (LIB, BusStats, CycleInfo, JointState, JointStats, RobotStats, Target,
-                      c_double, c_uint, c_uint8)
+                      c_double, c_uint, c_uint8, int_arg, path_arg, real_arg)
 from .errors import J288Error, error_for
 
 try:  # NumPy is optional: arrays where a loop wants them, lists without it.
@@ -32,6 +33,8 @@ class Cycle:
     fresh: int         #: joints with a new reply in this cycle
     joints: int
     complete: bool     #: every joint fresh
+    watchdog: int = 0  #: servos found with their watchdog tripped in this cycle (cleared by
+    #: the host layer: their next command went out with the watchdog bit 0); never silent
 
 
 @dataclass(frozen=True)
@@ -89,11 +92,13 @@ class Robot(_native.Handle):
     is left out.
 
     Args:
-        config: path of the robot config file.
+        config: path of the robot config file (str or os.PathLike).
         port: the device when the file names no bus.
         margin_us: reply margin for buses whose entry gives none (default 20 ms).
         down_after: sweeps without any reply before a bus is down and cycles stop waiting
             for it (default 3; until then a silent bus slows every cycle).
+        stop_on_bus_loss: a bus that goes down or vanishes stops every bus and the cycle
+            raises OfflineError (a legged robot is better all locked than half held).
     Raises:
         J288Error: J288_ERR_BAD_CONFIG (file errors, with "FILE:LINE: ..." in detail), a
             device that cannot be opened (OfflineError), ...
@@ -101,15 +106,18 @@ class Robot(_native.Handle):
 
     _kind = "robot"
 
-    def __init__(self, config: str, port: Optional[str] = None, margin_us: int = 0,
-                 down_after: int = 0) -> None:
-        if not 0 <= down_after <= 255:
-            raise ValueError(f"down_after {down_after} outside 0-255")
+    def __init__(self, config: Union[str, "os.PathLike[str]"],
+                 port: Union[str, "os.PathLike[str]", None] = None, margin_us: int = 0,
+                 down_after: int = 0, stop_on_bus_loss: bool = False) -> None:
+        path = path_arg(config, "config")
+        dev = path_arg(port, "port") if port is not None else None
+        margin_us = int_arg(margin_us, "margin_us", 0, 1000000)
+        down_after = int_arg(down_after, "down_after", 0, 255)
         self._r: Optional[ctypes.Array] = _native.new_robot()
-        opt = _native.Options(port=port.encode() if port else None, margin_us=margin_us,
-                              down_after=down_after)
-        rc = LIB.j288_robot_open_file(self._r, config.encode(), ctypes.byref(opt))
-        self._open(rc, config)
+        opt = _native.Options(port=dev, margin_us=margin_us, down_after=down_after,
+                              stop_on_bus_loss=bool(stop_on_bus_loss))
+        rc = LIB.j288_robot_open_file(self._r, path, ctypes.byref(opt))
+        self._open(rc, os.fsdecode(path))
         r = self._r
         self.joints: List[str] = [LIB.j288_robot_joint_name(r, j).decode()
                                   for j in range(LIB.j288_robot_njoints(r))]
@@ -132,22 +140,26 @@ class Robot(_native.Handle):
             if j < 0:
                 raise KeyError(f"no joint named {joint!r}")
             return int(j)
-        if not 0 <= joint < self._n:
-            raise IndexError(f"joint index {joint} outside 0-{self._n - 1}")
-        return joint
+        try:
+            return int_arg(joint, "joint", 0, self._n - 1)
+        except ValueError:
+            raise IndexError(f"joint index {joint} outside 0-{self._n - 1}") from None
 
     # ---- the loop
     def cycle(self, timeout: float = 1.0) -> Cycle:
         """Sweep every bus once. Returns the cycle's outcome, also when some joint got no
-        reply (complete False). timeout: seconds, (0, 4000]. Raises OfflineError when every
-        bus is gone."""
+        reply (complete False; watchdog > 0: servos found tripped, cleared). timeout: seconds,
+        (0, 4000]. Raises OfflineError when every bus is gone (with stop_on_bus_loss: when
+        one was lost; every bus was stopped)."""
+        timeout = real_arg(timeout, "timeout")
         if not 0 < timeout <= _MAX_SECONDS:
             raise ValueError(f"timeout {timeout} s outside (0, {_MAX_SECONDS}]")
         info = CycleInfo()
         rc = LIB.j288_robot_cycle(self._robot(), int(timeout * 1e6), ctypes.byref(info))
         if rc not in (0, -31):
             self._check(rc)
-        return Cycle(info.cycle, info.duration_us, info.fresh, info.joints, bool(info.complete))
+        return Cycle(info.cycle, info.duration_us, info.fresh, info.joints, bool(info.complete),
+                     info.watchdog)
 
     def run(self, cycles: int = 0, rate_hz: float = 0.0, duration: float = 0.0) -> None:
         """Cycles in C (no Python per cycle): `cycles` of them (0: no limit) or for `duration`
@@ -213,7 +225,8 @@ class Robot(_native.Handle):
         """One joint's target, joint frame. Raises J288Error: J288_ERR_ANGLE_UNKNOWN (not
         known yet), J288_ERR_LIMIT_POS / _SPEED / _TORQUE (outside its limits), ..."""
         j = self._index(joint)
-        t = Target(pos, speed, torque, kp, kd)
+        t = Target(*(real_arg(v, n) for v, n in ((pos, "pos"), (speed, "speed"),
+                                                   (torque, "torque"), (kp, "kp"), (kd, "kd"))))
         self._check(LIB.j288_robot_set_target(self._robot(), j, ctypes.byref(t)),
                     self.joints[j])
 

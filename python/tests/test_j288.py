@@ -137,9 +137,13 @@ def test_bus_status_and_command(sims) -> None:
         assert e.value.name == "J288_ERR_NEG_GAIN" and e.value.code == -4
         with pytest.raises(j288.J288Error) as e:
             bus.command(2, pos=1e9)
+        assert e.value.name == "J288_ERR_LIMIT_POS"  # joint frame: beyond [-pi, pi]
+    with j288.Bus(sim.pty, margin_us=MARGIN, frame="output") as bus:
+        with pytest.raises(j288.J288Error) as e:
+            bus.command(2, pos=1e9)
         assert e.value.name == "J288_ERR_RANGE_POS"
     assert sim.logged(" id=2 status=1 wd=1")
-    assert sim.logged(" id=15 status=0 wd=1"), "the with block's exit sends the broadcast lock"
+    assert sim.logged(" id=15 status=0 wd=0"), "the with block's exit sends the broadcast lock"
 
 
 def test_bus_errors(sims) -> None:
@@ -167,9 +171,8 @@ def test_bus_scan_skips_bad_replies(sims) -> None:
             bus.status(2)
         assert e.value.name == "J288_ERR_CRC"
         assert bus.scan() == []
-        with pytest.raises(j288.J288Error) as e:
+        with pytest.raises(ValueError, match="servo_id 15 outside 0-14"):
             bus.scan([2, 15])
-        assert e.value.name == "J288_ERR_BAD_ID"
 
 
 # ---- Robot ----------------------------------------------------------------------------------
@@ -221,7 +224,7 @@ def test_robot_two_buses(sims, tmp_path: Path) -> None:
         assert robot.joint_stats("leg0_1")["fresh_cycles"] == stats["cycles"]
     for s in (s0, s1):
         assert s.logged(" id=2 status=1 wd=1")
-        assert s.logged(" id=15 status=0 wd=1")
+        assert s.logged(" id=15 status=0 wd=0")
 
 
 def test_robot_stop_on_exception(sims, tmp_path: Path) -> None:
@@ -233,7 +236,7 @@ def test_robot_stop_on_exception(sims, tmp_path: Path) -> None:
             robot.hold()
             robot.cycle()
             raise RuntimeError("the controller failed")
-    assert s0.logged(" id=15 status=0 wd=1")
+    assert s0.logged(" id=15 status=0 wd=0")
 
 
 def test_robot_bad_config(sims, tmp_path: Path) -> None:
@@ -287,7 +290,7 @@ def test_robot_bus_stops_answering(sims, tmp_path: Path) -> None:
             complete = robot.cycle().complete
         assert complete and robot.bus_stats("leg2")["up"]
     for x in s:
-        assert x.logged(" id=15 status=0 wd=1")
+        assert x.logged(" id=15 status=0 wd=0")
 
 
 def test_robot_bus_gone(sims, tmp_path: Path) -> None:
@@ -317,6 +320,92 @@ def test_robot_without_numpy(sims, tmp_path: Path, monkeypatch) -> None:
         with pytest.raises(ValueError):
             robot.set_targets(pos[:2])
         assert robot.cycle().complete
+
+
+# ---- one host stack (issue 18) ----------------------------------------------------------------
+
+J288_BIN = Path(os.environ.get("BIN", str(ROOT / "build" / "bin"))) / "j288"
+
+
+def test_bus_pos_is_the_cli_s_joint_angle(sims) -> None:
+    """Bus.status(id).pos is the joint angle, the number `j288 status --id N --json` gives as
+    joint_pos (it counted from where the rotor woke up)."""
+    sim = sims("1", "--start-angle", "1:2.5")
+    out = subprocess.run([str(J288_BIN), "--port", sim.pty, "status", "--id", "1", "--json"],
+                         capture_output=True, text=True, timeout=60)
+    assert out.returncode == 0, out.stderr
+    cli = float(re.search(r'"joint_pos": ([-0-9.e]+)', out.stdout).group(1))
+    with j288.Bus(sim.pty, margin_us=MARGIN) as bus:
+        py = bus.status(1).pos
+    assert abs(py - cli) < 1e-3 and abs(py - 2.5) < 0.01
+
+
+def test_arguments_are_checked(sims, tmp_path: Path) -> None:
+    """Wrong types get a message naming the argument (a float id gave a raw ctypes error);
+    paths may be os.PathLike."""
+    sim = sims("1")
+    with j288.Bus(Path(sim.pty), margin_us=MARGIN) as bus:
+        with pytest.raises(TypeError, match="servo_id must be an int, not float"):
+            bus.status(1.0)
+        with pytest.raises(TypeError, match="kp must be a number, not str"):
+            bus.command(1, kp="20")
+        with pytest.raises(ValueError, match="servo_id 15 outside 0-14"):
+            bus.status(15)
+    cfg = write_config(tmp_path, [sim.pty])
+    cfg.write_text(cfg.read_text().replace("leg0_2", "x2").replace("leg0_3", "x3")
+                   .replace("id: 2", "id: 1").replace("id: 3", "id: 1"))
+    with pytest.raises(j288.J288Error):  # a PathLike config reaches the reader (id used 3x)
+        j288.Robot(cfg)
+    with pytest.raises(TypeError, match="config must be a path"):
+        j288.Robot(42)
+
+
+def test_watchdog_trip_is_cleared_and_reported(sims, tmp_path: Path) -> None:
+    """A servo left tripped (1.5 s without a command under FOC): Bus.command raises
+    WatchdogError after clearing it (the servo took the command); a Robot cycle says so in
+    Cycle.watchdog. Before, the servo stayed locked and every call reported success."""
+    sim = sims("1")
+    with j288.Bus(sim.pty, margin_us=MARGIN) as bus:
+        p = bus.status(1).pos
+        bus.command(1, pos=p, kp=20, kd=1)
+        time.sleep(1.5)  # the servo's 1 s watchdog trips (the scenario, not a bound)
+        with pytest.raises(j288.WatchdogError) as e:
+            bus.command(1, pos=p, kp=20, kd=1)
+        assert e.value.status.mode == j288.MODE_FOC
+        assert bus.command(1, pos=p, kp=20, kd=1).mode == j288.MODE_FOC
+    cfg = write_config(tmp_path, [sims("1,2,3").pty])
+    with j288.Robot(cfg) as robot:
+        cycle_until_known(robot)
+        robot.hold("leg0_1")
+        assert robot.cycle().watchdog == 0
+        time.sleep(1.5)
+        assert sum(robot.cycle().watchdog for _ in range(5)) == 1
+
+
+def test_sigterm_stops_the_servos(sims) -> None:
+    """SIGTERM in a with block stops the servos as Ctrl-C does (exit 143)."""
+    sim = sims("1")
+    script = textwrap.dedent(f"""\
+        import j288
+        with j288.Bus({sim.pty!r}, margin_us={MARGIN}) as bus:
+            p = bus.status(1).pos
+            print("ready", flush=True)
+            while True:
+                bus.command(1, pos=p, kp=20, kd=1)
+        """)
+    proc = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE,
+                            env=dict(os.environ, PYTHONPATH=str(ROOT / "python")), text=True)
+    try:
+        assert proc.stdout is not None and proc.stdout.readline() == "ready\n"
+        assert sim.logged(" id=1 status=1 wd=1")
+        proc.send_signal(signal.SIGTERM)
+        proc.wait(timeout=60)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+    assert proc.returncode == 143
+    assert sim.logged(" id=15 status=0 wd=0")
 
 
 @pytest.mark.parametrize("loop", ["while True:\n        robot.cycle()",
@@ -355,4 +444,4 @@ def test_ctrl_c_stops_every_bus(sims, tmp_path: Path, loop: str) -> None:
             proc.wait()
     assert proc.returncode != 0 and "KeyboardInterrupt" in err
     for s in (s0, s1):
-        assert s.logged(" id=15 status=0 wd=1")
+        assert s.logged(" id=15 status=0 wd=0")

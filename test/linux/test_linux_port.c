@@ -202,7 +202,7 @@ static void test_transfer_blocking(void)
     TEST_ASSERT_EQUAL_UINT32(23u * 20u, j288_linux_stats(&g_lp)->tx_bytes);
     TEST_ASSERT_EQUAL_UINT32(21u * 26u, j288_linux_stats(&g_lp)->rx_bytes);
     TEST_ASSERT_EQUAL_INT(0, sim_stop());
-    TEST_ASSERT_TRUE(log_contains(" id=15 status=0 wd=1"));
+    TEST_ASSERT_TRUE(log_contains(" id=15 status=0 wd=0"));
     TEST_ASSERT_TRUE(log_contains(" id=9 status=0"));
 }
 
@@ -395,7 +395,7 @@ static void test_stop_flag_aborts_run(void)
                           j288_linux_run(&g_lp, NULL, j288_linux_now_us() + 1000000u,
                                          J288_LINUX_RUN_UNTIL_IDLE | J288_LINUX_RUN_IGNORE_STOP));
     TEST_ASSERT_EQUAL_INT(0, sim_stop());
-    TEST_ASSERT_TRUE(log_contains(" id=15 status=0 wd=1"));
+    TEST_ASSERT_TRUE(log_contains(" id=15 status=0 wd=0"));
 }
 
 static void test_injected_faults_give_bus_errors(void)

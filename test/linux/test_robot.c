@@ -81,6 +81,20 @@ static void sim_stop(int k)
 
 static bool log_contains(int k, const char *needle) { return sim_log_contains(g_sim[k].log, needle); }
 
+/* Whether a line of simulator k's log contains both a and b. */
+static bool log_line_has_both(int k, const char *a, const char *b)
+{
+    char line[512];
+    bool found = false;
+    FILE *f = fopen(g_sim[k].log, "r");
+    if (f == NULL)
+        return false;
+    while (!found && fgets(line, sizeof line, f) != NULL)
+        found = strstr(line, a) != NULL && strstr(line, b) != NULL;
+    fclose(f);
+    return found;
+}
+
 /* Wait (bounded, 20 s) until simulator k has logged needle. */
 static bool log_wait(int k, const char *needle)
 {
@@ -121,8 +135,8 @@ static void make_config(int nbuses, uint32_t margin_us)
 
 /* ---- events ---------------------------------------------------------------------------- */
 
-static unsigned g_ev_count[5];
-static unsigned g_ev_bus[5];
+static unsigned g_ev_count[6];
+static unsigned g_ev_bus[6];
 static unsigned g_cycles_seen;
 
 static void count_event(void *user, const j288_robot_event_t *ev)
@@ -150,6 +164,19 @@ static j288_robot_options_t counting_options(void)
 }
 
 /* Cycle until every joint's angle is known (the joint layer's start takes 8 replies). */
+static void cycle_until_known_joint(unsigned joint)
+{
+    unsigned tries;
+    for (tries = 0; tries < 100; tries++) {
+        j288_robot_state_t st;
+        (void)j288_robot_cycle(&g_robot, 0, NULL);
+        TEST_ASSERT_EQUAL_INT(J288_OK, j288_robot_read(&g_robot, joint, &st));
+        if (st.known)
+            return;
+    }
+    TEST_FAIL_MESSAGE("the joint's angle never became known");
+}
+
 static void cycle_until_known(void)
 {
     unsigned j, tries;
@@ -268,7 +295,7 @@ static void test_four_buses_one_loop(void)
     /* Close stops every bus: the broadcast lock reaches each simulator. */
     j288_robot_close(&g_robot);
     for (k = 0; k < NSIM; k++)
-        TEST_ASSERT_TRUE(log_wait(k, " id=15 status=0 wd=1"));
+        TEST_ASSERT_TRUE(log_wait(k, " id=15 status=0 wd=0"));
 }
 
 /* The reader refuses a bus named twice and an id used twice; so does the runner given such
@@ -465,7 +492,7 @@ static void test_stop_flag_stops_every_bus(void)
     TEST_ASSERT_EQUAL_INT(J288_OK, j288_robot_stats(&g_robot, &rs));
     TEST_ASSERT_EQUAL_UINT32(5, rs.cycles);
     for (k = 0; k < 3; k++)
-        TEST_ASSERT_TRUE(log_wait(k, " id=15 status=0 wd=1"));
+        TEST_ASSERT_TRUE(log_wait(k, " id=15 status=0 wd=0"));
     /* A bounded run ends by itself. */
     TEST_ASSERT_EQUAL_INT(J288_ERR_NULL, j288_robot_run(NULL, 0, 1, 0));
 }
@@ -496,7 +523,7 @@ static void test_stop_waits_for_a_long_margin(void)
     TEST_ASSERT_EQUAL_INT(0, kill(g_sim[1].pid, SIGCONT));
     g_sim[1].stopped = false;
     /* Resumed, it reads what waited in the pty: the stop frame among it. */
-    TEST_ASSERT_TRUE(log_wait(1, " id=15 status=0 wd=1"));
+    TEST_ASSERT_TRUE(log_wait(1, " id=15 status=0 wd=0"));
 }
 
 /* Servo level on one bus without a config: scan-like exchanges. */
@@ -545,7 +572,7 @@ static void test_close_stops_after_an_unanswered_command(void)
     g_sim[0].stopped = false;
     TEST_ASSERT_TRUE(log_wait(0, " id=2 status=1 wd=1"));
     j288_robot_close(&g_robot);
-    TEST_ASSERT_TRUE(log_wait(0, " id=15 status=0 wd=1"));
+    TEST_ASSERT_TRUE(log_wait(0, " id=15 status=0 wd=0"));
 }
 
 /* A joint a hair beyond its limits (zeroed against a hard stop) is held at the nearest
@@ -568,6 +595,132 @@ static void test_hold_just_beyond_a_limit(void)
     TEST_ASSERT_EQUAL_INT(J288_ERR_LIMIT_POS, j288_robot_hold(&g_robot, 1));
 }
 
+
+/* 1.5 s without a command: longer than the servo's 1 s watchdog (the scenario, not a bound). */
+static void silence(void) { usleep(1500000); }
+
+/* A session after a stop: the stop's broadcast lock goes out with the watchdog bit 0, so the
+ * servos do not trip in the silence that follows, and the next session's FOC command is
+ * obeyed (a stop with the bit 1 left them tripped, deaf to it). */
+static void test_a_second_session_after_a_stop_is_obeyed(void)
+{
+    j288_robot_servo_t sv;
+    j288_robot_target_t foc = {0.0, 0.0, 0.0, 20.0, 1.0};
+    j288_robot_options_t o;
+    memset(&o, 0, sizeof o);
+    o.margin_us = LOADED_MARGIN_US;
+    sim_start(0, "2");
+    make_config(1, LOADED_MARGIN_US);
+    g_cfg.njoints = 2; /* ids 1 and 2; only 2 answers */
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_robot_open(&g_robot, &g_cfg, &o));
+    cycle_until_known_joint(1);
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_robot_hold(&g_robot, 1));
+    (void)j288_robot_cycle(&g_robot, 0, NULL);
+    TEST_ASSERT_TRUE(log_wait(0, " id=2 status=1 wd=1"));
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_robot_stop(&g_robot));
+    j288_robot_close(&g_robot);
+    TEST_ASSERT_TRUE(log_wait(0, " id=15 status=0 wd=0"));
+    silence();
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_robot_open_port(&g_robot, g_sim[0].pty, &o));
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_robot_exchange(&g_robot, 0, 2, &foc, &sv));
+    TEST_ASSERT_EQUAL_UINT(J288_MODE_FOC, sv.mode);
+    TEST_ASSERT_FALSE(sv.watchdog_cleared);
+    TEST_ASSERT_FALSE(sv.watchdog_tripped);
+}
+
+/* A servo left tripped (its host went silent under FOC): an exchange clears it, the command is
+ * obeyed, and the reply and an event say so; a lock exchange goes out with the bit 0. */
+static void test_exchange_clears_and_reports_a_trip(void)
+{
+    j288_robot_servo_t sv;
+    j288_robot_target_t foc = {0.0, 0.0, 0.0, 20.0, 1.0};
+    j288_robot_options_t o = counting_options();
+    o.margin_us = LOADED_MARGIN_US;
+    sim_start(0, "2");
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_robot_open_port(&g_robot, g_sim[0].pty, &o));
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_robot_exchange(&g_robot, 0, 2, NULL, &sv));
+    TEST_ASSERT_TRUE(log_wait(0, " id=2 status=0 wd=0"));
+    foc.pos = sv.pos;
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_robot_exchange(&g_robot, 0, 2, &foc, &sv));
+    TEST_ASSERT_FALSE(sv.watchdog_cleared);
+    silence();
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_robot_exchange(&g_robot, 0, 2, &foc, &sv));
+    TEST_ASSERT_TRUE(sv.watchdog_cleared);
+    TEST_ASSERT_EQUAL_UINT(J288_MODE_FOC, sv.mode);
+    TEST_ASSERT_EQUAL_UINT(1, g_ev_count[J288_ROBOT_EV_WATCHDOG]);
+    TEST_ASSERT_TRUE(log_wait(0, " id=2 status=1 wd=0"));
+}
+
+/* The same in cycles: a joint held, then 1.5 s without a cycle; the next cycle's reply
+ * reports the trip, the runner clears it (the joint is held again) and reports it, once. */
+static void test_cycles_clear_and_report_a_trip(void)
+{
+    j288_robot_options_t o = counting_options();
+    j288_robot_cycle_t info;
+    unsigned seen = 0, i;
+    j288_robot_state_t st;
+    sim_start(0, "1");
+    make_config(1, LOADED_MARGIN_US);
+    g_cfg.njoints = 1;
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_robot_open(&g_robot, &g_cfg, &o));
+    cycle_until_known();
+    TEST_ASSERT_TRUE(log_contains(0, " id=1 status=0 wd=0")); /* the start-up reads */
+    TEST_ASSERT_FALSE(log_contains(0, " id=1 status=0 wd=1"));
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_robot_hold(&g_robot, 0));
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_robot_cycle(&g_robot, 0, &info));
+    TEST_ASSERT_EQUAL_UINT(0, info.watchdog);
+    silence();
+    for (i = 0; i < 5; i++) {
+        (void)j288_robot_cycle(&g_robot, 0, &info);
+        seen += info.watchdog;
+    }
+    TEST_ASSERT_EQUAL_UINT(1, seen);
+    TEST_ASSERT_EQUAL_UINT(1, g_ev_count[J288_ROBOT_EV_WATCHDOG]);
+    TEST_ASSERT_TRUE(log_wait(0, " id=1 status=1 wd=0"));
+    TEST_ASSERT_EQUAL_UINT(J288_MODE_FOC,
+                           j288_sched_slot(&g_robot.bus[0].sched, 1)->reply.status);
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_robot_read(&g_robot, 0, &st));
+    TEST_ASSERT_TRUE(st.known);
+}
+
+/* A joint without gains in its config is held with the documented defaults, not kp = kd = 0. */
+static void test_hold_without_gains_uses_the_defaults(void)
+{
+    sim_start(0, "1");
+    make_config(1, LOADED_MARGIN_US);
+    g_cfg.njoints = 1;
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_robot_open(&g_robot, &g_cfg, NULL));
+    cycle_until_known();
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_robot_hold(&g_robot, 0));
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_robot_cycle(&g_robot, 0, NULL));
+    TEST_ASSERT_TRUE(log_wait(0, " id=1 status=1 wd=1"));
+    TEST_ASSERT_FALSE(log_line_has_both(0, " status=1 ", " kp=0 kd=0"));
+    TEST_ASSERT_TRUE(J288_ROBOT_DEFAULT_KP == 20.0 && J288_ROBOT_DEFAULT_KD == 2.5);
+}
+
+/* stop_on_bus_loss: one bus stops answering; once it is down every bus gets the stop and the
+ * cycle says so. */
+static void test_stop_on_bus_loss(void)
+{
+    j288_robot_options_t o;
+    int rc = J288_OK, i;
+    memset(&o, 0, sizeof o);
+    o.stop_on_bus_loss = true;
+    o.down_after = 1;
+    sim_start(0, "1,2,3");
+    sim_start(1, "1,2,3");
+    make_config(2, 20000u);
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_robot_open(&g_robot, &g_cfg, &o));
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_robot_cycle(&g_robot, 0, NULL));
+    TEST_ASSERT_EQUAL_INT(0, kill(g_sim[1].pid, SIGSTOP));
+    g_sim[1].stopped = true;
+    for (i = 0; i < 10 && rc != J288_ERR_OFFLINE; i++)
+        rc = j288_robot_cycle(&g_robot, 0, NULL);
+    TEST_ASSERT_EQUAL_INT(J288_ERR_OFFLINE, rc);
+    TEST_ASSERT_NOT_NULL(strstr(j288_robot_error(&g_robot), "every bus stopped"));
+    TEST_ASSERT_TRUE(log_wait(0, " id=15 status=0 wd=0"));
+}
+
 int main(void)
 {
     UNITY_BEGIN();
@@ -580,5 +733,10 @@ int main(void)
     RUN_TEST(test_exchange_on_one_port);
     RUN_TEST(test_close_stops_after_an_unanswered_command);
     RUN_TEST(test_hold_just_beyond_a_limit);
+    RUN_TEST(test_a_second_session_after_a_stop_is_obeyed);
+    RUN_TEST(test_exchange_clears_and_reports_a_trip);
+    RUN_TEST(test_cycles_clear_and_report_a_trip);
+    RUN_TEST(test_hold_without_gains_uses_the_defaults);
+    RUN_TEST(test_stop_on_bus_loss);
     return UNITY_END();
 }

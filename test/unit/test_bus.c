@@ -54,6 +54,15 @@ static j288_cmd_raw_t lock_cmd(uint8_t id)
     return c;
 }
 
+/* The emergency stop's frame: broadcast lock with the watchdog bit 0 (a stop leaves no
+ * watchdog to trip, and clears a trip). */
+static j288_cmd_raw_t stop_cmd(void)
+{
+    j288_cmd_raw_t c = lock_cmd(J288_BROADCAST_ID);
+    c.watchdog = false;
+    return c;
+}
+
 static j288_reply_raw_t reply_for(uint8_t id, int32_t pos)
 {
     j288_reply_raw_t r;
@@ -757,7 +766,7 @@ static void test_estop_and_submit_while_waiting_to_retry(void)
 {
     j288_bus_config_t cfg;
     j288_cmd_raw_t cmd = lock_cmd(3u);
-    j288_cmd_raw_t stop = lock_cmd(J288_BROADCAST_ID);
+    j288_cmd_raw_t stop = stop_cmd();
     memset(&cfg, 0, sizeof cfg);
     cfg.retries = 2u;
     setup_cfg(&cfg);
@@ -985,7 +994,7 @@ static void test_port_crc_hook_is_used(void)
 static void test_estop_while_busy(void)
 {
     j288_cmd_raw_t cmd = lock_cmd(3u);
-    j288_cmd_raw_t stop = lock_cmd(J288_BROADCAST_ID);
+    j288_cmd_raw_t stop = stop_cmd();
     j288_reply_raw_t r = reply_for(3u, 31);
     setup();
     fake_port_add_servo(&fp, 3u, &r);
@@ -1018,7 +1027,7 @@ static void test_estop_while_busy(void)
 static void test_estop_idle_and_with_queued_work(void)
 {
     j288_cmd_raw_t cmd = lock_cmd(3u);
-    j288_cmd_raw_t stop = lock_cmd(J288_BROADCAST_ID);
+    j288_cmd_raw_t stop = stop_cmd();
     setup();
     TEST_ASSERT_EQUAL_INT(J288_OK, j288_bus_estop(&bus, 0u));
     TEST_ASSERT_EQUAL_UINT32(1u, fp.nframes);
@@ -1079,7 +1088,7 @@ static void test_estop_counts_in_estops_only(void)
 static void test_estop_resent_after_port_error(void)
 {
     j288_cmd_raw_t cmd = lock_cmd(3u);
-    j288_cmd_raw_t stop = lock_cmd(J288_BROADCAST_ID);
+    j288_cmd_raw_t stop = stop_cmd();
     setup();
     fp.start_tx_fail = 1;
     TEST_ASSERT_EQUAL_INT(J288_OK, j288_bus_estop(&bus, 0u));
@@ -1100,7 +1109,7 @@ static void test_estop_resent_after_port_error(void)
 static void test_estop_resent_after_collision(void)
 {
     j288_bus_config_t cfg;
-    j288_cmd_raw_t stop = lock_cmd(J288_BROADCAST_ID);
+    j288_cmd_raw_t stop = stop_cmd();
     memset(&cfg, 0, sizeof cfg);
     cfg.echo = true;
     setup_cfg(&cfg);
@@ -1121,7 +1130,7 @@ static void test_estop_resent_after_collision(void)
 
 static void test_estop_resent_after_tx_timeout_and_line_error(void)
 {
-    j288_cmd_raw_t stop = lock_cmd(J288_BROADCAST_ID);
+    j288_cmd_raw_t stop = stop_cmd();
     setup();
     fp.txdone = FAKE_TXDONE_MANUAL; /* the first transmit never completes */
     TEST_ASSERT_EQUAL_INT(J288_OK, j288_bus_estop(&bus, 0u));

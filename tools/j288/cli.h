@@ -35,6 +35,10 @@ typedef struct {
     const char *config; /* --config FILE before the command, or NULL */
 } cli_global_t;
 
+/* Watchdog trips the host layer found and cleared in this process (cli_bus.c): main() turns
+ * a command's success into exit 1 when it is not 0. */
+extern unsigned cli_watchdog_trips;
+
 /* Name used as the message prefix ("encode" -> "j288 encode: ..."). NULL: plain "j288". */
 void cli_set_command(const char *name);
 

@@ -8,6 +8,7 @@
 #include <string.h>
 
 volatile sig_atomic_t cli_stop_signal = 0;
+unsigned cli_watchdog_trips = 0;
 
 /* A pseudo-terminal (the simulator) answers in a few hundred microseconds, but a loaded
  * machine can stall either side for milliseconds; a USB adapter needs its latency timer
@@ -95,10 +96,31 @@ static bool is_pseudo_terminal(const char *dev)
     return strncmp(real, "/dev/pts/", 9) == 0;
 }
 
+void cli_print_notices(const char *notices)
+{
+    static bool printed;
+    const char *quiet = getenv("J288_QUIET");
+    if (quiet != NULL && strcmp(quiet, "1") == 0) {
+        return;
+    }
+    if (!printed && notices != NULL && notices[0] != '\0') {
+        fputs(notices, stderr);
+        printed = true;
+    }
+}
+
+void cli_report_watchdog(const char *what)
+{
+    cli_watchdog_trips++;
+    cli_error("%s had tripped its watchdog (no command for 1 s): cleared, and the command "
+              "sent again with the watchdog bit 0",
+              what);
+}
+
 int cli_bus_open(cli_bus_t *b, const cli_bus_opts_t *o, int default_retries)
 {
-    j288_linux_options_t lo;
-    j288_bus_config_t cfg;
+    static j288_robot_t robot; /* large, and one bus per process */
+    j288_robot_options_t ro;
     const char *dev = o->port;
     int rc;
 
@@ -111,27 +133,23 @@ int cli_bus_open(cli_bus_t *b, const cli_bus_opts_t *o, int default_retries)
         return CLI_EXIT_USAGE;
     }
     b->dev = dev;
-    memset(&lo, 0, sizeof lo);
-    lo.echo = o->echo;
-    lo.margin_us =
+    b->robot = &robot;
+    memset(&ro, 0, sizeof ro);
+    ro.baud = o->baud;
+    ro.echo = o->echo;
+    ro.margin_us =
         o->margin_us != 0u ? o->margin_us : (is_pseudo_terminal(dev) ? PTY_MARGIN_US : 0u);
-    rc = j288_linux_open(&b->lp, dev, o->baud, &lo);
+    ro.retries = (uint8_t)(o->retries >= 0 ? o->retries : default_retries);
+    rc = j288_robot_open_port(&robot, dev, &ro);
     if (rc != J288_OK) {
-        cli_error("%s", j288_linux_error(&b->lp));
-        return CLI_EXIT_FAIL;
+        /* the runner prefixes "bus 'bus': "; the port's own message is what the user needs */
+        const char *msg = j288_robot_error(&robot);
+        const char *colon = strncmp(msg, "bus '", 5) == 0 ? strstr(msg, "': ") : NULL;
+        cli_error("%s", colon != NULL ? colon + 3 : msg);
+        return rc == J288_ERR_BAD_CONFIG && colon == NULL ? CLI_EXIT_USAGE : CLI_EXIT_FAIL;
     }
-    if (getenv("J288_VERBOSE") != NULL && j288_linux_notices(&b->lp)[0] != '\0') {
-        fprintf(stderr, "%s", j288_linux_notices(&b->lp));
-    }
-    j288_linux_bus_config(&b->lp, &cfg);
-    cfg.retries = (uint8_t)(o->retries >= 0 ? o->retries : default_retries);
-    rc = j288_linux_bus_init(&b->lp, &b->bus, &cfg);
-    if (rc != J288_OK) {
-        cli_error("%s: cannot start the bus: %s", dev, j288_strerror(rc));
-        j288_linux_close(&b->lp);
-        return CLI_EXIT_FAIL;
-    }
-    j288_linux_set_stop_flag(&b->lp, &cli_stop_signal);
+    cli_print_notices(j288_robot_notices(&robot, 0));
+    j288_robot_set_stop_flag(&robot, &cli_stop_signal);
     b->open = true;
     return CLI_EXIT_OK;
 }
@@ -139,19 +157,45 @@ int cli_bus_open(cli_bus_t *b, const cli_bus_opts_t *o, int default_retries)
 void cli_bus_close(cli_bus_t *b)
 {
     if (b->open) {
-        j288_linux_close(&b->lp);
+        /* Every servo driven confirmed its lock: no broadcast for the others on the bus. */
+        if (b->driven == 0u)
+            j288_robot_close_keep(b->robot);
+        else
+            j288_robot_close(b->robot);
         b->open = false;
     }
 }
 
+void cli_bus_close_keep(cli_bus_t *b)
+{
+    if (b->open) {
+        j288_robot_close_keep(b->robot);
+        b->open = false;
+    }
+}
+
+bool cli_bus_gone(const cli_bus_t *b)
+{
+    j288_robot_bus_stats_t bs;
+    return !b->open || j288_robot_bus_stats(b->robot, 0, &bs) != J288_OK || bs.gone;
+}
+
 int cli_bus_transfer(cli_bus_t *b, const j288_cmd_raw_t *cmd, j288_txn_t *txn)
 {
+    bool cleared = false;
+    int rc;
     /* Marked before sending: even unconfirmed, the servo may have obeyed, so it is owed a
      * lock. */
     if (cmd->status != J288_MODE_LOCK && cmd->id <= J288_MAX_ID) {
         b->driven = (uint16_t)(b->driven | (1u << cmd->id));
     }
-    return j288_bus_transfer_blocking(&b->bus, cmd, txn);
+    rc = j288_robot_transfer(b->robot, 0, cmd, txn, &cleared);
+    if (cleared) {
+        char what[32];
+        (void)snprintf(what, sizeof what, "servo %u", (unsigned)cmd->id);
+        cli_report_watchdog(what);
+    }
+    return rc;
 }
 
 void cli_lock_cmd(uint8_t id, j288_cmd_raw_t *cmd)
@@ -167,9 +211,8 @@ int cli_bus_lock_driven(cli_bus_t *b)
     int silent = 0;
     uint8_t id;
     j288_cmd_raw_t cmd;
-    j288_txn_t txn;
 
-    if (!b->open || j288_linux_offline(&b->lp)) {
+    if (cli_bus_gone(b)) {
         return b->driven != 0u ? 1 : 0;
     }
     for (id = 0; id <= J288_MAX_ID; id++) {
@@ -179,7 +222,7 @@ int cli_bus_lock_driven(cli_bus_t *b)
         }
         cli_lock_cmd(id, &cmd);
         for (attempt = 0; attempt < LOCK_ATTEMPTS && rc != J288_OK; attempt++) {
-            rc = j288_bus_transfer_blocking(&b->bus, &cmd, &txn);
+            rc = j288_robot_transfer(b->robot, 0, &cmd, NULL, NULL);
             if (rc == J288_ERR_OFFLINE) {
                 return 1;
             }
@@ -191,24 +234,21 @@ int cli_bus_lock_driven(cli_bus_t *b)
         }
     }
     if (silent > 0) {
-        /* Someone did not confirm: tell every servo at once (no reply to a broadcast). */
-        cli_lock_cmd(J288_BROADCAST_ID, &cmd);
-        (void)j288_bus_transfer_blocking(&b->bus, &cmd, &txn);
+        /* Someone did not confirm: tell every servo at once (the runner's stop). */
+        (void)j288_robot_stop(b->robot);
     }
     return silent;
 }
 
 void cli_report_txn_failure(cli_bus_t *b, uint8_t id, int rc)
 {
-    if (rc == J288_ERR_OFFLINE || j288_linux_offline(&b->lp)) {
-        cli_error("%s", j288_linux_error(&b->lp));
+    const char *msg = j288_robot_error(b->robot);
+    const char *colon = strncmp(msg, "bus '", 5) == 0 ? strstr(msg, "': ") : NULL;
+    if (rc == J288_ERR_OFFLINE || cli_bus_gone(b)) {
+        cli_error("%s", colon != NULL ? colon + 3 : msg);
     } else if (rc == J288_ERR_TIMEOUT) {
         cli_error("no reply from servo %u on %s (check id, power, wiring and --baud)", (unsigned)id,
                   b->dev);
-    } else if (rc == J288_ERR_PORT) {
-        cli_error("%s: %s", b->dev,
-                  j288_linux_error(&b->lp)[0] != '\0' ? j288_linux_error(&b->lp)
-                                                      : j288_strerror(rc));
     } else {
         cli_error("servo %u on %s: %s", (unsigned)id, b->dev, j288_strerror(rc));
     }
@@ -216,8 +256,7 @@ void cli_report_txn_failure(cli_bus_t *b, uint8_t id, int rc)
 
 int cli_bus_sleep_until(cli_bus_t *b, uint32_t until_us)
 {
-    int rc = j288_linux_run(&b->lp, NULL, until_us, 0u);
-    return rc == J288_ERR_TIMEOUT ? J288_OK : rc;
+    return j288_robot_idle(b->robot, until_us);
 }
 
 /* Parse loop shared by every bus command: common options are handled here, the command's

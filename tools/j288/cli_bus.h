@@ -1,12 +1,16 @@
 /*
  * cli_bus.h - what the bus commands share: the options every one of them takes (--port,
- * --baud, --margin-us, --echo, --retries), opening the Linux port and binding a bus, one
- * blocking transaction, the SIGINT/SIGTERM stop flag, and the safe stop (lock every servo a
- * command drove).
+ * --baud, --margin-us, --echo, --retries), opening a bus through the host layer (the runner,
+ * host/j288_robot.h: its loop, its stop, its watchdog policy), one transaction, the
+ * SIGINT/SIGTERM stop flag, and the safe stop (lock every servo a command drove).
  *
  * Signals: cli_signals_install() sets handlers (without SA_RESTART) that only record the
- * signal in cli_stop_signal; the port's sleeps return early on it (j288_linux_set_stop_flag)
+ * signal in cli_stop_signal; the runner's waits return early on it (j288_robot_set_stop_flag)
  * and the command loops see it within a millisecond or so, then send the locks themselves.
+ *
+ * Watchdog: a servo found tripped under an FOC command is cleared by the runner; cli_bus_*
+ * prints one line for it and counts it in cli_watchdog_trips, and main() turns a command's
+ * success into exit 1 when that count is not 0 (never a silent success).
  */
 #ifndef J288_CLI_BUS_H
 #define J288_CLI_BUS_H
@@ -64,14 +68,22 @@ typedef struct {
 } cli_bus_opts_t;
 
 typedef struct {
-    j288_linux_t lp;
-    j288_bus_t bus;
+    j288_robot_t *robot; /* the host layer's runner on this one bus (no joints) */
     bool open;
     const char *dev;
     uint16_t driven; /* ids this command has sent a moving (FOC) command to */
 } cli_bus_t;
 
 extern volatile sig_atomic_t cli_stop_signal;
+
+/* Print the port's notices (low latency refused, latency timer advice) on stderr, once per
+ * process: they explain late replies, so a user sees them without J288_VERBOSE. Scripts that
+ * want a quiet stderr set J288_QUIET=1. */
+void cli_print_notices(const char *notices);
+
+/* Count and report a trip the runner cleared on servo id (j288_robot_transfer()'s flag, a
+ * J288_ROBOT_EV_WATCHDOG event). */
+void cli_report_watchdog(const char *what);
 
 /* Start from the global options (cli_global_t). */
 void cli_bus_opts_init(cli_bus_opts_t *o, const cli_global_t *g);
@@ -94,13 +106,20 @@ void cli_signals_install(void);
 /* Exit code for a command stopped by a signal (130 or 143). */
 int cli_signal_exit_code(void);
 
-/* Open the device and bind a bus. Prints the port's notices (low latency refused, ...) as
- * "note:" lines on stderr only when J288_VERBOSE is set, and one error line on failure.
- * Returns CLI_EXIT_OK or CLI_EXIT_FAIL / CLI_EXIT_USAGE. */
+/* Open the device through the runner (j288_robot_open_port()). Prints the port's notices
+ * once (cli_print_notices()), and one error line on failure. Returns CLI_EXIT_OK or
+ * CLI_EXIT_FAIL / CLI_EXIT_USAGE. */
 int cli_bus_open(cli_bus_t *b, const cli_bus_opts_t *o, int default_retries);
+/* Close; servos the command drove and did not lock are stopped by the runner. */
 void cli_bus_close(cli_bus_t *b);
+/* Close leaving the last command in force (--keep). */
+void cli_bus_close_keep(cli_bus_t *b);
+/* Whether the device has vanished. */
+bool cli_bus_gone(const cli_bus_t *b);
 
-/* One blocking transaction (retries as configured). Returns the library result. */
+/* One transaction (retries as configured) through the runner (j288_robot_transfer(): a lock
+ * goes out with the watchdog bit 0; a trip under FOC is cleared, reported and counted).
+ * Returns the library result. */
 int cli_bus_transfer(cli_bus_t *b, const j288_cmd_raw_t *cmd, j288_txn_t *txn);
 
 /* A lock command (status 0, all fields 0) for id, watchdog bit 0: a locked servo needs no
@@ -116,8 +135,8 @@ int cli_bus_lock_driven(cli_bus_t *b);
  * or the port's own message when the device is gone. */
 void cli_report_txn_failure(cli_bus_t *b, uint8_t id, int rc);
 
-/* Sleep until until_us (j288_linux_now_us() time) while keeping the port serviced.
- * Returns J288_OK, J288_ERR_ABORTED (stop signal) or J288_ERR_OFFLINE. */
+/* Sleep until until_us (j288_linux_now_us() time) while the runner keeps the port serviced
+ * (j288_robot_idle()). Returns J288_OK, J288_ERR_ABORTED (stop signal) or J288_ERR_OFFLINE. */
 int cli_bus_sleep_until(cli_bus_t *b, uint32_t until_us);
 
 /* ---- the robot config and the joint frame (cli_joint.c) -------------------------------------

@@ -294,7 +294,8 @@ int cli_cmd_stop(int argc, char **argv, const cli_global_t *g)
         return ec;
     }
     cli_lock_cmd(c.id < 0 ? (uint8_t)J288_BROADCAST_ID : (uint8_t)c.id, &cmd);
-    rc = cli_bus_transfer(&b, &cmd, &txn);
+    /* All: the runner's stop, the one every front end uses (broadcast lock, watchdog bit 0). */
+    rc = c.id < 0 ? j288_robot_stop(b.robot) : cli_bus_transfer(&b, &cmd, &txn);
     if (rc != J288_OK) {
         cli_report_txn_failure(&b, cmd.id, rc);
         cli_bus_close(&b);
@@ -858,7 +859,11 @@ static int run_drive(drive_args_t *d, cli_bus_opts_t *o)
     if ((ec = drive_start(&b, d, &plan, &res)) == CLI_EXIT_OK) {
         ec = drive_finish(&b, d, &res, drive_loop(&b, d, &plan, &res), o->json);
     }
-    cli_bus_close(&b);
+    if (ec == CLI_EXIT_OK && d->keep) {
+        cli_bus_close_keep(&b); /* --keep: the last command stays in force */
+    } else {
+        cli_bus_close(&b);
+    }
     return ec;
 }
 

@@ -303,17 +303,24 @@ static bool all_answered(const j288_sched_t *s, uint32_t ids)
     return true;
 }
 
-/* Run one sweep to its end, even after a stop signal when ignore_stop is set. */
-static int sweep(cli_bus_t *b, j288_sched_t *s, uint32_t timeout_us, bool ignore_stop)
+/* One sweep of the listed slots, to its end: a cycle of the host layer's runner (its loop,
+ * its watchdog policy; a stop signal stops the bus there). */
+static int sweep(cli_bus_t *b, uint32_t timeout_us)
 {
-    uint32_t now = j288_linux_now_us();
-    int rc = j288_sched_start_sweep(s, now);
-    if (rc != J288_OK) {
-        return rc;
+    j288_robot_cycle_t info;
+    int rc = j288_robot_cycle(b->robot, timeout_us, &info);
+    if (info.watchdog != 0u) {
+        cli_report_watchdog(info.watchdog == 1u ? "a servo" : "servos");
     }
-    return j288_linux_run(&b->lp, s, now + timeout_us,
-                          J288_LINUX_RUN_UNTIL_IDLE |
-                              (ignore_stop ? J288_LINUX_RUN_IGNORE_STOP : 0u));
+    return rc == J288_ERR_TIMEOUT ? J288_OK : rc;
+}
+
+/* Why the bus failed (the runner's message, without its "bus 'bus': " prefix). */
+static const char *bus_error(const cli_bus_t *b)
+{
+    const char *msg = j288_robot_error(b->robot);
+    const char *colon = strncmp(msg, "bus '", 5) == 0 ? strstr(msg, "': ") : NULL;
+    return colon != NULL ? colon + 3 : msg;
 }
 
 typedef struct {
@@ -328,7 +335,7 @@ typedef struct {
     j288_side_t side;       /* of --swing, the gains and the CSV */
     j288_cmd_raw_t base;    /* a driven servo's command: FOC, gains, watchdog */
     cli_bus_t b;
-    j288_sched_t s;
+    j288_sched_t *s;        /* the runner's scheduler of the bus */
     FILE *csv;              /* NULL without --csv, and once closed */
     servo_acc_t acc[J288_MAX_ID + 1u];
     double pos_des[J288_MAX_ID + 1u];
@@ -356,7 +363,7 @@ static double mean_latency(const servo_acc_t *x)
 
 static void print_summary_json(const log_run_t *r, double achieved)
 {
-    const j288_bus_stats_t *bs = j288_bus_stats(&r->b.bus);
+    const j288_bus_stats_t *bs = j288_bus_stats(j288_robot_bus_engine(r->b.robot, 0));
     cli_json_t j;
     uint8_t id;
     cli_json_init(&j, stdout);
@@ -377,7 +384,7 @@ static void print_summary_json(const log_run_t *r, double achieved)
     cli_json_uint(&j, "collisions", bs->collisions);
     cli_json_uint(&j, "line_errors", bs->line_errors);
     cli_json_uint(&j, "stale_bytes", bs->stale_bytes);
-    cli_json_uint(&j, "garbage_bytes", j288_bus_parser_stats(&r->b.bus)->garbage_bytes);
+    cli_json_uint(&j, "garbage_bytes", j288_bus_parser_stats(j288_robot_bus_engine(r->b.robot, 0))->garbage_bytes);
     cli_json_end_object(&j);
     cli_json_begin_array(&j, "servos");
     for (id = 0; id <= J288_MAX_ID; id++) {
@@ -405,8 +412,8 @@ static void print_summary_json(const log_run_t *r, double achieved)
 
 static void print_summary_text(const log_run_t *r, double achieved)
 {
-    const j288_bus_stats_t *bs = j288_bus_stats(&r->b.bus);
-    const j288_parser_stats_t *ps = j288_bus_parser_stats(&r->b.bus);
+    const j288_bus_stats_t *bs = j288_bus_stats(j288_robot_bus_engine(r->b.robot, 0));
+    const j288_parser_stats_t *ps = j288_bus_parser_stats(j288_robot_bus_engine(r->b.robot, 0));
     uint8_t id;
     printf("log: %lu cycles in %.3f s: achieved %.1f Hz (asked %.1f Hz), %lu missed "
            "deadlines, %lu ticks skipped\n",
@@ -550,17 +557,17 @@ static int log_open(log_run_t *r)
         setvbuf(r->csv, NULL, _IOFBF, 1u << 16);
         csv_header(r->csv);
     }
-    j288_sched_init(&r->s, &r->b.bus, NULL);
+    r->s = j288_robot_bus_sched(r->b.robot, 0);
     for (id = 0; id <= J288_MAX_ID; id++) {
         if (listed(r, id)) {
             cli_lock_cmd(id, &cmd);
-            j288_sched_set_cmd(&r->s, &cmd);
-            j288_sched_enable(&r->s, id, true);
+            j288_sched_set_cmd(r->s, &cmd);
+            j288_sched_enable(r->s, id, true);
         }
         r->pos_des[id] = NAN;
     }
     /* The budget of one sweep: every servo's full reply window, plus slack. */
-    r->sweep_timeout_us = 15u * (j288_bus_reply_budget_us(&r->b.bus) * 2u + 1000u) + 100000u;
+    r->sweep_timeout_us = 15u * (j288_bus_reply_budget_us(j288_robot_bus_engine(r->b.robot, 0)) * 2u + 1000u) + 100000u;
     return CLI_EXIT_OK;
 }
 
@@ -585,7 +592,7 @@ static void probe_feed_joints(log_run_t *r, uint32_t *seen)
 {
     uint8_t id;
     for (id = 0; id <= J288_MAX_ID; id++) {
-        const j288_slot_t *sl = j288_sched_slot(&r->s, id);
+        const j288_slot_t *sl = j288_sched_slot(r->s, id);
         if (listed(r, id) && sl->stats.successes != seen[id]) {
             seen[id] = sl->stats.successes;
             (void)j288_joint_take_reply(&r->joint[id], &sl->reply, NULL);
@@ -602,19 +609,19 @@ static int log_probe(log_run_t *r)
     int i;
     uint32_t seen[J288_MAX_ID + 1u] = {0};
     int sweeps = r->a.side == SIDE_JOINT ? PROBE_SWEEPS_JOINT : PROBE_SWEEPS;
-    for (i = 0; i < sweeps && !(all_answered(&r->s, r->a.ids) && all_known(r)); i++) {
-        int rc = sweep(&r->b, &r->s, r->sweep_timeout_us, false);
+    for (i = 0; i < sweeps && !(all_answered(r->s, r->a.ids) && all_known(r)); i++) {
+        int rc = sweep(&r->b, r->sweep_timeout_us);
         probe_feed_joints(r, seen);
         if (rc == J288_ERR_ABORTED) {
             return cli_signal_exit_code();
         }
         if (rc == J288_ERR_OFFLINE) {
-            cli_error("%s", j288_linux_error(&r->b.lp));
+            cli_error("%s", bus_error(&r->b));
             return CLI_EXIT_FAIL;
         }
     }
     for (id = 0; id <= J288_MAX_ID; id++) {
-        const j288_slot_t *sl = j288_sched_slot(&r->s, id);
+        const j288_slot_t *sl = j288_sched_slot(r->s, id);
         if (!listed(r, id)) {
             continue;
         }
@@ -672,7 +679,7 @@ static void joint_cycle_command(log_run_t *r, uint8_t id, double t)
         if (rc == J288_OK) {
             cmd.watchdog = r->a.watchdog;
             r->pos_des[id] = (double)tg.pos;
-            j288_sched_set_cmd(&r->s, &cmd);
+            j288_sched_set_cmd(r->s, &cmd);
             return;
         }
         cli_joint_target_error(&r->joint[id], r->sel[id].name, "target", rc);
@@ -680,7 +687,7 @@ static void joint_cycle_command(log_run_t *r, uint8_t id, double t)
     }
     cli_lock_cmd(id, &cmd);
     r->pos_des[id] = NAN;
-    j288_sched_set_cmd(&r->s, &cmd);
+    j288_sched_set_cmd(r->s, &cmd);
 }
 
 /* This cycle's commands: hold where each servo started, or the swing at time t. Observed
@@ -708,7 +715,7 @@ static void set_cycle_commands(log_run_t *r, double t)
             swing_setpoint(&r->a, r->acc[id].p0, t, &cmd.pos, &cmd.speed);
         }
         r->pos_des[id] = (double)j288_pos_from_raw(cmd.pos, r->side);
-        j288_sched_set_cmd(&r->s, &cmd);
+        j288_sched_set_cmd(r->s, &cmd);
     }
 }
 
@@ -748,7 +755,7 @@ static void account_cycle(log_run_t *r, double t)
 {
     uint8_t id;
     for (id = 0; id <= J288_MAX_ID; id++) {
-        const j288_slot_t *sl = j288_sched_slot(&r->s, id);
+        const j288_slot_t *sl = j288_sched_slot(r->s, id);
         servo_acc_t *x = &r->acc[id];
         bool fresh;
         if (!listed(r, id)) {
@@ -801,7 +808,7 @@ static bool run_ends(const log_run_t *r, int rc, log_end_t *end)
         return true;
     }
     if (rc == J288_ERR_OFFLINE) {
-        cli_error("%s", j288_linux_error(&r->b.lp));
+        cli_error("%s", bus_error(&r->b));
         *end = LOG_FAILED;
         return true;
     }
@@ -822,7 +829,7 @@ static log_end_t log_cycles(log_run_t *r)
             break;
         }
         set_cycle_commands(r, t);
-        if (run_ends(r, sweep(&r->b, &r->s, r->sweep_timeout_us, false), &end)) {
+        if (run_ends(r, sweep(&r->b, r->sweep_timeout_us), &end)) {
             break;
         }
         r->rs.cycles++;
@@ -841,8 +848,6 @@ static int log_finish(log_run_t *r, log_end_t end)
 {
     bool failed = end == LOG_FAILED;
     if (!failed) {
-        (void)j288_linux_run(&r->b.lp, &r->s, j288_linux_now_us() + r->sweep_timeout_us,
-                             J288_LINUX_RUN_UNTIL_IDLE | J288_LINUX_RUN_IGNORE_STOP);
         if (cli_bus_lock_driven(&r->b) != 0) {
             cli_error("a servo did not confirm the lock (a broadcast lock was sent)");
             failed = true;

@@ -43,6 +43,24 @@ static bool have_program(const char *name)
 }
 
 /* One CSV line of `j288 log` split at commas (the fields hold no commas). */
+/* Whether the PNG can be written (checked before gnuplot, which, refused, would write it to
+ * the terminal); one error line if not. A file that did not exist is not left behind. */
+static bool png_writable(const char *png)
+{
+    struct stat st;
+    bool existed = stat(png, &st) == 0;
+    FILE *f = fopen(png, "a");
+    if (f == NULL) {
+        cli_error("cannot write %s: %s", png, strerror(errno));
+        return false;
+    }
+    (void)fclose(f);
+    if (!existed) {
+        (void)remove(png);
+    }
+    return true;
+}
+
 #define CSV_FIELDS 12
 static int split_csv(char *line, char *field[CSV_FIELDS])
 {
@@ -233,6 +251,9 @@ int cli_cmd_plot(int argc, char **argv, const cli_global_t *g)
     if (csv_scan(csv, &ids, &rows) != 0) {
         return CLI_EXIT_FAIL;
     }
+    if (!png_writable(png)) {
+        return CLI_EXIT_FAIL;
+    }
     if (!have_program("gnuplot")) {
         cli_error("gnuplot is not installed: no PNG written (apt-get install gnuplot-nox); "
                   "the CSV is %s",
@@ -245,7 +266,8 @@ int cli_cmd_plot(int argc, char **argv, const cli_global_t *g)
         return CLI_EXIT_FAIL;
     }
     close(fd);
-    snprintf(command, sizeof command, "gnuplot 2>%s", errfile);
+    /* stdout to /dev/null: gnuplot writes the PNG there when `set output` fails. */
+    snprintf(command, sizeof command, "gnuplot >/dev/null 2>%s", errfile);
     (void)remove(png);
     gp = popen(command, "w");
     if (gp == NULL) {

@@ -17,12 +17,14 @@ static const char robot_help[] =
     "limits), SI units.\n"
     "  status         read every joint once its angle is known; one line per joint\n"
     "  log            cycles at --rate for --duration; --csv FILE writes one row per joint\n"
-    "                 per cycle (time_s, cycle, joint, bus, id, fresh, known, pos_rad,\n"
-    "                 speed_rad_s, torque_nm); --hold holds every joint meanwhile\n"
-    "  hold           hold every joint where it is (the file's kp, kd) for --duration, or\n"
-    "                 until Ctrl-C\n"
-    "  stop           broadcast lock on every bus (each on its own: a bus that cannot be\n"
-    "                 opened is reported, the others are stopped)\n"
+    "                 per cycle in the single-servo log's format, which `j288 plot` reads\n"
+    "                 (time_s, id, ok, pos_rad, speed_rad_s, torque_nm, case_temp_c,\n"
+    "                 winding_temp_c, voltage_v, faults, latency_us, pos_des_rad), then\n"
+    "                 joint, bus, cycle; --hold holds every joint meanwhile\n"
+    "  hold           hold every joint where it is (the file's kp, kd; where it gives none,\n"
+    "                 kp 20 N*m/rad, kd 2.5 N*m*s/rad) for --duration, or until Ctrl-C\n"
+    "  stop           broadcast lock (watchdog bit 0) on every bus (each on its own: a bus\n"
+    "                 that cannot be opened is reported, the others are stopped)\n"
     "options:\n"
     "  --config FILE  the robot config (also accepted before the command)\n"
     "  --port DEV     the device when the file names no bus\n"
@@ -31,23 +33,37 @@ static const char robot_help[] =
     "  --duration S   seconds (log: default 1; hold: default until Ctrl-C)\n"
     "  --csv FILE     (log) per-joint rows\n"
     "  --hold         (log) hold every joint while logging\n"
-    "  --json         (status, log) machine-readable output\n"
+    "  --json         (status, log, hold, stop) machine-readable output\n"
+    "  --stop-on-bus-loss  (log, hold) a bus that stops answering or vanishes stops every\n"
+    "                 bus and ends the command (exit 1): no half-held robot\n"
     "A bus that stops answering is left behind (its joints go stale, reported at the end);\n"
+    "a servo found with its watchdog tripped is cleared and reported (exit 1);\n"
     "Ctrl-C or SIGTERM sends the broadcast lock on every bus before exiting (130 / 143).\n"
     "Exit status: 0 done; 1 a device or config error, or a joint that never answered;\n"
     "2 bad arguments.\n";
 
-enum { OPT_CONFIG = 0, OPT_PORT, OPT_MARGIN, OPT_RATE, OPT_DURATION, OPT_CSV, OPT_HOLD, OPT_JSON };
+enum {
+    OPT_CONFIG = 0,
+    OPT_PORT,
+    OPT_MARGIN,
+    OPT_RATE,
+    OPT_DURATION,
+    OPT_CSV,
+    OPT_HOLD,
+    OPT_JSON,
+    OPT_STOP_ON_LOSS
+};
 static const cli_opt_t robot_opts[] = {
     {"--config", true, OPT_CONFIG}, {"--port", true, OPT_PORT},   {"--margin-us", true, OPT_MARGIN},
     {"--rate", true, OPT_RATE},     {"--duration", true, OPT_DURATION}, {"--csv", true, OPT_CSV},
-    {"--hold", false, OPT_HOLD},    {"--json", false, OPT_JSON}, {NULL, false, 0}};
+    {"--hold", false, OPT_HOLD},    {"--json", false, OPT_JSON},
+    {"--stop-on-bus-loss", false, OPT_STOP_ON_LOSS}, {NULL, false, 0}};
 
 typedef struct {
     const char *config, *port, *csv;
     uint32_t margin_us;
     double rate_hz, duration_s;
-    bool have_duration, hold, json;
+    bool have_duration, hold, json, stop_on_loss;
 } robot_args_t;
 
 typedef struct {
@@ -55,7 +71,10 @@ typedef struct {
     FILE *csv;
     uint32_t t0;
     unsigned joint_events, bus_events;
+    bool held; /* every joint held where it was (pos_des: the hold pose) */
+    double hold_pos[J288_ROBOT_MAX_JOINTS];
 } robot_run_t;
+
 
 static const char *const robot_commands[] = {"log", "status", "hold", "stop", NULL};
 
@@ -127,6 +146,9 @@ static int parse_robot_args(int argc, char **argv, const cli_global_t *g, robot_
         case OPT_HOLD:
             a->hold = true;
             break;
+        case OPT_STOP_ON_LOSS:
+            a->stop_on_loss = true;
+            break;
         default: /* OPT_JSON */
             a->json = true;
             break;
@@ -156,6 +178,12 @@ static void on_event(void *user, const j288_robot_event_t *ev)
                 what[ev->kind]);
     } else if (ev->kind == J288_ROBOT_EV_JOINT) {
         run->joint_events++;
+    } else if (ev->kind == J288_ROBOT_EV_WATCHDOG) {
+        char what[J288_ROBOT_CONFIG_NAME_MAX + 16];
+        (void)snprintf(what, sizeof what, "joint %s",
+                       ev->joint >= 0 ? j288_robot_joint_name(run->robot, (unsigned)ev->joint)
+                                      : "?");
+        cli_report_watchdog(what);
     }
 }
 
@@ -167,13 +195,27 @@ static void on_cycle(void *user, j288_robot_t *r, const j288_robot_cycle_t *c)
         return;
     for (j = 0; j < j288_robot_njoints(r); j++) {
         j288_robot_state_t st;
+        j288_robot_joint_stats_t js;
+        char pos[32] = "", des[32] = "";
+        const char *bus = j288_robot_bus_name(r, (unsigned)j288_robot_joint_bus(r, j));
+        double t = (double)(c->start_us - run->t0) * 1e-6;
         (void)j288_robot_read(r, j, &st);
-        fprintf(run->csv, "%.6f,%u,%s,%s,%d,%d,%d,%.9g,%.9g,%.9g\n",
-                (double)(c->start_us - run->t0) * 1e-6, (unsigned)c->cycle,
-                j288_robot_joint_name(r, j),
-                j288_robot_bus_name(r, (unsigned)j288_robot_joint_bus(r, j)),
-                j288_robot_joint_id(r, j), st.fresh ? 1 : 0, st.known ? 1 : 0, st.pos, st.speed,
-                st.torque);
+        (void)j288_robot_joint_stats(r, j, &js);
+        if (st.known)
+            (void)snprintf(pos, sizeof pos, "%.7g", st.pos);
+        if (run->held)
+            (void)snprintf(des, sizeof des, "%.7g", run->hold_pos[j]);
+        /* j288 log's columns (cmd_log.c), then the joint's name, bus and cycle. */
+        if (st.fresh)
+            fprintf(run->csv, "%.6f,%d,1,%s,%.7g,%.7g,%.0f,%.0f,%.1f,%lu,%lu,%s,%s,%s,%u\n", t,
+                    j288_robot_joint_id(r, j), pos, st.speed, st.torque, st.case_temp_c,
+                    st.winding_temp_c, st.voltage_v, (unsigned long)st.faults,
+                    (unsigned long)js.servo.last_latency_us,
+                    des, j288_robot_joint_name(r, j), bus,
+                    (unsigned)c->cycle);
+        else
+            fprintf(run->csv, "%.6f,%d,0,,,,,,,,,,%s,%s,%u\n", t, j288_robot_joint_id(r, j),
+                    j288_robot_joint_name(r, j), bus, (unsigned)c->cycle);
     }
 }
 
@@ -271,16 +313,20 @@ static void print_summary(j288_robot_t *r, double seconds, uint32_t cycles, uint
     }
 }
 
-static int hold_all(j288_robot_t *r)
+static int hold_all(j288_robot_t *r, robot_run_t *run)
 {
     unsigned j;
     for (j = 0; j < j288_robot_njoints(r); j++) {
+        j288_robot_state_t st;
         int rc = j288_robot_hold(r, j);
         if (rc != J288_OK) {
             cli_error("joint %s: %s", j288_robot_joint_name(r, j), j288_strerror(rc));
             return -1;
         }
+        (void)j288_robot_read(r, j, &st);
+        run->hold_pos[j] = st.pos;
     }
+    run->held = true;
     return 0;
 }
 
@@ -324,8 +370,21 @@ static int stop_each_bus(const robot_args_t *a, const j288_robot_options_t *o)
         }
         j288_robot_close(&one);
     }
-    printf("broadcast lock sent on %zu of %zu buses\n", n - failed, n);
+    if (a->json)
+        printf("{\"stopped\": \"all\", \"buses\": %zu, \"sent\": %zu}\n", n, n - failed);
+    else
+        printf("broadcast lock sent on %zu of %zu buses\n", n - failed, n);
     return failed == 0u ? CLI_EXIT_OK : CLI_EXIT_FAIL;
+}
+
+/* Every bus's notices (low latency refused, latency timer advice), once, on stderr. */
+static void print_notices(const j288_robot_t *r)
+{
+    char all[2048] = "";
+    unsigned b;
+    for (b = 0; b < j288_robot_nbuses(r); b++)
+        (void)strncat(all, j288_robot_notices(r, b), sizeof all - strlen(all) - 1u);
+    cli_print_notices(all);
 }
 
 static FILE *g_csv_open; /* closed by finish() when a command ends before its run */
@@ -365,13 +424,16 @@ int cli_cmd_robot(int argc, char **argv, const cli_global_t *g)
     o.on_event = on_event;
     o.on_cycle = on_cycle;
     o.user = &run;
+    o.stop_on_bus_loss = a.stop_on_loss;
     if (a.csv != NULL && strcmp(cmd, "log") == 0) {
         csv = fopen(a.csv, "w");
         if (csv == NULL) {
             cli_error("%s: cannot write", a.csv);
             return CLI_EXIT_FAIL;
         }
-        fputs("time_s,cycle,joint,bus,id,fresh,known,pos_rad,speed_rad_s,torque_nm\n", csv);
+        fputs("time_s,id,ok,pos_rad,speed_rad_s,torque_nm,case_temp_c,winding_temp_c,voltage_v,"
+              "faults,latency_us,pos_des_rad,joint,bus,cycle\n",
+              csv);
         g_csv_open = csv;
     }
     cli_signals_install();
@@ -385,6 +447,7 @@ int cli_cmd_robot(int argc, char **argv, const cli_global_t *g)
         return CLI_EXIT_FAIL;
     }
     j288_robot_set_stop_flag(&robot, &cli_stop_signal);
+    print_notices(&robot);
 
     {
         unsigned unknown = acquire(&robot);
@@ -400,7 +463,7 @@ int cli_cmd_robot(int argc, char **argv, const cli_global_t *g)
             return finish(&robot, CLI_EXIT_FAIL);
         }
     }
-    if ((a.hold || strcmp(cmd, "hold") == 0) && hold_all(&robot) != 0)
+    if ((a.hold || strcmp(cmd, "hold") == 0) && hold_all(&robot, &run) != 0)
         return finish(&robot, CLI_EXIT_FAIL);
 
     /* log and hold: cycles at the rate; the statistics restart here (the start's cycles). */

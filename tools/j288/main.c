@@ -66,6 +66,12 @@ static const cli_opt_t global_opts[] = {{"--port", true, OPT_PORT},
                                         {"--version", false, OPT_VERSION},
                                         {NULL, false, 0}};
 
+/* A servo whose watchdog tripped was cleared and reported (cli_bus.h): never exit 0 then. */
+static int watchdog_exit(int code)
+{
+    return (code == CLI_EXIT_OK && cli_watchdog_trips != 0u) ? CLI_EXIT_FAIL : code;
+}
+
 int main(int argc, char **argv)
 {
     cli_global_t g = {NULL, 0, NULL};
@@ -127,12 +133,12 @@ int main(int argc, char **argv)
     }
     if (cli_robot_takes(v, argc - (a.index - 1), argv + (a.index - 1), &g)) {
         cli_set_command(v);
-        return cli_cmd_robot(argc - (a.index - 1), argv + (a.index - 1), &g);
+        return watchdog_exit(cli_cmd_robot(argc - (a.index - 1), argv + (a.index - 1), &g));
     }
     for (c = commands; c->name != NULL; c++) {
         if (strcmp(v, c->name) == 0) {
             cli_set_command(c->name);
-            return c->fn(argc - (a.index - 1), argv + (a.index - 1), &g);
+            return watchdog_exit(c->fn(argc - (a.index - 1), argv + (a.index - 1), &g));
         }
     }
     cli_error("unknown command '%s' (try j288 --help)", v);

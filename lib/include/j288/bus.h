@@ -219,7 +219,8 @@ void j288_bus_on_rx_idle(j288_bus_t *bus);
 void j288_bus_on_error(j288_bus_t *bus, uint32_t line_flags);
 void j288_bus_on_timer(j288_bus_t *bus);
 
-/* Emergency stop: broadcast lock (id 15, status 0, watchdog on, all fields 0) as soon as the
+/* Emergency stop: broadcast lock (id 15, status 0, watchdog bit 0, all fields 0: no watchdog
+ * left to trip, and a trip cleared) as soon as the
  * line is free, ahead of anything else. A transaction in flight is not cut mid-frame and its
  * reply is not talked over: it ends with J288_ERR_ABORTED when its attempt ends (reply taken,
  * deadline, collision; at most one reply budget), without retries, its real reason kept in
