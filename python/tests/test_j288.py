@@ -394,7 +394,7 @@ def test_sigterm_stops_the_servos(sims) -> None:
                 bus.command(1, pos=p, kp=20, kd=1)
         """)
     proc = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE,
-                            env=dict(os.environ, PYTHONPATH=str(ROOT / "python")), text=True)
+                            env=dict(os.environ, PYTHONPATH=PKG_PATH), text=True)
     try:
         assert proc.stdout is not None and proc.stdout.readline() == "ready\n"
         assert sim.logged(" id=1 status=1 wd=1")
