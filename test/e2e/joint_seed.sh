@@ -47,7 +47,9 @@ t_seed() {
     c=$(truth_val 1 c)
     near "$phase" "$c" 0.02 "$TWO_PI" || { echo "seed $seed: phase $phase vs c $c"; return 1; }
     grep -q '^  - name: hip             # servo 1$' "$cfg" || { echo "comment lost"; return 1; }
-    # Calibrated: the rotor's resolution, and the same across a power cycle.
+    # Calibrated: the rotor's resolution, and the same across a power cycle (once the joint
+    # has come to rest after the calibration's motion: on a loaded machine it still moved).
+    wait_settled 1 || return 1
     status_joint hip "$cfg" || { echo "seed $seed: $(cat "$E2E_TMP/st.err")"; return 1; }
     [ "$(jget "$E2E_TMP/st.json" joint_calibrated)" = True ] || { cat "$E2E_TMP/st.json"; return 1; }
     before=$(jget "$E2E_TMP/st.json" joint_pos)

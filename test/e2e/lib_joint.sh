@@ -11,7 +11,9 @@ cd "$(dirname "$0")/../.."
 e2e_need_python
 SIM_DIR=$E2E_TMP
 . test/e2e/lib_sim.sh
-M=(--margin-us 250000 --retries 1)
+# (3 retries: a simulator starved past the margin twice in a row, seen at load 18, is not a
+# failure of what these scripts check; every check is on where the joint ended)
+M=(--margin-us 250000 --retries 3)
 E2E_CMD_TIMEOUT=60
 CMD_TIMEOUT=$(e2e_scaled 60)
 
