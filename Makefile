@@ -74,7 +74,7 @@ ALL_TARGETS := $(LIB_A) $(UNIT_TESTS)
 # Each fragment may use what the ones before it define.
 include $(sort $(wildcard mk/cpu/*.mk))
 include mk/tools.mk mk/tests.mk mk/target.mk mk/bench.mk mk/hardening.mk mk/firmware.mk
-include mk/robot.mk mk/release.mk mk/python.mk
+include mk/robot.mk mk/release.mk mk/python.mk mk/dds.mk
 
 all: $(ALL_TARGETS)
 
@@ -123,15 +123,19 @@ test: $(HOST_TESTS) $(TEST_DEPS)
 # ---- install ---------------------------------------------------------------------------------
 # CMake's install (cmake/j288_install.cmake) from a tree in $(CMAKE_BUILD), for PREFIX, under
 # DESTDIR; `make uninstall` removes the files it listed (in $(INSTALLED), with DESTDIR), then
-# the j288 directories they leave empty.
+# the j288 directories they leave empty. A fragment that installs a program CMake does not
+# build (mk/dds.mk) makes it a prerequisite of install and lists it in $(INSTALLED_EXTRA).
 PREFIX ?= /usr/local
+BINDIR ?= $(PREFIX)/bin
 CMAKE_BUILD := $(BUILD)/cmake
 INSTALLED := $(CMAKE_BUILD)/installed.txt
+INSTALLED_EXTRA := $(CMAKE_BUILD)/installed-extra.txt
 install:
 	@$(call REQUIRE,cmake,cmake); \
 	 cmake -S . -B $(CMAKE_BUILD) -DCMAKE_INSTALL_PREFIX=$(PREFIX) $(CMAKE_FLAGS) >/dev/null && \
 	 cmake --build $(CMAKE_BUILD) -j2 && DESTDIR=$(DESTDIR) cmake --install $(CMAKE_BUILD) && \
-	 sed 's|^|$(DESTDIR)|' $(CMAKE_BUILD)/install_manifest.txt >$(INSTALLED)
+	 { sed 's|^|$(DESTDIR)|' $(CMAKE_BUILD)/install_manifest.txt; cat $(INSTALLED_EXTRA) 2>/dev/null; } \
+	     >$(INSTALLED); rm -f $(INSTALLED_EXTRA)
 
 uninstall:
 	@[ -f $(INSTALLED) ] || { echo "uninstall: $(INSTALLED) missing: nothing installed from here"; exit 1; }

@@ -3,8 +3,12 @@
 
 #include "j288_robot_config.h"
 
+#include "j288_number.h"
+
+#include <dirent.h>
 #include <errno.h>
 #include <limits.h>
+#include <signal.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -120,6 +124,29 @@ static int read_file(const char *path, char **text, size_t *len, char *err, size
     return 0;
 }
 
+/* A relative port names a device beside the file (a simulator's link in the robot's
+ * folder), wherever the tool was started: path's folder goes in front of it. */
+static int resolve_ports(const char *path, j288_robot_config_t *cfg, char *err, size_t errlen)
+{
+    const char *slash = strrchr(path, '/');
+    size_t dirlen = (slash == NULL) ? 0u : (size_t)(slash - path) + 1u; /* with the '/' */
+    size_t i;
+    for (i = 0; i < cfg->nbuses && dirlen > 0u; i++) {
+        j288_robot_config_bus_t *b = &cfg->bus[i];
+        char joined[J288_ROBOT_CONFIG_PORT_MAX];
+        if (b->port[0] == '/')
+            continue;
+        if ((size_t)snprintf(joined, sizeof joined, "%.*s%s", (int)dirlen, path, b->port) >=
+            sizeof joined)
+            return set_error(err, errlen,
+                             "%s:%u: bus '%s': port: %s within the file's folder is longer than "
+                             "%u bytes",
+                             path, b->line, b->name, b->port, J288_ROBOT_CONFIG_PORT_MAX - 1u);
+        memcpy(b->port, joined, sizeof joined);
+    }
+    return 0;
+}
+
 int j288_robot_config_load(const char *path, j288_robot_config_t *cfg, char *err, size_t errlen)
 {
     char *text = NULL;
@@ -131,7 +158,7 @@ int j288_robot_config_load(const char *path, j288_robot_config_t *cfg, char *err
         return -1;
     rc = j288_robot_config_parse(text, len, path, cfg, err, errlen);
     free(text);
-    return rc;
+    return (rc == 0) ? resolve_ports(path, cfg, err, errlen) : rc;
 }
 
 #ifndef J288_HAVE_LIBYAML
@@ -175,11 +202,15 @@ int j288_robot_config_write_joint(const char *path, const char *joint, const j28
     return set_error(err, errlen, "%s: %s", path, NO_YAML);
 }
 
+int j288_robot_config_check_writable(const char *path, char *err, size_t errlen)
+{
+    return set_error(err, errlen, "%s: %s", path, NO_YAML);
+}
+
 #else /* J288_HAVE_LIBYAML */
 
 #define PI          3.141592653589793
 #define TWO_PI      (2.0 * PI)
-#define VALUE_LIMIT 1e6 /* largest |zero| or |phase| written back */
 
 bool j288_robot_config_available(void)
 {
@@ -249,20 +280,34 @@ static bool is_null(const yaml_node_t *n)
     return false;
 }
 
+/* s for a message: its first 40 bytes, control characters (a folded scalar's line breaks)
+ * as '?', "..." when cut: a message stays one line whatever the file holds. */
+static const char *printable(const char *s, char *buf, size_t cap)
+{
+    size_t i, n = 0;
+    for (i = 0; s[i] != '\0' && i < 40u && n + 4u < cap; i++)
+        buf[n++] = ((unsigned char)s[i] < 0x20u || s[i] == 0x7F) ? '?' : s[i];
+    if (s[i] != '\0' && n + 4u <= cap) {
+        memcpy(buf + n, "...", 3);
+        n += 3u;
+    }
+    buf[n] = '\0';
+    return buf;
+}
+
 /* What a node is, for "expected X, got Y". */
 static const char *describe(const yaml_node_t *n, char *buf, size_t cap)
 {
+    char text[48];
     if (n->type == YAML_MAPPING_NODE)
         return "a mapping";
     if (n->type == YAML_SEQUENCE_NODE)
         return "a list";
     if (is_null(n))
         return "nothing";
-    if (n->data.scalar.style != YAML_PLAIN_SCALAR_STYLE) {
-        (void)snprintf(buf, cap, "the quoted text '%.40s'", scalar(n));
-        return buf;
-    }
-    (void)snprintf(buf, cap, "'%.40s'%s", scalar(n), strlen(scalar(n)) > 40u ? "..." : "");
+    (void)snprintf(buf, cap, "%s'%s'",
+                   n->data.scalar.style != YAML_PLAIN_SCALAR_STYLE ? "the quoted text " : "",
+                   printable(scalar(n), text, sizeof text));
     return buf;
 }
 
@@ -272,56 +317,37 @@ static int expected(ctx_t *x, const yaml_node_t *v, const char *key, const char 
     return fail(x, line_of(v), "%s: expected %s, got %s", key, what, describe(v, buf, sizeof buf));
 }
 
-/* A plain scalar made only of what a decimal number may hold: strtod alone would also take
- * "inf", "nan", hexadecimal and leading blanks. */
-static bool decimal_syntax(const char *s, bool integer)
+static bool plain_scalar(const yaml_node_t *v)
 {
-    size_t i, digits = 0;
-    for (i = 0; s[i] != '\0'; i++) {
-        char ch = s[i];
-        if (ch >= '0' && ch <= '9')
-            digits++;
-        else if (ch == '+' || ch == '-')
-            continue;
-        else if (integer || (ch != '.' && ch != 'e' && ch != 'E'))
-            return false;
-    }
-    return digits > 0u;
+    return v->type == YAML_SCALAR_NODE && v->data.scalar.style == YAML_PLAIN_SCALAR_STYLE;
 }
 
+/* A number in the syntax the tool's options take too (j288_number.h): decimal, no "inf",
+ * "nan" or hexadecimal. */
 static int get_number(ctx_t *x, const yaml_node_t *v, const char *key, double *out)
 {
-    char *end;
-    double d;
-    if (v->type != YAML_SCALAR_NODE || v->data.scalar.style != YAML_PLAIN_SCALAR_STYLE ||
-        !decimal_syntax(scalar(v), false))
+    j288_number_result_t rc = plain_scalar(v) ? j288_number_real(scalar(v), out)
+                                              : J288_NUMBER_SYNTAX;
+    if (rc == J288_NUMBER_SYNTAX)
         return expected(x, v, key, "a number");
-    errno = 0;
-    d = strtod(scalar(v), &end);
-    if (*end != '\0' || end == scalar(v))
-        return expected(x, v, key, "a number");
-    if (errno == ERANGE || !isfinite(d))
+    if (rc == J288_NUMBER_RANGE)
         return fail(x, line_of(v), "%s: %s is out of range", key, scalar(v));
-    *out = d;
     return 0;
 }
 
+/* A whole number (decimal or 0x hexadecimal, as on the command line) in [lo, hi]. */
 static int get_long(ctx_t *x, const yaml_node_t *v, const char *key, long lo, long hi, long *out)
 {
     char what[64];
-    char *end;
-    long n;
+    long long n = 0;
+    j288_number_result_t rc = plain_scalar(v) ? j288_number_int(scalar(v), &n)
+                                              : J288_NUMBER_SYNTAX;
     (void)snprintf(what, sizeof what, "an integer %ld-%ld", lo, hi);
-    if (v->type != YAML_SCALAR_NODE || v->data.scalar.style != YAML_PLAIN_SCALAR_STYLE ||
-        !decimal_syntax(scalar(v), true))
+    if (rc == J288_NUMBER_SYNTAX)
         return expected(x, v, key, what);
-    errno = 0;
-    n = strtol(scalar(v), &end, 10);
-    if (*end != '\0' || end == scalar(v))
-        return expected(x, v, key, what);
-    if (errno == ERANGE || n < lo || n > hi)
+    if (rc == J288_NUMBER_RANGE || n < lo || n > hi)
         return fail(x, line_of(v), "%s: %s is out of range (%ld-%ld)", key, scalar(v), lo, hi);
-    *out = n;
+    *out = (long)n;
     return 0;
 }
 
@@ -330,7 +356,7 @@ static int get_bool(ctx_t *x, const yaml_node_t *v, const char *key, bool *out)
     static const char *const yes[] = {"true", "True", "TRUE"};
     static const char *const no[] = {"false", "False", "FALSE"};
     size_t i;
-    if (v->type == YAML_SCALAR_NODE && v->data.scalar.style == YAML_PLAIN_SCALAR_STYLE) {
+    if (plain_scalar(v)) {
         for (i = 0; i < 3u; i++) {
             if (strcmp(scalar(v), yes[i]) == 0) {
                 *out = true;
@@ -350,6 +376,7 @@ static int get_bool(ctx_t *x, const yaml_node_t *v, const char *key, bool *out)
 static int get_text(ctx_t *x, const yaml_node_t *v, const char *key, bool is_name, char *buf,
                     size_t cap)
 {
+    char shown[48];
     size_t i, n;
     if (v->type != YAML_SCALAR_NODE || is_null(v))
         return expected(x, v, key, is_name ? "a name" : "text");
@@ -359,7 +386,8 @@ static int get_text(ctx_t *x, const yaml_node_t *v, const char *key, bool is_nam
     for (i = 0; i < n; i++) {
         unsigned char ch = v->data.scalar.value[i];
         if (ch < 0x20u || ch == 0x7Fu || (is_name && ch == ' '))
-            return fail(x, line_of(v), "%s: '%s' has a %s", key, scalar(v),
+            return fail(x, line_of(v), "%s: '%s' has a %s", key,
+                        printable(scalar(v), shown, sizeof shown),
                         ch == ' ' ? "blank" : "control character");
     }
     memcpy(buf, v->data.scalar.value, n);
@@ -371,6 +399,7 @@ static int get_text(ctx_t *x, const yaml_node_t *v, const char *key, bool is_nam
 static int check_keys(ctx_t *x, const yaml_node_t *m, const char *const *allowed, size_t nallowed,
                       const char *allowed_text)
 {
+    char shown[48];
     yaml_node_pair_t *p, *q;
     for (p = m->data.mapping.pairs.start; p < m->data.mapping.pairs.top; p++) {
         yaml_node_t *k = node_at(x, p->key);
@@ -382,10 +411,12 @@ static int check_keys(ctx_t *x, const yaml_node_t *m, const char *const *allowed
         for (i = 0; i < nallowed; i++)
             known = known || strcmp(scalar(k), allowed[i]) == 0;
         if (!known)
-            return fail(x, line_of(k), "unknown key '%.40s' (known: %s)", scalar(k), allowed_text);
+            return fail(x, line_of(k), "unknown key '%s' (known: %s)",
+                        printable(scalar(k), shown, sizeof shown), allowed_text);
         for (q = m->data.mapping.pairs.start; q < p; q++)
             if (strcmp(scalar(node_at(x, q->key)), scalar(k)) == 0)
-                return fail(x, line_of(k), "'%s' given twice (first on line %zu)", scalar(k),
+                return fail(x, line_of(k), "'%s' given twice (first on line %zu)",
+                            printable(scalar(k), shown, sizeof shown),
                             line_of(node_at(x, q->key)));
     }
     return 0;
@@ -409,10 +440,14 @@ static const char *peek_name(ctx_t *x, const yaml_node_t *m)
     for (p = m->data.mapping.pairs.start; p < m->data.mapping.pairs.top; p++) {
         yaml_node_t *k = node_at(x, p->key);
         yaml_node_t *v = node_at(x, p->value);
-        if (k->type == YAML_SCALAR_NODE && strcmp(scalar(k), "name") == 0 &&
-            v->type == YAML_SCALAR_NODE && v->data.scalar.length < J288_ROBOT_CONFIG_NAME_MAX &&
-            strlen(scalar(v)) == v->data.scalar.length)
-            return scalar(v);
+        size_t i, n;
+        if (k->type != YAML_SCALAR_NODE || strcmp(scalar(k), "name") != 0 ||
+            v->type != YAML_SCALAR_NODE || v->data.scalar.length >= J288_ROBOT_CONFIG_NAME_MAX)
+            continue;
+        for (i = 0, n = v->data.scalar.length; i < n; i++)
+            if (v->data.scalar.value[i] < 0x20u || v->data.scalar.value[i] == 0x7Fu)
+                return NULL; /* get_text() will say what is wrong with it */
+        return scalar(v);
     }
     return NULL;
 }
@@ -514,6 +549,33 @@ static int parse_bus(ctx_t *x, yaml_node_t *m, size_t i)
     return 0;
 }
 
+/* Where a number may lie: [lo, hi], lo itself excluded when lo_open. */
+typedef struct {
+    double lo, hi;
+    bool lo_open;
+} range_t;
+
+/* The library's own bounds (j288_joint_init()), so that what the file takes the runner's
+ * joints take too: angles within J288_JOINT_MAX_ANGLE, the phase within 2 pi, speeds,
+ * torques and gains up to 1e30 (beyond that a float build would hold infinities). */
+#define GAIN_MAX 1e30
+static const range_t k_angle = {-J288_JOINT_MAX_ANGLE, J288_JOINT_MAX_ANGLE, false};
+static const range_t k_phase = {-TWO_PI, TWO_PI, false};
+static const range_t k_at_least_0 = {0.0, GAIN_MAX, false};
+static const range_t k_above_0 = {0.0, GAIN_MAX, true};
+
+/* v's number d within r, else an error naming key, the value as written and the range. */
+static int check_range(ctx_t *x, const yaml_node_t *v, const char *key, double d, const range_t *r)
+{
+    if (r->lo == 0.0 && (r->lo_open ? !(d > 0.0) : !(d >= 0.0)))
+        return fail(x, line_of(v), "%s: %s must be %s", key, scalar(v),
+                    r->lo_open ? "above 0" : "0 or more");
+    if (d < r->lo || d > r->hi)
+        return fail(x, line_of(v), "%s: %s is out of range (%.10g to %.10g)", key, scalar(v),
+                    r->lo, r->hi);
+    return 0;
+}
+
 static int get_limits(ctx_t *x, const yaml_node_t *v, j288_robot_config_joint_t *jt)
 {
     yaml_node_t *lo, *hi;
@@ -523,7 +585,9 @@ static int get_limits(ctx_t *x, const yaml_node_t *v, j288_robot_config_joint_t 
     lo = node_at(x, v->data.sequence.items.start[0]);
     hi = node_at(x, v->data.sequence.items.start[1]);
     if (get_number(x, lo, "limits", &jt->pos_min) != 0 ||
-        get_number(x, hi, "limits", &jt->pos_max) != 0)
+        check_range(x, lo, "limits", jt->pos_min, &k_angle) != 0 ||
+        get_number(x, hi, "limits", &jt->pos_max) != 0 ||
+        check_range(x, hi, "limits", jt->pos_max, &k_angle) != 0)
         return -1;
     if (!(jt->pos_min < jt->pos_max))
         return fail(x, line_of(v), "limits: [%s, %s] are reversed or empty: [min, max]", scalar(lo),
@@ -537,21 +601,15 @@ static int get_limits(ctx_t *x, const yaml_node_t *v, j288_robot_config_joint_t 
     return 0;
 }
 
-/* Bounds of a number: none, 0 or more, above 0. */
-typedef enum { ANY_VALUE, AT_LEAST_0, ABOVE_0 } bound_t;
-
 /* key's number in mapping m into *out, when it is there (then *has, if given, is set). */
-static int opt_number(ctx_t *x, const yaml_node_t *m, const char *key, bound_t bound, bool *has,
-                      double *out)
+static int opt_number(ctx_t *x, const yaml_node_t *m, const char *key, const range_t *r,
+                      bool *has, double *out)
 {
     yaml_node_t *v = value_of(x, m, key);
     if (v == NULL)
         return 0;
-    if (get_number(x, v, key, out) != 0)
+    if (get_number(x, v, key, out) != 0 || check_range(x, v, key, *out, r) != 0)
         return -1;
-    if ((bound == AT_LEAST_0 && !(*out >= 0.0)) || (bound == ABOVE_0 && !(*out > 0.0)))
-        return fail(x, line_of(v), "%s: %s must be %s", key, scalar(v),
-                    bound == ABOVE_0 ? "above 0" : "0 or more");
     if (has != NULL)
         *has = true;
     return 0;
@@ -563,12 +621,12 @@ static int parse_joint_numbers(ctx_t *x, const yaml_node_t *m, j288_robot_config
     yaml_node_t *v;
     if ((v = value_of(x, m, "limits")) != NULL && get_limits(x, v, jt) != 0)
         return -1;
-    if (opt_number(x, m, "zero", ANY_VALUE, NULL, &jt->zero) != 0 ||
-        opt_number(x, m, "max_speed", ABOVE_0, &jt->has_max_speed, &jt->max_speed) != 0 ||
-        opt_number(x, m, "max_torque", ABOVE_0, &jt->has_max_torque, &jt->max_torque) != 0 ||
-        opt_number(x, m, "kp", AT_LEAST_0, &jt->has_kp, &jt->kp) != 0 ||
-        opt_number(x, m, "kd", AT_LEAST_0, &jt->has_kd, &jt->kd) != 0 ||
-        opt_number(x, m, "phase", ANY_VALUE, &jt->has_phase, &jt->phase) != 0)
+    if (opt_number(x, m, "zero", &k_angle, NULL, &jt->zero) != 0 ||
+        opt_number(x, m, "max_speed", &k_above_0, &jt->has_max_speed, &jt->max_speed) != 0 ||
+        opt_number(x, m, "max_torque", &k_above_0, &jt->has_max_torque, &jt->max_torque) != 0 ||
+        opt_number(x, m, "kp", &k_at_least_0, &jt->has_kp, &jt->kp) != 0 ||
+        opt_number(x, m, "kd", &k_at_least_0, &jt->has_kd, &jt->kd) != 0 ||
+        opt_number(x, m, "phase", &k_phase, &jt->has_phase, &jt->phase) != 0)
         return -1;
     return 0;
 }
@@ -601,11 +659,9 @@ static int parse_joint(ctx_t *x, yaml_node_t *m, size_t i)
         return -1;
     jt->id = (uint8_t)n;
     if ((v = value_of(x, m, "direction")) != NULL) {
-        long d = 0;
-        if (v->type == YAML_SCALAR_NODE && v->data.scalar.style == YAML_PLAIN_SCALAR_STYLE &&
-            decimal_syntax(scalar(v), true))
-            d = strtol(scalar(v), NULL, 10);
-        if (d != 1 && d != -1)
+        long long d = 0;
+        if (!plain_scalar(v) || j288_number_int(scalar(v), &d) != J288_NUMBER_OK ||
+            (d != 1 && d != -1))
             return expected(x, v, "direction", "1 or -1");
         jt->direction = (int)d;
     }
@@ -653,7 +709,7 @@ static int resolve_joints(ctx_t *x)
 }
 
 /* buses: or joints: - a list (or nothing) of at most max entries; parse each with fn. */
-static int parse_list(ctx_t *x, yaml_node_t *v, const char *key, size_t max, size_t *count,
+static int parse_list(ctx_t *x, yaml_node_t *v, const entry_kind_t *k, size_t max, size_t *count,
                       int (*fn)(ctx_t *, yaml_node_t *, size_t))
 {
     yaml_node_item_t *it;
@@ -661,11 +717,13 @@ static int parse_list(ctx_t *x, yaml_node_t *v, const char *key, size_t max, siz
     if (v == NULL || is_null(v))
         return 0;
     if (v->type != YAML_SEQUENCE_NODE)
-        return expected(x, v, key, "a list (- name: ...)");
+        return expected(x, v, k->list, "a list (- name: ...)");
     for (it = v->data.sequence.items.start; it < v->data.sequence.items.top; it++) {
         yaml_node_t *e = node_at(x, *it);
-        if (*count == max)
-            return fail(x, line_of(e), "%s: more than %zu", key, max);
+        if (*count == max) { /* named as the entry one too many, not as the last one read */
+            set_label(x, k->kind, e->type == YAML_MAPPING_NODE ? peek_name(x, e) : NULL, *count);
+            return fail(x, line_of(e), "%s: more than %zu", k->list, max);
+        }
         if (fn(x, e, *count) != 0)
             return -1;
         (*count)++;
@@ -686,11 +744,11 @@ static int parse_root(ctx_t *x)
         return expected(x, root, "the file", "a mapping with 'buses:' and 'joints:'");
     if (check_keys(x, root, top_keys, 2, "buses, joints") != 0)
         return -1;
-    if (parse_list(x, value_of(x, root, "buses"), "buses", J288_ROBOT_CONFIG_MAX_BUSES, &x->cfg->nbuses,
-                   parse_bus) != 0)
+    if (parse_list(x, value_of(x, root, "buses"), &k_bus, J288_ROBOT_CONFIG_MAX_BUSES,
+                   &x->cfg->nbuses, parse_bus) != 0)
         return -1;
     x->label[0] = '\0';
-    if (parse_list(x, value_of(x, root, "joints"), "joints", J288_ROBOT_CONFIG_MAX_JOINTS,
+    if (parse_list(x, value_of(x, root, "joints"), &k_joint, J288_ROBOT_CONFIG_MAX_JOINTS,
                    &x->cfg->njoints, parse_joint) != 0)
         return -1;
     for (p = root->data.mapping.pairs.start; p < root->data.mapping.pairs.top; p++)
@@ -752,12 +810,59 @@ static void parser_setup(ctx_t *x, yaml_parser_t *p)
     yaml_parser_set_input_string(p, x->text, x->len);
 }
 
-/* A pass over the events: syntax errors, aliases, more than one document. */
+/* An event's explicit tag (!!str, !foo), or NULL: libyaml gives none for untagged values. */
+static const char *event_tag(const yaml_event_t *e)
+{
+    const yaml_char_t *tag = NULL;
+    if (e->type == YAML_SCALAR_EVENT)
+        tag = e->data.scalar.tag;
+    else if (e->type == YAML_SEQUENCE_START_EVENT)
+        tag = e->data.sequence_start.tag;
+    else if (e->type == YAML_MAPPING_START_EVENT)
+        tag = e->data.mapping_start.tag;
+    return (const char *)tag;
+}
+
+/* One event's verdict: an alias, a tag, a second document, nesting beyond the bound. */
+static int check_event(ctx_t *x, const yaml_event_t *e, int *docs, unsigned *depth)
+{
+    static const char yaml_prefix[] = "tag:yaml.org,2002:"; /* what libyaml makes of "!!" */
+    const char *tag = event_tag(e);
+    char shown[48];
+    size_t line = e->start_mark.line + 1u;
+    if (e->type == YAML_ALIAS_EVENT)
+        return fail(x, line, "aliases (*%s) are not supported: write the value out",
+                    (const char *)e->data.alias.anchor);
+    if (e->type == YAML_DOCUMENT_START_EVENT && ++*docs > 1)
+        return fail(x, line, "a second YAML document: one per file");
+    /* Each key has one type, checked as written: a tag would either repeat it or ask for
+     * another (id: !!str 1), and ignoring it would silently read what the tag contradicts. */
+    if (tag != NULL) {
+        bool core = strncmp(tag, yaml_prefix, sizeof yaml_prefix - 1u) == 0;
+        return fail(x, line, "YAML tags (%s%s) are not supported: write the value alone",
+                    core ? "!!" : "",
+                    printable(core ? tag + sizeof yaml_prefix - 1u : tag, shown, sizeof shown));
+    }
+    if (e->type == YAML_SEQUENCE_START_EVENT || e->type == YAML_MAPPING_START_EVENT) {
+        if (++*depth > J288_ROBOT_CONFIG_MAX_DEPTH)
+            return fail(x, line, "nested deeper than %u lists and mappings: not a robot config",
+                        J288_ROBOT_CONFIG_MAX_DEPTH);
+    } else if (e->type == YAML_SEQUENCE_END_EVENT || e->type == YAML_MAPPING_END_EVENT) {
+        --*depth;
+    }
+    return 0;
+}
+
+/* A pass over the events, before libyaml builds the document: syntax errors and what
+ * check_event() refuses. It stops at the first refusal: libyaml's time grows with the square
+ * of the nesting depth (200 KB of '[' took minutes), so a file nested too deep is refused
+ * as soon as the bound is crossed, before the rest is read. */
 static int scan_events(ctx_t *x)
 {
     yaml_parser_t p;
     yaml_event_t e;
     int docs = 0, rc = 0;
+    unsigned depth = 0;
     parser_setup(x, &p);
     for (;;) {
         bool end;
@@ -766,12 +871,7 @@ static int scan_events(ctx_t *x)
             break;
         }
         end = (e.type == YAML_STREAM_END_EVENT);
-        if (e.type == YAML_ALIAS_EVENT)
-            rc = fail(x, e.start_mark.line + 1u,
-                      "aliases (*%s) are not supported: write the value out",
-                      (const char *)e.data.alias.anchor);
-        else if (e.type == YAML_DOCUMENT_START_EVENT && ++docs > 1)
-            rc = fail(x, e.start_mark.line + 1u, "a second YAML document: one per file");
+        rc = check_event(x, &e, &docs, &depth);
         yaml_event_delete(&e);
         if (end || rc != 0)
             break;
@@ -983,12 +1083,13 @@ static int check_update(const j288_robot_config_update_t *upd, const char *name,
 {
     if (!upd->set_zero && !upd->set_phase)
         return set_error(err, errlen, "%s: nothing to change (neither zero nor phase)", name);
-    if (upd->set_zero && !(fabs(upd->zero) <= VALUE_LIMIT))
+    /* The bounds the file is read with (a value written must read back). */
+    if (upd->set_zero && !(fabs(upd->zero) <= k_angle.hi))
         return set_error(err, errlen, "%s: zero %g is not a finite value within +-%g", name,
-                         upd->zero, VALUE_LIMIT);
-    if (upd->set_phase && !(fabs(upd->phase) <= VALUE_LIMIT))
-        return set_error(err, errlen, "%s: phase %g is not a finite value within +-%g", name,
-                         upd->phase, VALUE_LIMIT);
+                         upd->zero, k_angle.hi);
+    if (upd->set_phase && !(fabs(upd->phase) <= k_phase.hi))
+        return set_error(err, errlen, "%s: phase %g is not a finite value within +-%.9g", name,
+                         upd->phase, k_phase.hi);
     return 0;
 }
 
@@ -1075,15 +1176,89 @@ int j288_robot_config_edit(const char *text, size_t len, const char *name, const
     return rc;
 }
 
-/* Write len bytes to a new file beside real (same folder: rename is atomic) with mode, then
- * rename it over real. */
+/* The temporary file of a write-back: hidden, beside the config (rename is atomic within a
+ * folder), named after the config and the writing process: ".robot.yaml.j288-PID.XXXXXX". */
+#define TEMP_TAG ".j288-"
+
+/* The folder of real (an absolute path from realpath) into dir, and where its name starts. */
+static int split_path(const char *real, char *dir, size_t cap, const char **base)
+{
+    const char *slash = strrchr(real, '/');
+    size_t n = (slash == NULL || slash == real) ? 1u : (size_t)(slash - real);
+    if (slash == NULL || n >= cap)
+        return -1;
+    memcpy(dir, real, n);
+    dir[n] = '\0';
+    *base = slash + 1;
+    return 0;
+}
+
+/* A write-back killed between creating its temporary file and renaming it (SIGKILL, a
+ * power cut) leaves the file behind: the next write-back of the same config removes those
+ * whose process is gone. A live process's file is its own business. */
+static void remove_stale_temps(const char *dir, const char *base)
+{
+    char prefix[NAME_MAX + 16];
+    char full[PATH_MAX + NAME_MAX + 2];
+    size_t plen;
+    struct dirent *e;
+    DIR *d;
+    if ((size_t)snprintf(prefix, sizeof prefix, ".%s" TEMP_TAG, base) >= sizeof prefix ||
+        (d = opendir(dir)) == NULL)
+        return;
+    plen = strlen(prefix);
+    while ((e = readdir(d)) != NULL) {
+        char *end;
+        long pid;
+        if (strncmp(e->d_name, prefix, plen) != 0)
+            continue;
+        errno = 0;
+        pid = strtol(e->d_name + plen, &end, 10);
+        if (errno != 0 || pid <= 0 || end[0] != '.' || strlen(end) != 7u)
+            continue; /* not ours: ".XXXXXX" follows the process id */
+        if (kill((pid_t)pid, 0) == 0 || errno != ESRCH)
+            continue;
+        if ((size_t)snprintf(full, sizeof full, "%s/%s", dir, e->d_name) < sizeof full)
+            (void)unlink(full);
+    }
+    (void)closedir(d);
+}
+
+int j288_robot_config_check_writable(const char *path, char *err, size_t errlen)
+{
+    char real[PATH_MAX], dir[PATH_MAX];
+    const char *base;
+    struct stat st;
+    if (realpath(path, real) == NULL || stat(real, &st) != 0)
+        return set_error(err, errlen, "%s: %s", path, strerror(errno));
+    if (!S_ISREG(st.st_mode))
+        return set_error(err, errlen, "%s: not a regular file: cannot write it back", path);
+    /* A file without any write permission says "keep this as it is", to root too (whom
+     * access() lets write anything); renaming over it in a writable folder would not ask. */
+    if ((st.st_mode & 0222) == 0 || access(real, W_OK) != 0)
+        return set_error(err, errlen,
+                         "%s: read-only: the new value could not be written back (make it "
+                         "writable, or work on a copy)",
+                         path);
+    if (split_path(real, dir, sizeof dir, &base) != 0 || access(dir, W_OK | X_OK) != 0)
+        return set_error(err, errlen,
+                         "%s: its folder %s is not writable: the new value could not be written "
+                         "back (a temporary file is renamed over the file)",
+                         path, dir);
+    return 0;
+}
+
+/* Write len bytes to a new file beside real with mode, then rename it over real. */
 static int replace_file(const char *real, const char *shown, const char *data, size_t len,
                         mode_t mode, char *err, size_t errlen)
 {
-    char tmp[PATH_MAX + 16];
+    char tmp[PATH_MAX + 64], dir[PATH_MAX];
+    const char *base;
     size_t done = 0;
     int fd;
-    if ((size_t)snprintf(tmp, sizeof tmp, "%s.XXXXXX", real) >= sizeof tmp)
+    if (split_path(real, dir, sizeof dir, &base) != 0 ||
+        (size_t)snprintf(tmp, sizeof tmp, "%s/.%s" TEMP_TAG "%ld.XXXXXX", dir, base,
+                         (long)getpid()) >= sizeof tmp)
         return set_error(err, errlen, "%s: path too long", shown);
     fd = mkstemp(tmp);
     if (fd < 0)
@@ -1125,9 +1300,15 @@ int j288_robot_config_write_joint(const char *path, const char *joint, const j28
     char *text = NULL, *out;
     size_t len, outlen, outcap;
     int rc;
+    char dir[PATH_MAX];
+    const char *base;
+    if (j288_robot_config_check_writable(path, err, errlen) != 0)
+        return -1;
     /* The file a symlink points at is the one to replace, not the link. */
     if (realpath(path, real) == NULL || stat(real, &st) != 0)
         return set_error(err, errlen, "%s: %s", path, strerror(errno));
+    if (split_path(real, dir, sizeof dir, &base) == 0)
+        remove_stale_temps(dir, base); /* whatever this write-back's own outcome */
     if (read_file(real, &text, &len, err, errlen) != 0)
         return -1;
     /* Each added line is at most 160 bytes (indentation up to 100, then key and value). */

@@ -2,35 +2,25 @@
  * j288_robot_config.h - the robot config file: buses and joints in YAML, read into a plain struct
  * and written back in place (host side; needs libyaml, Debian's libyaml-dev).
  *
- * The file (every key but a bus's name and port and a joint's name and id is optional):
- *
- *   buses:                      # none: the one bus the tool's --port names
- *     - name: left              # unique
- *       port: /dev/ttyUSB0      # unique
- *       baud: 6000000           # line rate
- *       margin_us: 3000         # reply deadline margin for host latency
- *       echo: false             # the adapter hears its own transmit
- *   joints:
- *     - name: hip               # unique
- *       bus: left               # needed when there are two buses or more
- *       id: 1                   # 0-14, unique on its bus
- *       direction: 1            # 1 or -1 (default 1)
- *       zero: 0.0               # rad, output-encoder frame: the pose that is joint 0 (default 0)
- *       limits: [-1.5, 1.5]     # rad, joint frame, min < max, at most 2 pi wide
- *                               # (default: [-pi, pi), the output encoder angle wrapped)
- *       max_speed: 6.0          # rad/s, joint frame, above 0
- *       max_torque: 30.0        # N*m, joint frame, above 0
- *       kp: 20.0                # N*m/rad, joint frame, 0 or more
- *       kd: 0.5                 # N*m*s/rad, joint frame, 0 or more
- *       phase: 2.1              # rotor rad (c in r = N * theta + c); written by calibration
- *       clamp: false            # true: clamp targets at the limits instead of refusing them
+ * The file: examples/robot.yaml is the reference, every key there with its meaning, unit,
+ * default and range (a test loads it, so it stays a file this reader takes). In short:
+ * 'buses:' (each a name, a port, and optionally baud, margin_us, echo) and 'joints:' (each a
+ * name and an id, and optionally bus, direction, zero, limits, max_speed, max_torque, kp, kd,
+ * phase, clamp). A relative port (sim/bus0) is taken from the config file's folder, not from
+ * where the program runs (j288_robot_config_load(); j288_robot_config_parse() has no folder
+ * and keeps it as written).
  *
  * Reading is strict, so that a typo never silently becomes a default: unknown or repeated
- * keys, values of the wrong type (numbers must be plain, e.g. 1.5, not "1.5"; booleans are
- * true or false), names that repeat, an id used twice on one bus, and values out of range are
- * errors. Every error is one line "FILE:LINE: what is wrong" (LINE counts from 1; syntax
- * errors name the column too). Aliases (*name) are refused: a value written back must belong
- * to one joint only.
+ * keys, values of the wrong type (numbers must be plain, e.g. 1.5, not "1.5", in the syntax the
+ * j288 tool's options take too: host/j288_number.h, decimal reals, decimal or 0x whole
+ * numbers; booleans are true or false), names that repeat, an id used twice on one bus, and
+ * values out of range (each key's range is the library's: the message names the key, the
+ * value as written and the range) are errors. Every error is one line "FILE:LINE: what is
+ * wrong" (LINE counts from 1; syntax errors name the column too). Refused as well: aliases
+ * (*name; a value written back must belong to one joint only), YAML tags (!!str 1: a key's
+ * type is its own, a tag would contradict or repeat it), more than one document, and lists
+ * and mappings nested deeper than J288_ROBOT_CONFIG_MAX_DEPTH (refused as soon as the reader
+ * gets there: libyaml's time grows with the square of the depth).
  *
  * Writing back (j288_robot_config_write_joint) changes one joint's zero and/or phase in the file's
  * own text: an existing value is replaced where it stands; a missing key is added as a line
@@ -40,6 +30,11 @@
  * differ), then replaces the file atomically (a temporary file in the same folder, renamed
  * over it; the file's permission bits are kept; a symlink is followed, not replaced). A
  * joint written as a flow mapping ({name: hip, ...}) can have values replaced, not added.
+ * A file the user may not write, or without any write permission bit (root too: renaming
+ * over it would not ask), is refused (j288_robot_config_check_writable() tells beforehand,
+ * before a tool moves anything). The temporary file is ".NAME.j288-PID.XXXXXX" beside the
+ * file: removed on every error; one left by a write-back that was killed (SIGKILL, power
+ * loss) is removed by the next write-back of the same file once process PID is gone.
  *
  * No allocation by callers: structures are caller-allocated with fixed capacities (the
  * functions allocate internally for the file's text and libyaml's document, and free it
@@ -66,6 +61,8 @@ extern "C" {
 #define J288_ROBOT_CONFIG_PORT_MAX   256u            /* bytes with the terminating NUL */
 #define J288_ROBOT_CONFIG_FILE_MAX   (1024u * 1024u) /* largest file read */
 #define J288_ROBOT_CONFIG_ERROR_MAX  512u            /* holds any message for a name below 200 bytes */
+#define J288_ROBOT_CONFIG_MAX_DEPTH  8u              /* lists and mappings inside each other (a
+                                                        valid file needs 4) */
 #define J288_ROBOT_CONFIG_NO_BUS     (-1)            /* joint.bus when the file has no buses */
 
 typedef struct {
@@ -136,18 +133,23 @@ const j288_robot_config_joint_t *j288_robot_config_find_joint(const j288_robot_c
 int j288_robot_config_find_bus(const j288_robot_config_t *cfg, const char *name);
 
 /* Change joint's zero and/or phase in the file at path (see the top of this header). The
- * values must be finite and within +-1e6. 0 on success; -1 with a message in err, the file
+ * values must be finite and within the ranges the file is read with (zero +-64 rad,
+ * J288_JOINT_MAX_ANGLE; phase +-2 pi). 0 on success; -1 with a message in err, the file
  * then untouched (an error while replacing it leaves the old file in place). */
 int j288_robot_config_write_joint(const char *path, const char *joint, const j288_robot_config_update_t *upd,
                             char *err, size_t errlen);
+
+/* 0 when j288_robot_config_write_joint() could replace the file at path (a regular file the
+ * user may write, with a write permission bit, in a folder the user may write); -1 with a
+ * message in err saying what stands in the way. Reads nothing but the file's metadata. */
+int j288_robot_config_check_writable(const char *path, char *err, size_t errlen);
 
 /* The library's configuration of a joint read from the file (j288/joint.h): id, direction,
  * zero, clamp and phase as given; limits, max_speed, max_torque, kp and kd as given, else 0
  * (the library's defaults: [-pi, pi], no speed or torque limit beyond the wire's, no default
  * gains); the start's sample count and tolerances at the library's defaults (0). Checks
  * nothing: j288_joint_init() does, and the file's own checks keep its values in the ranges
- * the library takes (but zero, which the library bounds by J288_JOINT_MAX_ANGLE). Works
- * without libyaml. NULL arguments are ignored. */
+ * the library takes. Works without libyaml. NULL arguments are ignored. */
 void j288_robot_config_joint_config(const j288_robot_config_joint_t *rj, j288_joint_config_t *jc);
 
 /* The text-level edit behind j288_robot_config_write_joint(): the len bytes of text in, the edited

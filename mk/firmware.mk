@@ -86,39 +86,48 @@ firmware-build: $(FW_BUILD)
 	@if $(call FW_HAVE,f4); then \
 	     ST_DIR=$(ST_DIR) ARM_CC=$(call TC,m4f,CC) CC="$(CC)" bash test/stm32/dcache_needs_a_cache.sh; fi
 
-# ---- make bench-stm32-hal: what the port adds per transaction, ST's F4 HAL included --------
-# test/stm32/hal_bench.c on Cortex-M4 under QEMU (-icount), against ST's HAL in ST_DIR, with
-# the NUCLEO-F446RE's HAL configuration; skipped with a notice without the sources.
-HB_HAL := $(FW_nucleo_f446re_HAL:%=$(ST_DIR)/stm32f4xx_hal_driver/Src/stm32f4xx_%.c) \
-    $(ST_DIR)/cmsis_device_f4/Source/Templates/system_stm32f4xx.c
+# ---- make bench-stm32-hal: what the port adds per transaction, on F4 and G4 -------------------
+# test/stm32/hal_bench.c on Cortex-M4 under QEMU (-icount), built against ST's headers and HAL
+# of each family fetched in ST_DIR, with its NUCLEO's HAL configuration; the F4 is required (a
+# notice without it), the G4 runs when fetched.
+HB_FAMILIES := f4 g4
+HB_f4_BOARD := nucleo_f446re
+HB_g4_BOARD := nucleo_g474re
+HB_HAL = $(FW_$(HB_$(1)_BOARD)_HAL:%=$(ST_DIR)/stm32$(1)xx_hal_driver/Src/stm32$(1)xx_%.c) \
+    $(ST_DIR)/cmsis_device_$(1)/Source/Templates/system_stm32$(1)xx.c
 HB_APP := test/stm32/hal_bench.c port/stm32_hal/j288_stm32.c $(LIB_SRC) $(call TC,m4f,STARTUP)
-HB_CC = $(call CPU_CC,m4f) -DSTM32F446xx -DUSE_HAL_DRIVER -Iexamples/stm32_hal/nucleo_f446re \
-    -Iport/stm32_hal -Itest/support $(CPPFLAGS_LIB) -isystem $(ST_DIR)/stm32f4xx_hal_driver/Inc \
-    -isystem $(ST_DIR)/cmsis_device_f4/Include -isystem $(ST_DIR)/cmsis_core/Include \
-    -ffunction-sections -fdata-sections -g $(DEPFLAGS)
+HB_CC = $(call CPU_CC,m4f) -D$(FW_$(HB_$(1)_BOARD)_DEVICE) -DUSE_HAL_DRIVER \
+    -Iexamples/stm32_hal/$(HB_$(1)_BOARD) -Iport/stm32_hal -Itest/support $(CPPFLAGS_LIB) \
+    -isystem $(ST_DIR)/stm32$(1)xx_hal_driver/Inc -isystem $(ST_DIR)/cmsis_device_$(1)/Include \
+    -isystem $(ST_DIR)/cmsis_core/Include -ffunction-sections -fdata-sections -g $(DEPFLAGS)
 
+# $(call HB_RULES,opt,family)
 define HB_RULES
-$(BUILD)/bench-stm32-hal/$(1)/app/%.o: %.c
+$(BUILD)/bench-stm32-hal/$(2)-$(1)/app/%.o: %.c
 	@mkdir -p $$(@D)
-	$(HB_CC) -$(1) $(CSTD) $(WARN) -c $$< -o $$@
-$(BUILD)/bench-stm32-hal/$(1)/st/%.o: $(ST_DIR)/%.c
+	$(call HB_CC,$(2)) -$(1) $(CSTD) $(WARN) -c $$< -o $$@
+$(BUILD)/bench-stm32-hal/$(2)-$(1)/st/%.o: $(ST_DIR)/%.c
 	@mkdir -p $$(@D)
-	$(HB_CC) -$(1) -std=gnu11 -w -c $$< -o $$@
-$(BUILD)/bench-stm32-hal/hal_bench_$(1).elf: $(HB_APP:%.c=$(BUILD)/bench-stm32-hal/$(1)/app/%.o) \
-    $(patsubst $(ST_DIR)/%.c,$(BUILD)/bench-stm32-hal/$(1)/st/%.o,$(HB_HAL))
+	$(call HB_CC,$(2)) -$(1) -std=gnu11 -w -c $$< -o $$@
+$(BUILD)/bench-stm32-hal/hal_bench_$(2)_$(1).elf: $(HB_APP:%.c=$(BUILD)/bench-stm32-hal/$(2)-$(1)/app/%.o) \
+    $(patsubst $(ST_DIR)/%.c,$(BUILD)/bench-stm32-hal/$(2)-$(1)/st/%.o,$(call HB_HAL,$(2)))
 	$(call TC,m4f,CC) $(call TGT_LINK_FLAGS,m4f,SEMIHOST,$(CPU_m4f_LD)) $$^ -o $$@ -lm
 endef
-$(foreach o,O2 Os,$(eval $(call HB_RULES,$(o))))
+$(foreach f,$(HB_FAMILIES),$(foreach o,O2 Os,$(eval $(call HB_RULES,$(o),$(f)))))
 
 .PHONY: bench-stm32-hal
 bench-stm32-hal:
 	@$(call REQUIRE_TC,m4f,QEMU); \
-	 if [ ! -f $(ST_DIR)/stm32f4xx_hal_driver/.tag ] || [ ! -f $(ST_DIR)/cmsis_device_f4/.tag ] || \
-	    [ ! -f $(ST_DIR)/cmsis_core/.tag ]; then \
+	 if ! $(call FW_HAVE,f4); then \
 	     echo "bench-stm32-hal: skipped: ST's F4 sources are not in $(ST_DIR) (bash scripts/fetch-st.sh f4)"; \
 	     exit 0; fi; \
-	 $(MAKE) --no-print-directory $(BUILD)/bench-stm32-hal/hal_bench_O2.elf $(BUILD)/bench-stm32-hal/hal_bench_Os.elf && \
-	 for o in O2 Os; do \
-	    echo "Cortex-M4F ($(CPU_m4f_QEMU), QEMU -icount shift=0), -$$o:"; \
-	    $(call QEMU_BENCH,m4f,$(BUILD)/bench-stm32-hal/hal_bench_$$o.elf) || exit 1; echo; \
+	 fams=f4; if $(call FW_HAVE,g4); then fams="f4 g4"; \
+	 else echo "bench-stm32-hal: G4 skipped: ST's G4 sources are not in $(ST_DIR)"; fi; \
+	 for f in $$fams; do \
+	    $(MAKE) --no-print-directory $(BUILD)/bench-stm32-hal/hal_bench_$${f}_O2.elf \
+	        $(BUILD)/bench-stm32-hal/hal_bench_$${f}_Os.elf || exit 1; \
+	    for o in O2 Os; do \
+	       echo "$$f: Cortex-M4F ($(CPU_m4f_QEMU), QEMU -icount shift=0), -$$o:"; \
+	       $(call QEMU_BENCH,m4f,$(BUILD)/bench-stm32-hal/hal_bench_$${f}_$$o.elf) || exit 1; echo; \
+	    done; \
 	 done

@@ -27,9 +27,11 @@ FUZZ_CFLAGS := -std=c99 -g -O1 -fsanitize=fuzzer,address,undefined -fno-sanitize
     -Ilib/include -Itest/fuzz -Itest/support
 FUZZ_BINS := $(FUZZ_NAMES:%=$(BUILD)/fuzz/fuzz_%)
 
-$(BUILD)/fuzz/fuzz_%: test/fuzz/fuzz_%.c $(LIB_SRC) $(TEST_HDR) $(wildcard test/fuzz/*.h tools/j288/*.[ch])
+$(BUILD)/fuzz/fuzz_%: test/fuzz/fuzz_%.c $(LIB_SRC) $(TEST_HDR) $(wildcard test/fuzz/*.h tools/j288/*.[ch] host/j288_number.[ch] host/j288_robot_config.[ch])
 	@mkdir -p $(@D)
-	$(FUZZ_CC) $(FUZZ_CFLAGS) $(FUZZ_CPPFLAGS_$*) $< $(FUZZ_EXTRA_$*) $(LIB_SRC) -o $@ -lm
+	$(FUZZ_CC) $(FUZZ_CFLAGS) $(FUZZ_CPPFLAGS_$*) $< $(FUZZ_EXTRA_$*) $(LIB_SRC) -o $@ $(FUZZ_LIBS_$*) -lm
+# The config target's flags come from libyaml's probe (mk/tools.mk).
+$(BUILD)/fuzz/fuzz_config: $(YAML_ENV)
 
 .PHONY: fuzz fuzz-ci fuzz-all fuzz-corpus $(FUZZ_NAMES:%=fuzz-run-%)
 fuzz:

@@ -20,7 +20,8 @@ $(OBJ)/test/cli/%.o: test/cli/%.c $(UNITY)/unity.c
 CLI_CAPTURE_OBJ := $(OBJ)/test/cli/cli_capture.o
 
 $(CLI_TEST): $(OBJ)/test/cli/test_cli_helpers.o $(CLI_CAPTURE_OBJ) \
-    $(addprefix $(OBJ)/tools/j288/,args.o hexparse.o json.o frameview.o report.o) $(UNITY_OBJ) $(LIB_A)
+    $(addprefix $(OBJ)/tools/j288/,args.o hexparse.o json.o frameview.o report.o) $(NUMBER_OBJ) \
+    $(UNITY_OBJ) $(LIB_A)
 	@mkdir -p $(@D)
 	$(CC) $(CFLAGS_COMMON) $^ -o $@ $(LDFLAGS_COMMON) -lm
 
@@ -63,8 +64,14 @@ $(CODEC_CRC_TEST_NAMES:%=$(BUILD)/crc-\%/test/%): $(UNITY)/unity.c codec-force
 # sources (the cli target links the tool's parsers as functions, not by exec).
 FUZZ_NAMES := $(sort $(patsubst test/fuzz/fuzz_%.c,%,$(wildcard test/fuzz/fuzz_*.c)))
 FUZZ_REPLAY_TESTS := $(FUZZ_NAMES:%=$(BUILD)/test/fuzz_replay_%)
-FUZZ_EXTRA_cli := tools/j288/hexparse.c tools/j288/args.c
+FUZZ_EXTRA_cli := tools/j288/hexparse.c tools/j288/args.c host/j288_number.c
 FUZZ_CPPFLAGS_cli := -Itools/j288 $(TOOL_CPPFLAGS)
+# The config target links the reader and libyaml (FUZZ_LIBS_<name>: a target's libraries).
+FUZZ_EXTRA_config := host/j288_robot_config.c host/j288_number.c
+FUZZ_CPPFLAGS_config := -Ihost $(call yaml_var,YAML_CFLAGS)
+FUZZ_LIBS_config := $(call yaml_var,YAML_LIBS)
+$(OBJ)/test/fuzz/fuzz_config.o: host/j288_robot_config.h $(YAML_ENV)
+$(BUILD)/test/fuzz_replay_config: LDFLAGS_COMMON += $(FUZZ_LIBS_config)
 
 $(OBJ)/test/fuzz/replay_%.o: test/fuzz/replay_main.c
 	@mkdir -p $(@D)
@@ -95,7 +102,8 @@ $(LINUX_PORT_TEST): $(OBJ)/test/linux/test_linux_port.o $(SIM_PROCESS_OBJ) $(UNI
 CONFIG_TEST := $(BUILD)/test/test_robot_config
 $(OBJ)/test/linux/test_robot_config.o: test/linux/test_robot_config.c $(UNITY)/unity.c $(YAML_ENV)
 	@mkdir -p $(@D)
-	$(CC) $(TEST_CPPFLAGS) -Iport/linux -Ihost $(call yaml_var,YAML_CFLAGS) $(CFLAGS_COMMON) -c $< -o $@
+	$(CC) $(TEST_CPPFLAGS) -Iport/linux -Ihost $(call yaml_var,YAML_CFLAGS) \
+	    -DJ288_EXAMPLE_CONFIG='"examples/robot.yaml"' $(CFLAGS_COMMON) -c $< -o $@
 
 $(CONFIG_TEST): $(OBJ)/test/linux/test_robot_config.o $(CONFIG_OBJ) $(UNITY_OBJ) $(LIB_A)
 	@mkdir -p $(@D)
@@ -110,35 +118,52 @@ $(SIM_MODEL_TEST): $(OBJ)/test/sim/test_sim_model.o $(SIM_MODEL_OBJ) $(UNITY_OBJ
 	@mkdir -p $(@D)
 	$(CC) $(CFLAGS_COMMON) $^ -o $@ $(LDFLAGS_COMMON) -lm
 
-# Built with the D-cache maintenance on and a 32-byte receive buffer (a reply then crosses the
-# half-transfer point), so that both paths are exercised; the target tests use the same.
-STM32_TEST_DEFS := -DJ288_STM32_DCACHE=1 -DJ288_STM32_RX_BUF_SIZE=32u
-STM32_TEST := $(BUILD)/test/test_stm32_port
+# Built with the D-cache maintenance on and a 64-byte receive buffer (a transaction's echo and
+# reply then cross the half, complete and wrap points), so that every path is exercised, and
+# with the bytes handed to the bus watched (test_rx_sink); the target tests use the same.
+# Against the F4's USART and DMA registers, the G4's (test_stm32_port_g4), and the F4's under
+# the H7's name (test_stm32_port_h7).
+STM32_TEST_DEFS := -DJ288_STM32_DCACHE=1 -DJ288_STM32_RX_BUF_SIZE=64u -DJ288_STM32_RX_SINK=test_rx_sink
 STM32_TEST_SRC := port/stm32_hal/j288_stm32.c test/stm32/fake_hal.c test/stm32/test_stm32_port.c
-$(OBJ)/stm32host/%.o: %.c $(UNITY)/unity.c
-	@mkdir -p $(@D)
-	$(CC) $(TEST_CPPFLAGS) -Iport/stm32_hal -Itest/stm32/stub -Itest/stm32 $(STM32_TEST_DEFS) \
-	    $(CFLAGS_COMMON) -c $< -o $@
 
-$(STM32_TEST): $(STM32_TEST_SRC:%.c=$(OBJ)/stm32host/%.o) $(UNITY_OBJ) $(LIB_A)
-	@mkdir -p $(@D)
-	$(CC) $(CFLAGS_COMMON) $^ -o $@ $(LDFLAGS_COMMON) -lm
+# $(call STM32_HOST_TEST,name,objdir,defs): test_stm32_port built with the stub's defs.
+define STM32_HOST_TEST
+$$(OBJ)/$(2)/%.o: %.c $$(UNITY)/unity.c
+	@mkdir -p $$(@D)
+	$$(CC) $$(TEST_CPPFLAGS) -Iport/stm32_hal -Itest/stm32/stub -Itest/stm32 $$(STM32_TEST_DEFS) $(3) \
+	    $$(CFLAGS_COMMON) -c $$< -o $$@
+
+$$(BUILD)/test/$(1): $$(STM32_TEST_SRC:%.c=$$(OBJ)/$(2)/%.o) $$(UNITY_OBJ) $$(LIB_A)
+	@mkdir -p $$(@D)
+	$$(CC) $$(CFLAGS_COMMON) $$^ -o $$@ $$(LDFLAGS_COMMON) -lm
+endef
+STM32_TEST := $(BUILD)/test/test_stm32_port
+STM32_G4_TEST := $(BUILD)/test/test_stm32_port_g4
+# The F4's register model under the H7's name: what the port decides by family (the RAM its
+# DMA reaches).
+STM32_H7_TEST := $(BUILD)/test/test_stm32_port_h7
+$(eval $(call STM32_HOST_TEST,test_stm32_port,stm32host,))
+$(eval $(call STM32_HOST_TEST,test_stm32_port_g4,stm32host-g4,-DJ288_STUB_G4))
+$(eval $(call STM32_HOST_TEST,test_stm32_port_h7,stm32host-h7,-DJ288_STUB_H7))
 
 # ---- the lists -------------------------------------------------------------------------------
 HOST_TESTS += $(CLI_TEST) $(foreach v,$(CODEC_CRC_VARIANTS),$(CODEC_CRC_TEST_NAMES:%=$(BUILD)/crc-$(v)/test/%)) \
-    $(FUZZ_REPLAY_TESTS) $(LINUX_PORT_TEST) $(CONFIG_TEST) $(SIM_MODEL_TEST) $(STM32_TEST)
+    $(FUZZ_REPLAY_TESTS) $(LINUX_PORT_TEST) $(CONFIG_TEST) $(SIM_MODEL_TEST) $(STM32_TEST) \
+    $(STM32_G4_TEST) $(STM32_H7_TEST)
 TEST_SCRIPTS += test/e2e/cli_offline.sh test/e2e/cli_bus.sh tools/vectors/check-drift.sh \
     test/e2e/sim_cli.sh test/e2e/example_linux.sh test/abi/check-abi.sh
 # The joint frame end to end against the simulator's truth (the tool, the config, the sim),
 # in three scripts that run side by side (test/e2e/lib_joint.sh).
 TEST_SCRIPTS += test/e2e/joint_seed.sh test/e2e/joint_range.sh test/e2e/joint_refuse.sh
+# j288 top on a terminal (tmux: capture-pane, send-keys) and through a pipe.
+TEST_SCRIPTS += test/e2e/cli_top.sh
 # The scripts' own process helpers (whom they signal, what their cleanup removes).
 TEST_SCRIPTS += test/e2e/lib_sim_check.sh
 # The bash completion (tools/completion/j288.bash) against the tools' --help.
 TEST_SCRIPTS += test/e2e/completion.sh
 TEST_DEPS += $(J288_BIN) $(SIM_BIN) $(EXAMPLE_LINUX) $(LIB_A)
 ALL_TARGETS += $(CLI_TEST) $(FUZZ_REPLAY_TESTS) $(LINUX_PORT_TEST) $(CONFIG_TEST) $(SIM_MODEL_TEST) \
-    $(STM32_TEST)
+    $(STM32_TEST) $(STM32_G4_TEST) $(STM32_H7_TEST)
 
 .PHONY: check-abi vectors-check
 check-abi: $(LIB_A)

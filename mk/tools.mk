@@ -26,7 +26,7 @@ $(OBJ)/tools/j288/%.o: tools/j288/%.c
 	@mkdir -p $(@D)
 	$(CC) $(TOOL_CPPFLAGS) $(CFLAGS_COMMON) -c $< -o $@
 
-$(J288_BIN): $(J288_SRC:%.c=$(OBJ)/%.o) $(OBJ)/host/j288_robot_config.o $(LINUX_A) $(LIB_A)
+$(J288_BIN): $(J288_SRC:%.c=$(OBJ)/%.o) $(CONFIG_OBJ) $(LINUX_A) $(LIB_A)
 	@mkdir -p $(@D)
 	$(CC) $(CFLAGS_COMMON) $^ -o $@ $(LDFLAGS_COMMON) $(call yaml_var,YAML_LIBS) -lm
 
@@ -43,10 +43,12 @@ $(SIM_BIN): $(SIM_MODEL_OBJ) $(OBJ)/tools/j288-sim/sim_main.o $(LIB_A)
 # The robot config reader (host/j288_robot_config.c, not in the archive: it needs
 # libyaml). pkg-config's yaml-0.1 (Debian's libyaml-dev), checked to link with $(CC), gives the
 # flags written into $(YAML_ENV); without it the reader builds as stubs that say so. Users:
-# $(CONFIG_OBJ), and $(call yaml_var,YAML_LIBS) in a recipe. Delete the file to look again.
+# $(CONFIG_OBJ) (the reader and the number syntax it shares with the tool's options,
+# $(NUMBER_OBJ)), and $(call yaml_var,YAML_LIBS) in a recipe. Delete the file to look again.
 YAML_ENV := $(BUILD)/libyaml/libyaml.env
 yaml_var = $$(sed -n 's/^$(1)=//p' $(YAML_ENV))
-CONFIG_OBJ := $(OBJ)/host/j288_robot_config.o
+NUMBER_OBJ := $(OBJ)/host/j288_number.o
+CONFIG_OBJ := $(OBJ)/host/j288_robot_config.o $(NUMBER_OBJ)
 
 $(YAML_ENV):
 	@mkdir -p $(@D)
@@ -57,7 +59,11 @@ $(YAML_ENV):
 	else printf 'YAML_CFLAGS=\nYAML_LIBS=\n' >$@; \
 	    echo "libyaml: not found: building without robot config support (install libyaml-dev)"; fi
 
-$(CONFIG_OBJ): host/j288_robot_config.c $(YAML_ENV)
+$(NUMBER_OBJ): host/j288_number.c
+	@mkdir -p $(@D)
+	$(CC) $(HOST_CPPFLAGS) $(CFLAGS_COMMON) -c $< -o $@
+
+$(OBJ)/host/j288_robot_config.o: host/j288_robot_config.c $(YAML_ENV)
 	@mkdir -p $(@D)
 	$(CC) $(HOST_CPPFLAGS) $(call yaml_var,YAML_CFLAGS) $(CFLAGS_COMMON) -c $< -o $@
 

@@ -26,7 +26,11 @@ packages=(
     # RISC-V (mk/cpu/rv32imac.mk): test-target and bench-bus-target on RV32 under QEMU
     gcc-riscv64-unknown-elf picolibc-riscv64-unknown-elf qemu-system-misc
     python3-pytest python3-numpy    # scripts/python-test.sh (make test: the Python package)
-    pkg-config                      # libyaml's flags (mk/tools.mk); check-consumers.sh's consumer
+    pkg-config                      # libyaml (mk/tools.mk); check-consumers.sh; mk/dds.mk
+    tmux                            # test/e2e/cli_top.sh: j288 top on a terminal (required
+                                    # under CI=true, skipped with a notice elsewhere)
+    cyclonedds-dev cyclonedds-tools # j288-dds (mk/dds.mk): libddsc, its pkg-config file, idlc
+    iproute2 util-linux             # the DDS tests' private network namespace (ip, unshare)
     help2man                        # the man pages of j288 and j288-sim (cmake/j288_tools.cmake)
     python3-venv python3-setuptools python3-wheel python3-build  # make pip-check (no network)
     debhelper dpkg-dev fakeroot lintian  # make deb, make deb-check (debian/)

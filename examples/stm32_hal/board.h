@@ -28,6 +28,16 @@ extern volatile board_fault_t board_fault;
 /* The system clock runs from the external clock (true) or fell back to the HSI (false). */
 extern volatile bool board_clock_hse;
 
+/* The UART, its RX stream and the timer share one priority, so that none of the port's entries
+ * preempts another (required with advance_in_isr); SysTick stays lowest. main.c gives it to
+ * the port, whose bus lock masks up to it (BASEPRI). */
+#define BOARD_BUS_IRQ_PRIORITY 5u
+
+/* The bus's interrupt entries (main.c, to the port): USART1's and the RX stream's IRQ
+ * handlers call them. */
+void board_bus_uart_irq(void);
+void board_bus_dma_rx_irq(void);
+
 /* Clocks, pins, DMA, NVIC, UART, timer, CRC unit; board_fatal() on any failure. */
 void board_init(void);
 /* The emergency-stop button (the NUCLEO's blue button B1 on PC13) is pressed. */

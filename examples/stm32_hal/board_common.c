@@ -22,9 +22,10 @@ void board_fatal(void)
     }
 }
 
-/* Interrupt handlers (stm32xxxx_it.c in CubeMX): hand over to the HAL, which calls the
- * application's callbacks in main.c. The DMA ones are the board's: their names differ. */
+/* Interrupt handlers (stm32xxxx_it.c in CubeMX): the bus UART's goes to the port (main.c),
+ * the timer's to the HAL, which calls the application's callback in main.c. The DMA one is
+ * the board's: its name differs. */
 void USART1_IRQHandler(void);
 void TIM2_IRQHandler(void);
-void USART1_IRQHandler(void) { HAL_UART_IRQHandler(&huart1); }
+void USART1_IRQHandler(void) { board_bus_uart_irq(); }
 void TIM2_IRQHandler(void) { HAL_TIM_IRQHandler(&htim2); }

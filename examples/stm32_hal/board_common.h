@@ -11,9 +11,6 @@
 
 #define BOARD_BUS_BAUD 6000000u
 #define BOARD_TICK_HZ 1000000u
-/* UART, both DMA channels and the timer share one priority, so that none of the port's
- * callbacks preempts another (required with advance_in_isr); SysTick stays lowest. */
-#define BOARD_BUS_IRQ_PRIORITY 5u
 
 /* huart1's bus line: USART1, BOARD_BUS_BAUD, 8N1, both directions, no flow control, with the
  * given oversampling (UART_OVERSAMPLING_8 or _16). Sets the handle only; the board adds its
@@ -45,14 +42,13 @@ static inline void board_tick_timer_init(uint32_t timer_clock_hz)
     }
 }
 
-/* USART1's and the two DMA channels' interrupts at BOARD_BUS_IRQ_PRIORITY, enabled. */
-static inline void board_bus_irqs_enable(IRQn_Type tx_dma, IRQn_Type rx_dma)
+/* USART1's and the RX stream's interrupts at BOARD_BUS_IRQ_PRIORITY, enabled (the TX stream's
+ * is not used: the UART's transmit complete ends a transmit). */
+static inline void board_bus_irqs_enable(IRQn_Type rx_dma)
 {
     HAL_NVIC_SetPriority(USART1_IRQn, BOARD_BUS_IRQ_PRIORITY, 0u);
-    HAL_NVIC_SetPriority(tx_dma, BOARD_BUS_IRQ_PRIORITY, 0u);
     HAL_NVIC_SetPriority(rx_dma, BOARD_BUS_IRQ_PRIORITY, 0u);
     HAL_NVIC_EnableIRQ(USART1_IRQn);
-    HAL_NVIC_EnableIRQ(tx_dma);
     HAL_NVIC_EnableIRQ(rx_dma);
 }
 

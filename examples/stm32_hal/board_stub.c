@@ -30,7 +30,7 @@ void board_init(void)
     if (HAL_CRC_Init(&hcrc) != HAL_OK) {
         board_fatal();
     }
-    board_bus_irqs_enable(DMA2_Stream7_IRQn, DMA2_Stream2_IRQn);
+    board_bus_irqs_enable(DMA2_Stream2_IRQn);
     board_timer_irq_enable();
 }
 
@@ -39,10 +39,7 @@ bool board_estop_pressed(void)
     return HAL_GPIO_ReadPin(GPIOC, (uint16_t)0x2000u) == GPIO_PIN_RESET; /* PC13 */
 }
 
-/* The DMA streams' interrupt handlers (stm32f4xx_it.c in CubeMX; USART1's and TIM2's are in
- * board_common.c). */
-void DMA2_Stream7_IRQHandler(void);
+/* The RX stream's interrupt handler (stm32f4xx_it.c in CubeMX; USART1's and TIM2's are in
+ * board_common.c): the port's, not the HAL's. The TX stream's interrupt is not used. */
 void DMA2_Stream2_IRQHandler(void);
-
-void DMA2_Stream7_IRQHandler(void) { HAL_DMA_IRQHandler(&hdma_usart1_tx); }
-void DMA2_Stream2_IRQHandler(void) { HAL_DMA_IRQHandler(&hdma_usart1_rx); }
+void DMA2_Stream2_IRQHandler(void) { board_bus_dma_rx_irq(); }

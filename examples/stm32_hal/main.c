@@ -52,16 +52,10 @@ static volatile uint32_t stop_cause; /* the j288_event_kind_t bit, or 1u << 31 f
 static float home_rad[SERVO_COUNT];
 static bool home_known[SERVO_COUNT];
 
-/* ---- HAL callbacks: the application owns them and forwards to the port ------------------ */
+/* ---- interrupts: the bus UART's and RX stream's go to the port, the timer's via the HAL ---- */
 
-void HAL_UART_TxCpltCallback(UART_HandleTypeDef *huart) { (void)j288_stm32_on_tx_cplt(huart); }
-
-void HAL_UARTEx_RxEventCallback(UART_HandleTypeDef *huart, uint16_t Size)
-{
-    (void)j288_stm32_on_rx_event(huart, Size);
-}
-
-void HAL_UART_ErrorCallback(UART_HandleTypeDef *huart) { (void)j288_stm32_on_error(huart); }
+void board_bus_uart_irq(void) { j288_stm32_on_uart_irq(&bus1); }
+void board_bus_dma_rx_irq(void) { j288_stm32_on_dma_rx_irq(&bus1); }
 
 void HAL_TIM_OC_DelayElapsedCallback(TIM_HandleTypeDef *htim) { (void)j288_stm32_on_timer(htim); }
 
@@ -153,6 +147,7 @@ static void bus_setup(void)
     pc.htim = &htim2;
     pc.tim_channel = TIM_CHANNEL_1;
     pc.hcrc = &hcrc;
+    pc.irq_priority = BOARD_BUS_IRQ_PRIORITY; /* the bus lock masks the bus's interrupts only */
 
     bc.advance_in_isr = true; /* sweeps run back to back from the interrupts */
 

@@ -12,7 +12,6 @@ extern int main(void);
 void Reset_Handler(void);
 void Default_Handler(void);
 void USART1_IRQHandler(void);
-void DMA2_Stream7_IRQHandler(void);
 void DMA2_Stream2_IRQHandler(void);
 void TIM2_IRQHandler(void);
 void SysTick_Handler(void);
@@ -58,5 +57,4 @@ __attribute__((section(".isr_vector"), used)) const vector_t example_vectors[16 
     [IRQ(28)] = TIM2_IRQHandler,
     [IRQ(37)] = USART1_IRQHandler,
     [IRQ(58)] = DMA2_Stream2_IRQHandler,
-    [IRQ(70)] = DMA2_Stream7_IRQHandler,
 };

@@ -1,39 +1,42 @@
 /*
- * j288_stm32.h - j288 port for the STM32Cube HAL: one bus per UART in single-wire
- * half-duplex mode, DMA both ways, idle-line reception, optional DE pin, response timeout
- * from a timer compare channel, and the CRC unit as the frame CRC.
+ * j288_stm32.h - j288 port for STM32: one bus per UART in single-wire half-duplex mode, DMA
+ * both ways, the response timeout from a timer compare channel, and the CRC unit as the frame
+ * CRC. The HAL initialises (clocks, pins, UART, DMA streams, timer, CRC unit); every
+ * transaction then runs on the registers (start transmit, transmit complete, receive events),
+ * because the HAL's per-transaction path cost more than the library it serves
+ * (docs/performance.md). Register models: the F1/F2/F4 USART (SR/DR) or the newer one
+ * (ISR/ICR: F0, F3, F7, G0, G4, H7, L4...), and DMA streams (F2, F4, F7, H7 DMA1/2) or
+ * channels (F0, F1, F3, G0, G4, L4...); checked against the F4, G4 and H7 HAL.
  *
- * What the application does (see examples/stm32_hal/, docs/stm32.md and docs/porting.md):
- *  - configures each UART with HAL_HalfDuplex_Init() at the bus baud (6 Mbps), 8N1, with a
- *    DMA stream for TX (normal mode) and one for RX (circular mode recommended: a pause
- *    inside a reply then loses nothing; normal mode works, but a byte arriving while the
- *    port re-arms after an idle line, a few microseconds, is lost), byte width, both linked
- *    to the UART handle (hdmatx, hdmarx), and enables the UART and both DMA stream
- *    interrupts at ONE priority (also the timer's, when advance_in_isr);
- *  - declares the DMA buffers with J288_STM32_DMA_BUFFER() in RAM the DMA can reach;
- *  - calls j288_stm32_init() per bus, then forwards from its own HAL callbacks (the port
- *    never defines the HAL's weak callbacks):
- *        HAL_UART_TxCpltCallback(h)           -> j288_stm32_on_tx_cplt(h)
- *        HAL_UARTEx_RxEventCallback(h, size)  -> j288_stm32_on_rx_event(h, size)
- *        HAL_UART_ErrorCallback(h)            -> j288_stm32_on_error(h)
- *        HAL_TIM_OC_DelayElapsedCallback(t)   -> j288_stm32_on_timer(t)
- *    Each returns true when the handle belonged to a registered bus, so one callback can
- *    serve several buses and unrelated UARTs/timers.
+ * How the line runs (docs/stm32.md says why):
+ *  - The receiver is never switched off and the receive stream runs circular from init on,
+ *    so there is no moment at the turnaround where a reply byte can be lost. The line hears
+ *    our own 20 bytes, and their end is the end of the transmit (seen at the idle line after
+ *    them; with a DE pin, transmit complete drops DE at once instead): with the bus's echo
+ *    option they are handed to the bus, which checks them (collisions); without, skipped.
+ *  - The receive position is read from the stream's counter (NDTR/CNDTR) at every event: idle
+ *    line, half and whole buffer. The events may come in any order, late or twice: every byte
+ *    is handed to the bus once, in order, as long as less than a buffer passes between two
+ *    events (the half and complete interrupts see to that).
+ *  - Line errors are left to the CRC: one-bit sampling (no noise flag, which on the newer
+ *    USART keeps a good byte from the DMA) and the error interrupt masked; nothing aborts the
+ *    reception. Flags seen at the next event are counted and reported to the bus.
  *
- * Several buses: up to J288_STM32_MAX_BUSES are registered at once (one per UART); the
- * callbacks find the bus by handle with a short linear search.
+ * What the application does (examples/stm32_hal/, docs/stm32.md):
+ *  - HAL_HalfDuplex_Init() at the bus baud (6 Mbps), 8N1; a DMA stream/channel for TX and one
+ *    for RX, byte width, memory increment, linked to the UART handle (hdmatx, hdmarx) and
+ *    initialised with HAL_DMA_Init (the port sets the RX one circular itself);
+ *  - the UART, the RX stream's and the timer's interrupts enabled at ONE priority (the TX
+ *    stream's interrupt is not used); its IRQ handlers call j288_stm32_on_uart_irq() and
+ *    j288_stm32_on_dma_rx_irq() instead of the HAL's handlers, and the timer's
+ *    HAL_TIM_OC_DelayElapsedCallback forwards to j288_stm32_on_timer();
+ *  - j288_stm32_dma_t buffers in RAM the DMA reaches (init refuses the F4's CCM RAM and the
+ *    H7's TCMs); j288_stm32_init() per bus. After init the UART belongs to the port: no HAL
+ *    UART call on it until j288_stm32_deinit().
  *
- * Interrupt context: every j288_stm32_on_* function is ISR-safe and is meant to be called from
- * the HAL callbacks above (i.e. from the UART/DMA/timer IRQ). init/deinit are thread only.
- *
- * Pauses: an idle line inside a reply never ends the transaction (bus.h): the port keeps
- * receiving, and a frame still incomplete at the deadline is J288_ERR_TRUNCATED.
- * HAL failures: every one is counted (hal_failures) and ends the attempt with an error the
- * application sees: J288_ERR_PORT when the line could not be turned to transmit or the
- * transmit not started, J288_ERR_LINE (flag J288_LINE_DMA) when the turn to receive or the
- * reception could not be started. A transfer left running by an earlier transaction (a lost
- * completion interrupt) is aborted before the next one (dma_resets), so the next
- * transaction works.
+ * Interrupt context: j288_stm32_on_* are ISR-safe and meant for the bus's IRQs. init/deinit
+ * are thread only. No function of the port waits on SysTick: a stream that must stop is
+ * stopped at the register with a bounded wait.
  */
 #ifndef J288_STM32_H
 #define J288_STM32_H
@@ -68,6 +71,18 @@ extern "C" {
  * out; frames use the library's compile-time software backend (J288_CONFIG_CRC_BACKEND). */
 #ifndef J288_STM32_HW_CRC
 #define J288_STM32_HW_CRC 1
+#endif
+
+/* Bytes the bus is given in one piece when a reception wraps round the end of the circular
+ * buffer (copied into a scratch of this size; larger runs go as two pieces). */
+#ifndef J288_STM32_BOUNCE_SIZE
+#define J288_STM32_BOUNCE_SIZE 64u
+#endif
+
+/* Reads of a stream's enable bit that a stop waits for at most (a stream finishes its
+ * current single transfer, a few bus cycles, before the bit reads 0). */
+#ifndef J288_STM32_STOP_SPINS
+#define J288_STM32_STOP_SPINS 64u
 #endif
 
 /* The CRC unit is shared by everything on the chip (other libraries, firmware image checks).
@@ -109,10 +124,11 @@ extern "C" {
 #define J288_STM32_DMA_ALIGN __attribute__((aligned(J288_STM32_DCACHE_LINE)))
 #endif
 
-/* Receive DMA buffer size: a whole number of cache lines, larger than one reply so that the
- * idle line, not a full buffer, ends a normal reception. */
+/* Receive DMA buffer size (circular): a whole number of cache lines, at least two frames of
+ * a transaction (command echo and reply, 46 bytes). Larger means fewer half/complete events
+ * per transaction (one every RX_BUF_SIZE/2 bytes). */
 #ifndef J288_STM32_RX_BUF_SIZE
-#define J288_STM32_RX_BUF_SIZE 64u
+#define J288_STM32_RX_BUF_SIZE 256u
 #endif
 
 /* Transmit DMA buffer size: one command rounded up to whole cache lines. */
@@ -121,20 +137,48 @@ extern "C" {
 
 /* ---- types ----------------------------------------------------------------------------- */
 
-/* The DMA buffers of one bus. Declare with J288_STM32_DMA_BUFFER(name) at file scope, so that
- * placement and alignment apply; the port copies each command in (20 bytes) rather than let
- * the DMA read the bus object, which may live in RAM the DMA cannot reach. */
-typedef struct {
+/* The DMA buffers of one bus. The type carries the alignment (whole cache lines on a core with
+ * a D-cache), so any declaration is aligned; J288_STM32_DMA_BUFFER(name) adds the placement
+ * (J288_STM32_DMA_SECTION). The port copies each command in (20 bytes) rather than let the
+ * DMA read the bus object, which may live in RAM the DMA cannot reach. */
+typedef struct J288_STM32_DMA_ALIGN {
     uint8_t tx[J288_STM32_TX_BUF_SIZE];
     uint8_t rx[J288_STM32_RX_BUF_SIZE];
 } j288_stm32_dma_t;
 
-#define J288_STM32_DMA_BUFFER(name) J288_STM32_DMA_SECTION J288_STM32_DMA_ALIGN j288_stm32_dma_t name
+#define J288_STM32_DMA_BUFFER(name) J288_STM32_DMA_SECTION j288_stm32_dma_t name
+
+/* How the port drives the UART's pin (j288_stm32_config_t.tx_drive; docs/stm32.md has the
+ * reasoning and the reference wiring). */
+typedef enum {
+    J288_STM32_PIN_AS_CONFIGURED = 0, /* leave the pin as the application set it up */
+    J288_STM32_PIN_PUSH_PULL,         /* drives both levels: fast edges at 6 Mbps; a series
+                                         resistor limits a collision's current */
+    J288_STM32_PIN_OPEN_DRAIN         /* drives low only, a pull-up makes the high: no
+                                         collision can short two drivers */
+} j288_stm32_pin_drive_t;
 
 /* All pointers must outlive the bus. Fields marked optional may be NULL/0. */
 typedef struct {
     UART_HandleTypeDef *huart; /* required: initialised with HAL_HalfDuplex_Init() */
-    j288_stm32_dma_t *dma;     /* required: declared with J288_STM32_DMA_BUFFER() */
+    j288_stm32_dma_t *dma;     /* required: in RAM the DMA reaches (J288_STM32_DMA_BUFFER) */
+
+    /* The NVIC preemption priority of the bus's interrupts (UART, RX stream, timer: one
+     * priority). The bus lock raises BASEPRI to it, masking those and anything less urgent
+     * while other interrupts keep their latency. 0, or a core without BASEPRI (Cortex-M0/M0+/
+     * M23): the lock masks every interrupt (PRIMASK); BASEPRI cannot mask priority 0. */
+    uint8_t irq_priority;
+
+    /* The line does not hear our own transmit: a transceiver whose receiver is switched off
+     * with DE (/RE tied to DE). false (the single-wire line, or a transceiver whose receiver
+     * stays on): the 20 echoed bytes are skipped or, with the bus's echo option, checked. */
+    bool deaf_while_transmitting;
+
+    /* Optional: the UART's TX pin and how to drive it (set in the GPIO's OTYPER at init).
+     * tx_port NULL: leave the pin as configured. */
+    GPIO_TypeDef *tx_port;
+    uint16_t tx_pin;
+    j288_stm32_pin_drive_t tx_drive;
 
     /* Optional driver-enable pin of an external transceiver: driven active while we
      * transmit, inactive otherwise. de_port NULL: no pin. */
@@ -151,9 +195,10 @@ typedef struct {
      * deadline's distance from now_us, so both must count microseconds. */
     uint32_t (*now_us)(void);
 
-    /* Optional response timeout: a timer counting at 1 MHz, started by the application
-     * (HAL_TIM_Base_Start), whose capture/compare channel tim_channel (TIM_CHANNEL_1..4) is
-     * free and in its reset (frozen output compare) mode. The port writes the compare value,
+    /* Optional response timeout, used by a bus that advances in its interrupts
+     * (advance_in_isr; a polled bus reads the clock when polled): a timer counting at 1 MHz,
+     * started by the application (HAL_TIM_Base_Start), whose capture/compare channel
+     * tim_channel (TIM_CHANNEL_1..4) is free and in its reset (frozen output compare) mode. The port writes the compare value,
      * enables that channel's interrupt and, for a deadline already due, raises the channel's
      * event through the timer's EGR; forward HAL_TIM_OC_DelayElapsedCallback to
      * j288_stm32_on_timer(). Several buses may share one timer on different channels. NULL:
@@ -173,12 +218,17 @@ typedef struct {
 /* Port-side counters. */
 typedef struct {
     uint32_t tx_frames;    /* transmits started */
-    uint32_t rx_events;    /* receive events taken (half, idle, full) */
+    uint32_t rx_events;    /* receive events taken (idle line, half, complete) */
     uint32_t rx_bytes;     /* bytes handed to the bus */
-    uint32_t line_errors;  /* error callbacks */
-    uint32_t hal_failures; /* HAL calls that did not return HAL_OK */
-    uint32_t dma_resets;   /* transfers found still running from an earlier transaction and
-                              aborted before the next (a lost TX complete or DMA interrupt) */
+    uint32_t rx_skipped;   /* bytes not handed over: our own echo (without the echo option)
+                              and bytes heard before a transmit, which belong to nobody */
+    uint32_t noise_errors;   /* line error flags seen at an event (the byte was still stored */
+    uint32_t framing_errors; /* on the F4; the newer USART drops a flagged byte): each reported */
+    uint32_t overruns;       /* to the bus as a line error, the frame left to the CRC */
+    uint32_t parity_errors;
+    uint32_t dma_errors;   /* RX stream transfer errors: the stream was restarted */
+    uint32_t dma_resets;   /* transmits found still running from an earlier transaction and
+                              stopped before the next (a lost TX complete interrupt) */
     uint32_t timer_events; /* compare interrupts taken (timer_rearms included) */
     uint32_t timer_rearms; /* of those, early ones (before the deadline): re-armed for the
                               rest, the bus not called */
@@ -190,10 +240,24 @@ typedef struct j288_stm32 {
     j288_bus_t bus;
     j288_port_t ops; /* the port's operations, as this configuration uses them */
     j288_stm32_config_t cfg;
-    volatile uint16_t rx_pos;  /* bytes of the current reception already handed out */
-    volatile uint8_t dir;      /* j288_dir_t last set */
-    volatile bool tx_refused;  /* the turn to transmit failed: start_tx refuses */
+    USART_TypeDef *uart;       /* the registers, from the handles at init */
+    void *tx_stream;
+    void *rx_stream;
+    volatile uint32_t *tx_ifcr; /* flag clear register of each stream/channel, and its shift */
+    volatile uint32_t *rx_isr;
+    volatile uint32_t *rx_ifcr;
+    uint8_t tx_shift;
+    uint8_t rx_shift;
+    bool echo;                 /* the bus checks the echo: hand it over */
+    bool tc_ends_tx;           /* transmit complete ends a transmit (DE pin, deaf line), not
+                                  the echo's idle line */
+    volatile uint16_t rx_pos;  /* position in the circular buffer handed out so far */
+    volatile uint16_t tx_len;  /* bytes of the last transmit (its echo) */
+    volatile uint16_t tx_start; /* where its echo starts in the receive buffer */
+    volatile bool tx_on;       /* a transmit is in flight */
     uint32_t lock_saved;
+    volatile bool live;        /* registered: the IRQ entries serve it */
+    uint8_t bounce[J288_STM32_BOUNCE_SIZE]; /* a wrapped run, handed over in one piece */
     volatile uint32_t tim_deadline; /* last arm_timeout deadline (now_us clock) */
     j288_stm32_stats_t stats;
 } j288_stm32_t;
@@ -203,16 +267,22 @@ typedef struct j288_stm32 {
 /* Set up p, register it and initialise its bus (j288_bus_init with bus_cfg, which may be
  * NULL for defaults). cfg and bus_cfg are copied; what cfg points to must outlive the bus.
  * The application initialises the UART, its DMA streams, the timer (started) and the CRC
- * unit before. Leaves the line in receive direction with the DE pin inactive.
+ * unit before. Init then takes the UART's registers: one-bit sampling, error interrupt off,
+ * transmitter and receiver on, DMA requests both ways, idle-line interrupt; the RX stream
+ * circular over dma->rx with its half/complete/error interrupts, started; the TX stream
+ * pointed at dma->tx. The DE pin is left inactive and the TX pin driven as tx_drive says.
  * Errors: J288_ERR_NULL (p, cfg, huart or dma), J288_ERR_BUSY (this UART is registered
  * already, or J288_STM32_MAX_BUSES are), J288_ERR_BAD_CONFIG for any of:
+ *   - dma in RAM the DMA controller cannot reach: the F4's CCM data RAM
+ *     (0x10000000-0x1000FFFF), the H7's ITCM (below 0x00040000) and DTCM
+ *     (0x20000000-0x2001FFFF); or, with J288_STM32_DCACHE, not on a cache line;
  *   - no now_us and no 32-bit 1 MHz timer, or a tim_channel that is no TIM_CHANNEL_n;
  *   - the UART handle has no DMA stream linked (hdmatx or hdmarx NULL);
- *   - bus_cfg->echo: the receiver is off while the port transmits, so no echo can come;
+ *   - bus_cfg->echo with deaf_while_transmitting: no echo can come;
  *   - the CRC unit does not compute the servo's CRC: a handle in another configuration (see
  *     hcrc above), or a unit that fails a known-answer check (its clock not enabled,
  *     HAL_CRC_Init not called, registers reprogrammed by other code);
- * J288_ERR_PORT (the HAL refused to turn the line to receive), or j288_bus_init()'s codes.
+ * J288_ERR_PORT (a DMA stream that would not stop), or j288_bus_init()'s codes.
  * Thread only. */
 int j288_stm32_init(j288_stm32_t *p, const j288_stm32_config_t *cfg,
                     const j288_bus_config_t *bus_cfg);
@@ -236,14 +306,19 @@ uint32_t j288_stm32_now_us(const j288_stm32_t *p);
  * updating them, so two fields read one after the other may be from different moments. */
 const j288_stm32_stats_t *j288_stm32_stats(const j288_stm32_t *p);
 
-/* Callback forwarding, ISR-safe; call them from the HAL callbacks named at the top, i.e. from
- * the bus's UART, DMA and timer interrupts, never from two priorities at once. Each returns
- * false (and does nothing) when the handle belongs to no registered bus (or is NULL). Bytes
- * of a receive event are handed to the bus during the call; the port's DMA buffer is not
- * read after it returns. */
-bool j288_stm32_on_tx_cplt(UART_HandleTypeDef *huart);
-bool j288_stm32_on_rx_event(UART_HandleTypeDef *huart, uint16_t size);
-bool j288_stm32_on_error(UART_HandleTypeDef *huart);
+/* Interrupt entries, ISR-safe; each does nothing for NULL or an unregistered p.
+ * on_uart_irq: call from the UART's IRQ handler (instead of HAL_UART_IRQHandler): the idle
+ *   line (received bytes handed over), line error flags (counted, reported), transmit
+ *   complete (the bus is told; the echo skipped or handed over first).
+ * on_dma_rx_irq: call from the RX stream's IRQ handler (instead of HAL_DMA_IRQHandler): half
+ *   and complete (received bytes handed over), transfer error (stream restarted, reported).
+ * Bytes are handed to the bus during the call; the DMA buffer is not read after it returns. */
+void j288_stm32_on_uart_irq(j288_stm32_t *p);
+void j288_stm32_on_dma_rx_irq(j288_stm32_t *p);
+
+/* Call from HAL_TIM_OC_DelayElapsedCallback (HAL_TIM_IRQHandler serves the timer, which is
+ * not per transaction). Returns false (and does nothing) when htim's active channel belongs
+ * to no registered bus, so one callback can serve several buses and other timers. */
 bool j288_stm32_on_timer(TIM_HandleTypeDef *htim);
 
 #if J288_STM32_HW_CRC

@@ -152,7 +152,8 @@ static void test_real(void)
 static void test_real_refusals(void)
 {
     static const char *const bad[] = {"nan", "inf", "-inf", "1e999",  "1.5rad",
-                                      "",    " 1",  ".",    "0x1p3x", "e5"};
+                                      "",    " 1",  ".",    "0x1p3x", "e5",
+                                      "0x1p1", "0x10", "1e", "1e+", "1.2.3", "+-1", "1 "};
     size_t i;
     for (i = 0; i < sizeof bad / sizeof bad[0]; i++) {
         double v = 42.0;

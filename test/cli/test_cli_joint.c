@@ -122,7 +122,7 @@ static const char k_two_buses[] = "buses:\n"
                                   "    direction: -1\n"
                                   "    limits: [-1, 1]\n"
                                   "  - {name: hip_r, bus: right, id: 1}\n"
-                                  "  - {name: knee, bus: left, id: 2, zero: 100}\n";
+                                  "  - {name: knee, bus: left, id: 2, zero: 0.5}\n";
 
 /* By name: the file's joint, and its bus's options where the command line left them open. */
 static void test_by_name_fills_bus(void)
@@ -186,17 +186,15 @@ static void test_unknown_name(void)
     cli_expect_one_error("no joint named 'ankle'");
 }
 
-/* A value the file allows but the library does not (|zero| > 64): "FILE:LINE: joint ...". */
+/* A value the library would refuse (|zero| > 64) is refused by the file already, with its
+ * line, key and value. */
 static void test_library_refusal_names_the_line(void)
 {
-    cli_bus_opts_t o;
-    cli_joint_sel_t sel;
-    char want[200];
-    write_config(k_two_buses);
-    TEST_ASSERT_EQUAL_INT(0, cli_robot_load(&robot, path));
-    opts(&o);
-    TEST_ASSERT_EQUAL_INT(-1, cli_joint_select(&robot, "knee", -1, &o, &sel));
-    snprintf(want, sizeof want, "%s:15: joint knee: ", path);
+    char text[sizeof k_two_buses + 8], want[200];
+    (void)snprintf(text, sizeof text, "%.*s100}\n", (int)(sizeof k_two_buses - 6u), k_two_buses);
+    write_config(text);
+    TEST_ASSERT_EQUAL_INT(-1, cli_robot_load(&robot, path));
+    snprintf(want, sizeof want, "%s:15: joint 'knee': zero: 100 is out of range (-64 to 64)", path);
     cli_expect_one_error(want);
 }
 

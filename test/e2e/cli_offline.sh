@@ -179,5 +179,18 @@ expect_bad no_command 2 'no command given' "$J288"
 expect_bad unknown_command 2 "unknown command 'frob'" "$J288" frob
 expect_bad global_unknown_option 2 "unknown option '--prot'" "$J288" --prot x scan
 expect_bad global_baud_garbage 2 "--baud: '6M' is not a whole number" "$J288" --baud 6M scan
+# One number syntax with the robot config file (host/j288_number.h): no hexadecimal reals.
+expect_bad encode_hex_real 2 "--pos: '0x1p1' is not a number" "$J288" encode --id 1 --pos 0x1p1
+# One udev rule, installed the same way by every page that mentions it.
+udev_rule_everywhere() {
+    local install='sudo cp docs/99-j288.rules /etc/udev/rules.d/ && sudo udevadm control --reload && sudo udevadm trigger'
+    local f
+    grep -q '^SUBSYSTEM=="tty", .*GROUP="dialout"' docs/99-j288.rules || return 1
+    for f in README.md docs/porting.md docs/troubleshooting.md tools/j288/README.md; do
+        grep -qF -- "$install" "$f" || { echo "$f: no '$install'"; return 1; }
+        ! grep -q 'ATTRS{idVendor}' "$f" || { echo "$f: a udev rule of its own"; return 1; }
+    done
+}
+expect_true udev_rule_everywhere udev_rule_everywhere
 
 e2e_summary

@@ -111,6 +111,19 @@ t_config_errors() {
     # (the default motion: a 0.04 rad one left too few samples for the fit on a loaded machine)
     e2e_run "$J288" --port "$DEV" calibrate --id 1 "${M[@]}"
     [ "$E2E_RC" -eq 0 ] && grep -q "^put 'phase: " <<<"$E2E_OUT" || { echo "calibrate: $E2E_OUT $E2E_ERR"; return 1; }
+    # A relative port is the config file's folder's, wherever the tool runs.
+    mkdir -p "$E2E_TMP/robot" && ln -sf "$DEV" "$E2E_TMP/robot/bus0"
+    printf 'buses:\n  - {name: a, port: bus0, margin_us: 250000}\njoints:\n  - {name: j, id: 1}\n' >"$E2E_TMP/robot/robot.yaml"
+    status_joint j "$E2E_TMP/robot/robot.yaml" || return 1
+    # A read-only config: zero and calibrate refuse before sending anything (root too).
+    local frames
+    cp "$cfg" "$E2E_TMP/ro.yaml" && chmod 444 "$E2E_TMP/ro.yaml"
+    frames=$(grep -c 'id=1 ' "$SLOG")
+    expect_bad zero_read_only 1 "^j288 zero: $E2E_TMP/ro.yaml: read-only: .*; nothing was sent\$" \
+        "$J288" zero --joint j --config "$E2E_TMP/ro.yaml"
+    expect_bad calibrate_read_only 1 "^j288 calibrate: $E2E_TMP/ro.yaml: read-only: " \
+        "$J288" calibrate --joint j --config "$E2E_TMP/ro.yaml"
+    [ "$(grep -c 'id=1 ' "$SLOG")" = "$frames" ] || { echo "frames sent to a read-only config's joint"; return 1; }
     stop_sim
 }
 

@@ -132,9 +132,9 @@ static int port_start_tx(void *ctx, const uint8_t *data, size_t len)
     }
     FUZZ_CHECK(fuzz_cmd_valid(data));
     static const uint8_t stop_body[13] = {0}; /* bytes 3-15 of the stop */
-    bool is_stop = (data[2] == 0x8Fu) && (memcmp(&data[3], stop_body, sizeof stop_body) == 0);
+    bool is_stop = (data[2] == 0x0Fu) && (memcmp(&data[3], stop_body, sizeof stop_body) == 0);
     if (w.estop_expected) {
-        /* The stop goes out before anything else: broadcast, lock, watchdog on, all zero. */
+        /* The stop goes out before anything else: broadcast, lock, watchdog bit 0, all zero. */
         FUZZ_CHECK(is_stop);
         w.estop_expected = false;
     } else if (is_stop && w.estops > 0u) {

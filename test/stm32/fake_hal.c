@@ -6,17 +6,68 @@
 #define FAKE_UARTS 4u
 #define FAKE_PINS 16u
 
+/* ---- the register models ---------------------------------------------------------------- */
+#if defined(J288_STUB_G4)
+#define U_STATUS(u) ((u)->ISR)
+#define U_DATA(u) ((u)->RDR)
+#define U_RXNE USART_ISR_RXNE_RXFNE
+#define U_IDLE USART_ISR_IDLE
+#define U_TC USART_ISR_TC
+#define U_PE USART_ISR_PE
+#define U_FE USART_ISR_FE
+#define U_NE USART_ISR_NE
+#define U_ORE USART_ISR_ORE
+#define D_CTRL(s) ((s)->CCR)
+#define D_COUNT(s) ((s)->CNDTR)
+#define D_MEM(s) ((s)->CMAR)
+#define D_EN DMA_CCR_EN
+#define D_CIRC DMA_CCR_CIRC
+#define D_HTIE DMA_CCR_HTIE
+#define D_TCIE DMA_CCR_TCIE
+#define D_TEIE DMA_CCR_TEIE
+#define D_HT DMA_ISR_HTIF1
+#define D_TC DMA_ISR_TCIF1
+#define D_TE DMA_ISR_TEIF1
+#define D_ALL (DMA_ISR_GIF1 | DMA_ISR_HTIF1 | DMA_ISR_TCIF1 | DMA_ISR_TEIF1)
+#else
+#define U_STATUS(u) ((u)->SR)
+#define U_DATA(u) ((u)->DR)
+#define U_RXNE USART_SR_RXNE
+#define U_IDLE USART_SR_IDLE
+#define U_TC USART_SR_TC
+#define U_PE USART_SR_PE
+#define U_FE USART_SR_FE
+#define U_NE USART_SR_NE
+#define U_ORE USART_SR_ORE
+#define D_CTRL(s) ((s)->CR)
+#define D_COUNT(s) ((s)->NDTR)
+#define D_MEM(s) ((s)->M0AR)
+#define D_EN DMA_SxCR_EN
+#define D_CIRC DMA_SxCR_CIRC
+#define D_HTIE DMA_SxCR_HTIE
+#define D_TCIE DMA_SxCR_TCIE
+#define D_TEIE DMA_SxCR_TEIE
+#define D_HT DMA_LISR_HTIF0
+#define D_TC DMA_LISR_TCIF0
+#define D_TE DMA_LISR_TEIF0
+#define D_ALL (DMA_LISR_FEIF0 | DMA_LISR_DMEIF0 | DMA_LISR_TEIF0 | DMA_LISR_HTIF0 | DMA_LISR_TCIF0)
+#endif
+#define U_ERRORS (U_PE | U_FE | U_NE | U_ORE)
+
 typedef struct {
-    const UART_HandleTypeDef *huart;
-    bool te, re;
-    bool tx_busy;
+    UART_HandleTypeDef *huart;
+    USART_TypeDef usart;
+    J288_STUB_DMA_INSTANCE tx_stream, rx_stream;
+    DMA_HandleTypeDef htx, hrx;
+    DMA_TypeDef flags; /* both streams' flags: RX at shift 16 (low), TX at 22 (high) */
     uint8_t tx[64];
     size_t tx_len;
-    bool dmat, dmar; /* the UART's DMA requests (CR3) */
-    uint8_t *rx_buf; /* armed reception, NULL when none */
-    uint16_t rx_size;
-    uint16_t rx_fill;
-    bool half_done;
+    bool deaf;
+    bool lag;
+    bool rx_since_idle;
+    bool rx_running; /* the RX stream seen enabled: rx_size is its length */
+    uint32_t rx_size;
+    unsigned stolen;
 } fake_uart_t;
 
 typedef struct {
@@ -28,14 +79,14 @@ typedef struct {
 static fake_hal_call_t call_log[FAKE_HAL_LOG_SIZE];
 static size_t log_len;
 static unsigned counts[FAKE_FN_COUNT];
-static bool fail_next[FAKE_FN_COUNT];
 static fake_uart_t uarts[FAKE_UARTS];
 static fake_pin_t pins[FAKE_PINS];
 static uint32_t primask;
+static uint32_t basepri;
 static unsigned irq_disables;
+static bool irq_hold;
 static uint32_t crc_reg = 0xFFFFFFFFu;
 static bool crc_unclocked;
-static bool rx_circular;
 /* The counter-advance hook of fake_hal_tim_advance_at(). */
 static TIM_TypeDef *hook_tim;
 static unsigned hook_countdown;
@@ -47,16 +98,16 @@ void fake_hal_reset(void)
     memset(call_log, 0, sizeof call_log);
     log_len = 0u;
     memset(counts, 0, sizeof counts);
-    memset(fail_next, 0, sizeof fail_next);
     memset(uarts, 0, sizeof uarts);
     memset(pins, 0, sizeof pins);
     primask = 0u;
+    basepri = 0u;
     irq_disables = 0u;
+    irq_hold = false;
     hook_tim = NULL;
     tim_accesses = 0u;
     crc_reg = 0xFFFFFFFFu;
     crc_unclocked = false;
-    rx_circular = false;
 }
 
 static void record(fake_hal_fn_t fn, const void *handle, uint32_t arg)
@@ -70,20 +121,10 @@ static void record(fake_hal_fn_t fn, const void *handle, uint32_t arg)
     }
 }
 
-/* A call of fn: logged; true when the test scripted it to fail (once, by fake_hal_fail_next). */
-static bool call_fails(fake_hal_fn_t fn, const void *handle, uint32_t arg)
-{
-    bool f = fail_next[fn];
-    record(fn, handle, arg);
-    fail_next[fn] = false;
-    return f;
-}
-
 size_t fake_hal_log_len(void) { return log_len; }
 const fake_hal_call_t *fake_hal_log_at(size_t i) { return (i < log_len) ? &call_log[i] : NULL; }
 void fake_hal_log_clear(void) { log_len = 0u; }
 unsigned fake_hal_count(fake_hal_fn_t fn) { return counts[fn]; }
-void fake_hal_fail_next(fake_hal_fn_t fn) { fail_next[fn] = true; }
 
 long fake_hal_log_find(fake_hal_fn_t fn, const void *handle, size_t from)
 {
@@ -102,247 +143,336 @@ static fake_uart_t *uart_of(const UART_HandleTypeDef *huart)
             return &uarts[i];
         }
     }
-    for (size_t i = 0; i < FAKE_UARTS; i++) {
-        if (uarts[i].huart == NULL) {
-            uarts[i].huart = huart;
-            return &uarts[i];
+    return &uarts[FAKE_UARTS - 1u]; /* tests set up fewer UARTs than this */
+}
+
+void fake_hal_uart_setup(UART_HandleTypeDef *huart)
+{
+    fake_uart_t *f = NULL;
+    for (size_t i = 0; (i < FAKE_UARTS) && (f == NULL); i++) {
+        if ((uarts[i].huart == NULL) || (uarts[i].huart == huart)) {
+            f = &uarts[i];
         }
     }
-    return &uarts[FAKE_UARTS - 1u]; /* tests use fewer UARTs than this */
-}
-
-/* ---- UART ------------------------------------------------------------------------------ */
-
-/* The DMA handles linked to huart are ready after init, as HAL_DMA_Init leaves them. */
-static void dma_set_state(DMA_HandleTypeDef *hdma, HAL_DMA_StateTypeDef st)
-{
-    if (hdma != NULL) {
-        hdma->State = st;
+    if (f == NULL) {
+        return;
     }
-}
-
-/* The F4 HAL starts the stream with HAL_DMA_Start_IT and ignores its result, which is
- * HAL_BUSY when the stream's handle is not READY (a transfer left running): the UART call
- * then returns HAL_OK and nothing moves. */
-static bool dma_start(DMA_HandleTypeDef *hdma)
-{
-    if ((hdma != NULL) && (hdma->State != HAL_DMA_STATE_READY)) {
-        return false;
-    }
-    dma_set_state(hdma, HAL_DMA_STATE_BUSY);
-    return true;
-}
-
-HAL_DMA_StateTypeDef HAL_DMA_GetState(DMA_HandleTypeDef *hdma) { return hdma->State; }
-
-HAL_StatusTypeDef HAL_DMA_Abort(DMA_HandleTypeDef *hdma)
-{
-    record(FAKE_DMA_ABORT, hdma, 0u);
-    if (hdma->State != HAL_DMA_STATE_BUSY) {
-        return HAL_ERROR; /* no transfer to abort */
-    }
-    hdma->State = HAL_DMA_STATE_READY;
-    return HAL_OK;
-}
-
-HAL_StatusTypeDef HAL_HalfDuplex_Init(UART_HandleTypeDef *huart)
-{
-    dma_set_state(huart->hdmatx, HAL_DMA_STATE_READY);
-    dma_set_state(huart->hdmarx, HAL_DMA_STATE_READY);
+    memset(f, 0, sizeof *f);
+    f->huart = huart;
+    huart->Instance = &f->usart;
+    huart->hdmatx = &f->htx;
+    huart->hdmarx = &f->hrx;
     huart->gState = HAL_UART_STATE_READY;
     huart->RxState = HAL_UART_STATE_READY;
-    huart->ErrorCode = HAL_UART_ERROR_NONE;
-    return HAL_OK;
+    f->usart.CR1 = USART_CR1_UE | USART_CR1_TE | USART_CR1_RE;
+    f->usart.CR3 = USART_CR3_HDSEL;
+    U_STATUS(&f->usart) = U_TC; /* TC is up after reset */
+    f->htx.Instance = &f->tx_stream;
+    f->hrx.Instance = &f->rx_stream;
+    f->htx.Parent = huart;
+    f->hrx.Parent = huart;
+    f->htx.State = HAL_DMA_STATE_READY;
+    f->hrx.State = HAL_DMA_STATE_READY;
+    f->hrx.Init.Mode = DMA_NORMAL;
+#if defined(J288_STUB_G4)
+    f->htx.DmaBaseAddress = &f->flags;
+    f->hrx.DmaBaseAddress = &f->flags;
+    f->htx.ChannelIndex = 0u;  /* channel 1 */
+    f->hrx.ChannelIndex = 4u;  /* channel 2 */
+#else
+    f->htx.StreamBaseAddress = (uintptr_t)&f->flags.HISR;
+    f->htx.StreamIndex = 22u; /* stream 7: HISR */
+    f->hrx.StreamBaseAddress = (uintptr_t)&f->flags.LISR;
+    f->hrx.StreamIndex = 16u; /* stream 2: LISR */
+#endif
 }
 
-static HAL_StatusTypeDef half_duplex_enable(UART_HandleTypeDef *huart, bool transmitter)
+/* The flag register and shift of a stream, as the silicon lays them out. */
+static volatile uint32_t *flag_reg(fake_uart_t *f, bool rx)
 {
-    fake_uart_t *u = uart_of(huart);
-    if (call_fails(transmitter ? FAKE_HALFDUPLEX_TX : FAKE_HALFDUPLEX_RX, huart, 0u)) {
-        return HAL_ERROR;
-    }
-    u->te = transmitter;
-    u->re = !transmitter;
-    huart->gState = HAL_UART_STATE_READY; /* as ST's HAL does, whatever the transmit's state */
-    return HAL_OK;
+#if defined(J288_STUB_G4)
+    (void)rx;
+    return &f->flags.ISR;
+#else
+    return rx ? &f->flags.LISR : &f->flags.HISR;
+#endif
+}
+static uint32_t flag_shift(fake_uart_t *f, bool rx)
+{
+#if defined(J288_STUB_G4)
+    return rx ? f->hrx.ChannelIndex : f->htx.ChannelIndex;
+#else
+    return rx ? f->hrx.StreamIndex : f->htx.StreamIndex;
+#endif
 }
 
-HAL_StatusTypeDef HAL_HalfDuplex_EnableTransmitter(UART_HandleTypeDef *huart)
+/* Clears written by the CPU take effect (ICR on the G4; the DMA's IFCR). */
+static void sync(fake_uart_t *f)
 {
-    return half_duplex_enable(huart, true);
+#if defined(J288_STUB_G4)
+    U_STATUS(&f->usart) &= ~f->usart.ICR;
+    f->usart.ICR = 0u;
+    f->flags.ISR &= ~f->flags.IFCR;
+    f->flags.IFCR = 0u;
+#else
+    f->flags.LISR &= ~f->flags.LIFCR;
+    f->flags.LIFCR = 0u;
+    f->flags.HISR &= ~f->flags.HIFCR;
+    f->flags.HIFCR = 0u;
+#endif
+    if ((D_CTRL(&f->rx_stream) & D_EN) == 0u) {
+        f->rx_running = false;
+    } else if (!f->rx_running) {
+        f->rx_running = true;
+        f->rx_size = D_COUNT(&f->rx_stream);
+    }
 }
 
-HAL_StatusTypeDef HAL_HalfDuplex_EnableReceiver(UART_HandleTypeDef *huart)
+/* The RX stream takes the byte waiting in the data register. */
+static void dma_rx_take(fake_uart_t *f)
 {
-    return half_duplex_enable(huart, false);
+    J288_STUB_DMA_INSTANCE *s = &f->rx_stream;
+    volatile uint32_t *fl = flag_reg(f, true);
+    uint32_t sh = flag_shift(f, true);
+    uint8_t *mem = (uint8_t *)D_MEM(s);
+
+    sync(f);
+    if (((U_STATUS(&f->usart) & U_RXNE) == 0u) || ((f->usart.CR3 & USART_CR3_DMAR) == 0u) ||
+        !f->rx_running || (D_COUNT(s) == 0u)) {
+        return;
+    }
+    mem[f->rx_size - D_COUNT(s)] = (uint8_t)U_DATA(&f->usart);
+    U_STATUS(&f->usart) &= ~U_RXNE;
+    D_COUNT(s)--;
+    if (D_COUNT(s) == f->rx_size / 2u) {
+        *fl |= (uint32_t)D_HT << sh;
+    }
+    if (D_COUNT(s) == 0u) {
+        *fl |= (uint32_t)D_TC << sh;
+        if ((D_CTRL(s) & D_CIRC) != 0u) {
+            D_COUNT(s) = f->rx_size;
+        } else {
+            D_CTRL(s) &= ~(uint32_t)D_EN;
+        }
+    }
 }
 
-HAL_StatusTypeDef HAL_UART_Transmit_DMA(UART_HandleTypeDef *huart, const uint8_t *pData, uint16_t Size)
+static bool uart_irq_pending(fake_uart_t *f)
 {
-    fake_uart_t *u = uart_of(huart);
-    if (call_fails(FAKE_TRANSMIT_DMA, huart, Size) || (pData == NULL) || (Size == 0u) ||
-        (huart->gState != HAL_UART_STATE_READY)) {
-        return (huart->gState != HAL_UART_STATE_READY) ? HAL_BUSY : HAL_ERROR;
-    }
-    huart->pTxBuffPtr = pData;
-    huart->TxXferSize = Size;
-    huart->gState = HAL_UART_STATE_BUSY_TX;
-    u->dmat = true; /* set after the stream start, whatever its result */
-    if (!dma_start(huart->hdmatx)) {
-        u->tx_busy = false; /* no transfer that will ever complete: a stalled one never does */
-        return HAL_OK;      /* the F4 HAL's silent failure: nothing goes out, ever */
-    }
-    u->tx_len = (Size <= sizeof u->tx) ? Size : sizeof u->tx;
-    memcpy(u->tx, pData, u->tx_len);
-    u->tx_busy = true;
-    return HAL_OK;
+    uint32_t st = U_STATUS(&f->usart);
+    uint32_t cr1 = f->usart.CR1;
+    return (((st & U_IDLE) != 0u) && ((cr1 & USART_CR1_IDLEIE) != 0u)) ||
+           (((st & U_TC) != 0u) && ((cr1 & USART_CR1_TCIE) != 0u)) ||
+           (((st & (U_FE | U_NE | U_ORE)) != 0u) && ((f->usart.CR3 & USART_CR3_EIE) != 0u));
 }
 
-HAL_StatusTypeDef HAL_UARTEx_ReceiveToIdle_DMA(UART_HandleTypeDef *huart, uint8_t *pData, uint16_t Size)
+static bool dma_irq_pending(fake_uart_t *f)
 {
-    fake_uart_t *u = uart_of(huart);
-    if (call_fails(FAKE_RECEIVE_TO_IDLE_DMA, huart, Size) || (pData == NULL) || (Size == 0u)) {
-        return HAL_ERROR;
-    }
-    if (huart->RxState != HAL_UART_STATE_READY) {
-        return HAL_BUSY;
-    }
-    huart->pRxBuffPtr = pData;
-    huart->RxXferSize = Size;
-    huart->RxState = HAL_UART_STATE_BUSY_RX;
-    huart->ErrorCode = HAL_UART_ERROR_NONE;
-    u->dmar = true;
-    if (!dma_start(huart->hdmarx)) {
-        return HAL_OK; /* as above: the reception never receives */
-    }
-    u->rx_buf = pData;
-    u->rx_size = Size;
-    u->rx_fill = 0u;
-    u->half_done = false;
-    return HAL_OK;
+    uint32_t fl = (*flag_reg(f, true) >> flag_shift(f, true));
+    uint32_t cr = D_CTRL(&f->rx_stream);
+    return (((fl & D_HT) != 0u) && ((cr & D_HTIE) != 0u)) ||
+           (((fl & D_TC) != 0u) && ((cr & D_TCIE) != 0u)) ||
+           (((fl & D_TE) != 0u) && ((cr & D_TEIE) != 0u));
 }
 
-HAL_StatusTypeDef HAL_UART_AbortReceive(UART_HandleTypeDef *huart)
+/* One handler, if its interrupt is pending; the DMA catches up afterwards. */
+static bool service(fake_uart_t *f, bool uart)
 {
-    fake_uart_t *u = uart_of(huart);
-    if (call_fails(FAKE_ABORT_RECEIVE, huart, 0u)) {
-        return HAL_ERROR;
+    bool pending;
+    sync(f);
+    pending = uart ? uart_irq_pending(f) : dma_irq_pending(f);
+    if (pending) {
+        if (uart) {
+            fake_app_uart_irq(f->huart);
+        } else {
+            fake_app_dma_rx_irq(f->huart);
+        }
     }
-    u->rx_buf = NULL;
-    if (u->dmar) { /* the HAL aborts the stream only when the UART's DMA request is on */
-        u->dmar = false;
-        dma_set_state(huart->hdmarx, HAL_DMA_STATE_READY);
-    }
-    huart->RxState = HAL_UART_STATE_READY;
-    return HAL_OK;
+    dma_rx_take(f);
+    return pending;
 }
 
-HAL_StatusTypeDef HAL_UART_AbortTransmit(UART_HandleTypeDef *huart)
+/* The NVIC: pending interrupts are taken until none is (the UART's first, its vector being
+ * the lower number on both families); a handler that leaves its flag up is taken again, a
+ * bounded number of times. */
+static void dispatch(fake_uart_t *f)
 {
-    fake_uart_t *u = uart_of(huart);
-    if (call_fails(FAKE_ABORT_TRANSMIT, huart, 0u)) {
-        return HAL_ERROR;
+    for (unsigned n = 0; (n < 16u) && !irq_hold; n++) {
+        if (!service(f, true) && !service(f, false)) {
+            return;
+        }
     }
-    u->tx_busy = false;
-    if (u->dmat) {
-        u->dmat = false;
-        dma_set_state(huart->hdmatx, HAL_DMA_STATE_READY);
-    }
-    huart->gState = HAL_UART_STATE_READY;
-    return HAL_OK;
 }
 
-void HAL_UART_IRQHandler(UART_HandleTypeDef *huart) { (void)huart; }
-
-const uint8_t *fake_hal_tx_data(const UART_HandleTypeDef *huart, size_t *len)
+void fake_hal_irq_hold(bool hold) { irq_hold = hold; }
+bool fake_hal_irq_service(UART_HandleTypeDef *huart, bool uart) { return service(uart_of(huart), uart); }
+bool fake_hal_irq_pending(UART_HandleTypeDef *huart, bool uart)
 {
-    fake_uart_t *u = uart_of(huart);
-    if (len != NULL) {
-        *len = u->tx_len;
-    }
-    return u->tx;
+    fake_uart_t *f = uart_of(huart);
+    sync(f);
+    return uart ? uart_irq_pending(f) : dma_irq_pending(f);
 }
 
-bool fake_hal_tx_busy(const UART_HandleTypeDef *huart) { return uart_of(huart)->tx_busy; }
-bool fake_hal_rx_armed(const UART_HandleTypeDef *huart) { return uart_of(huart)->rx_buf != NULL; }
-bool fake_hal_receiver_on(const UART_HandleTypeDef *huart) { return uart_of(huart)->re; }
-bool fake_hal_transmitter_on(const UART_HandleTypeDef *huart) { return uart_of(huart)->te; }
+void fake_hal_line_deaf(UART_HandleTypeDef *huart, bool deaf) { uart_of(huart)->deaf = deaf; }
+void fake_hal_dma_lag(UART_HandleTypeDef *huart, bool lag) { uart_of(huart)->lag = lag; }
+unsigned fake_hal_bytes_stolen(const UART_HandleTypeDef *huart) { return uart_of(huart)->stolen; }
+USART_TypeDef *fake_hal_usart(const UART_HandleTypeDef *huart) { return &uart_of(huart)->usart; }
+J288_STUB_DMA_INSTANCE *fake_hal_rx_stream(const UART_HandleTypeDef *huart) { return &uart_of(huart)->rx_stream; }
+J288_STUB_DMA_INSTANCE *fake_hal_tx_stream(const UART_HandleTypeDef *huart) { return &uart_of(huart)->tx_stream; }
 
-bool fake_hal_tx_complete(UART_HandleTypeDef *huart)
+/* A byte at the receiver. */
+static bool receive(fake_uart_t *f, uint8_t byte, unsigned flags)
 {
-    fake_uart_t *u = uart_of(huart);
-    if (!u->tx_busy) {
+    USART_TypeDef *u = &f->usart;
+    uint32_t err = 0u;
+
+    dma_rx_take(f); /* a lagging stream has caught up within a byte's time */
+    if (((u->CR1 & USART_CR1_UE) == 0u) || ((u->CR1 & USART_CR1_RE) == 0u)) {
+        return false; /* nobody listening */
+    }
+    f->rx_since_idle = true;
+    if (((flags & FAKE_OVERRUN) != 0u) || ((U_STATUS(u) & U_RXNE) != 0u)) {
+        U_STATUS(u) |= U_ORE; /* the byte is lost behind the full data register */
         return false;
     }
-    u->tx_busy = false;
-    u->dmat = false;
-    dma_set_state(huart->hdmatx, HAL_DMA_STATE_READY);
-    huart->gState = HAL_UART_STATE_READY; /* the HAL is ready again before the callback */
-    HAL_UART_TxCpltCallback(huart);
+    err |= (((flags & FAKE_NOISE) != 0u) && ((u->CR3 & USART_CR3_ONEBIT) == 0u)) ? U_NE : 0u;
+    err |= ((flags & FAKE_FRAMING) != 0u) ? U_FE : 0u;
+    err |= ((flags & FAKE_PARITY) != 0u) ? U_PE : 0u;
+    U_STATUS(u) |= err;
+#if defined(J288_STUB_G4)
+    if ((err != 0u) && ((u->CR3 & USART_CR3_DDRE) == 0u)) {
+        return false; /* RM0440: the flagged byte is not handed to the DMA, RXNE stays 0 */
+    }
+#endif
+    U_DATA(u) = byte;
+    U_STATUS(u) |= U_RXNE;
+    if (!f->lag) {
+        dma_rx_take(f);
+    }
     return true;
-}
-
-/* Reception over: the HAL marks the handle ready, then reports the fill level. */
-static void rx_end(UART_HandleTypeDef *huart, fake_uart_t *u)
-{
-    uint16_t fill = u->rx_fill;
-    u->rx_buf = NULL;
-    u->dmar = false;
-    dma_set_state(huart->hdmarx, HAL_DMA_STATE_READY);
-    huart->RxState = HAL_UART_STATE_READY;
-    HAL_UARTEx_RxEventCallback(huart, fill);
 }
 
 size_t fake_hal_rx_bytes(UART_HandleTypeDef *huart, const uint8_t *data, size_t len)
 {
-    fake_uart_t *u = uart_of(huart);
-    size_t stored = 0u;
+    fake_uart_t *f = uart_of(huart);
+    size_t taken = 0u;
     for (size_t i = 0; i < len; i++) {
-        if ((u->rx_buf == NULL) || !u->re) {
-            continue; /* nobody listening: the byte is lost */
-        }
-        u->rx_buf[u->rx_fill++] = data[i];
-        stored++;
-        if ((u->rx_fill == u->rx_size) && rx_circular) {
-            u->rx_fill = 0u; /* the stream wraps and goes on */
-            u->half_done = false;
-            HAL_UARTEx_RxEventCallback(huart, u->rx_size);
-        } else if (u->rx_fill == u->rx_size) {
-            rx_end(huart, u); /* buffer full (DMA transfer complete) */
-        } else if (!u->half_done && (u->rx_fill == (uint16_t)(u->rx_size / 2u))) {
-            u->half_done = true; /* half transfer: reception goes on */
-            HAL_UARTEx_RxEventCallback(huart, u->rx_fill);
-        }
+        taken += receive(f, data[i], 0u) ? 1u : 0u;
+        dispatch(f);
     }
-    return stored;
+    return taken;
 }
 
-void fake_hal_rx_circular(bool on) { rx_circular = on; }
-
-bool fake_hal_rx_idle(UART_HandleTypeDef *huart)
+bool fake_hal_rx_flagged(UART_HandleTypeDef *huart, uint8_t byte, unsigned flags)
 {
-    fake_uart_t *u = uart_of(huart);
-    if ((u->rx_buf == NULL) || (u->rx_fill == 0u)) {
-        return false; /* the HAL reports idle only inside a reception that has data */
+    fake_uart_t *f = uart_of(huart);
+    bool taken = receive(f, byte, flags);
+    dispatch(f);
+    return taken;
+}
+
+bool fake_hal_line_idle(UART_HandleTypeDef *huart)
+{
+    fake_uart_t *f = uart_of(huart);
+    sync(f);
+    if (!f->rx_since_idle) {
+        return false;
     }
-    if (rx_circular) {
-        HAL_UARTEx_RxEventCallback(huart, u->rx_fill); /* the reception goes on */
-        return true;
-    }
-    rx_end(huart, u);
+    f->rx_since_idle = false;
+    U_STATUS(&f->usart) |= U_IDLE;
+    dispatch(f);
     return true;
 }
 
-void fake_hal_rx_error(UART_HandleTypeDef *huart, uint32_t error_code)
+void fake_hal_dma_rx_error(UART_HandleTypeDef *huart)
 {
-    fake_uart_t *u = uart_of(huart);
-    u->rx_buf = NULL; /* DMA mode: the HAL treats the error as blocking and aborts */
-    u->dmar = false;
-    dma_set_state(huart->hdmarx, HAL_DMA_STATE_READY);
-    huart->RxState = HAL_UART_STATE_READY;
-    huart->ErrorCode = error_code;
-    HAL_UART_ErrorCallback(huart);
+    fake_uart_t *f = uart_of(huart);
+    sync(f);
+    D_CTRL(&f->rx_stream) &= ~(uint32_t)D_EN;
+    *flag_reg(f, true) |= (uint32_t)D_TE << flag_shift(f, true);
+    dispatch(f);
 }
+
+const uint8_t *fake_hal_tx_data(const UART_HandleTypeDef *huart, size_t *len)
+{
+    fake_uart_t *f = uart_of(huart);
+    if (fake_hal_tx_busy(huart)) { /* what the stream was loaded with */
+        uint32_t n = D_COUNT(&f->tx_stream);
+        f->tx_len = (n <= sizeof f->tx) ? n : sizeof f->tx;
+        memcpy(f->tx, (const uint8_t *)D_MEM(&f->tx_stream), f->tx_len);
+    }
+    if (len != NULL) {
+        *len = f->tx_len;
+    }
+    return f->tx;
+}
+
+bool fake_hal_tx_busy(const UART_HandleTypeDef *huart)
+{
+    fake_uart_t *f = uart_of(huart);
+    return ((D_CTRL(&f->tx_stream) & D_EN) != 0u) && (D_COUNT(&f->tx_stream) != 0u) &&
+           ((f->usart.CR3 & USART_CR3_DMAT) != 0u);
+}
+
+bool fake_hal_tx_complete(UART_HandleTypeDef *huart) { return fake_hal_tx_complete_ex(huart, true); }
+
+bool fake_hal_tx_complete_ex(UART_HandleTypeDef *huart, bool then_idle)
+{
+    fake_uart_t *f = uart_of(huart);
+    J288_STUB_DMA_INSTANCE *s = &f->tx_stream;
+    const uint8_t *mem = (const uint8_t *)D_MEM(s);
+    uint32_t n;
+
+    sync(f);
+    if (!fake_hal_tx_busy(huart) || ((f->usart.CR1 & USART_CR1_TE) == 0u)) {
+        return false;
+    }
+    n = D_COUNT(s);
+    f->tx_len = (n <= sizeof f->tx) ? n : sizeof f->tx;
+    memcpy(f->tx, mem, f->tx_len);
+    for (uint32_t i = 0; i < n; i++) {
+        if (!f->deaf) {
+            (void)receive(f, mem[i], 0u); /* the single wire: the receiver hears it */
+            dispatch(f);
+        }
+    }
+    D_COUNT(s) = 0u;
+#if !defined(J288_STUB_G4)
+    D_CTRL(s) &= ~(uint32_t)D_EN; /* a stream stops at the end; a channel stays enabled */
+#endif
+    *flag_reg(f, false) |= (uint32_t)D_TC << flag_shift(f, false);
+    U_STATUS(&f->usart) |= U_TC;
+    dispatch(f);
+    if (then_idle) {
+        (void)fake_hal_line_idle(huart);
+    }
+    return true;
+}
+
+#if !defined(J288_STUB_G4)
+static fake_uart_t *uart_of_usart(const USART_TypeDef *u)
+{
+    for (size_t i = 0; i < FAKE_UARTS; i++) {
+        if (&uarts[i].usart == u) {
+            return &uarts[i];
+        }
+    }
+    return NULL;
+}
+
+void stub_usart_sr_clear(USART_TypeDef *u, uint32_t bits) { u->SR &= ~bits; }
+
+/* SR then DR: IDLE and the error flags go; a byte still waiting for the DMA goes with them. */
+uint32_t stub_usart_dr_read(USART_TypeDef *u)
+{
+    fake_uart_t *f = uart_of_usart(u);
+    if ((f != NULL) && ((u->SR & USART_SR_RXNE) != 0u)) {
+        f->stolen++;
+    }
+    u->SR &= ~(uint32_t)(USART_SR_RXNE | USART_SR_IDLE | U_ERRORS);
+    return u->DR;
+}
+#endif
 
 /* ---- timers ---------------------------------------------------------------------------- */
 
@@ -565,6 +695,16 @@ void __disable_irq(void)
     irq_disables++;
 }
 uint32_t fake_hal_primask(void) { return primask; }
+uint32_t __get_BASEPRI(void) { return basepri; }
+void __set_BASEPRI(uint32_t basePri) { basepri = basePri & 0xFFu; }
+void __set_BASEPRI_MAX(uint32_t basePri)
+{
+    basePri &= 0xFFu;
+    if ((basePri != 0u) && ((basepri == 0u) || (basePri < basepri))) {
+        basepri = basePri;
+    }
+}
+uint32_t fake_hal_basepri(void) { return basepri; }
 unsigned fake_hal_irq_disables(void) { return irq_disables; }
 
 void SCB_CleanDCache_by_Addr(volatile void *addr, int32_t dsize)

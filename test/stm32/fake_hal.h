@@ -1,20 +1,24 @@
 /*
- * fake_hal.h - a host-side fake of the HAL slice in test/stm32/stub/: it records every
- * call the port makes and lets a test play the hardware, firing the HAL's callbacks in the
- * order the real HAL fires them:
- *   transmit:  HAL_UART_Transmit_DMA ... fake_hal_tx_complete() -> HAL_UART_TxCpltCallback
- *   receive:   HAL_UARTEx_ReceiveToIdle_DMA ... fake_hal_rx_bytes() (half-transfer and
- *              buffer-full events fire on their own as the buffer fills, with the fill level)
- *              ... fake_hal_rx_idle() -> HAL_UARTEx_RxEventCallback(fill level), reception ends
- *   error:     fake_hal_rx_error() -> reception aborted, ErrorCode set, HAL_UART_ErrorCallback
- *   timer:     fake_hal_tim_fire() -> HAL_TIM_OC_DelayElapsedCallback when the CC interrupt
- *              is enabled; fake_hal_tim_run() runs the counter with compare matches, and
- *              fake_hal_tim_advance_at() lets it run between any two register accesses
- *   DMA:       a stream whose handle is not READY does not start, and (as the F4 HAL does)
- *              the UART call still returns HAL_OK
- * The test defines the weak callbacks itself (as an application does) and forwards them to
- * the port. Bytes sent while the receiver is off (TX direction, or no reception armed) are
- * lost, as on the wire.
+ * fake_hal.h - a host-side model of what the STM32 port touches: the USART and DMA registers
+ * of the F4 (the default) or of the G4 (-DJ288_STUB_G4), played as the silicon plays them,
+ * plus the HAL slice (GPIO, CRC unit, timer macros) that the port still calls. The test plays
+ * the rest of the hardware:
+ *   transmit:  the port loads the TX stream and enables the UART's transmit complete; the
+ *              test ends it with fake_hal_tx_complete(): the frame goes out, the line hears
+ *              it back (the echo, unless the line is deaf), TC rises
+ *   receive:   fake_hal_rx_bytes() puts bytes on the line: each one the receiver takes (when
+ *              on) goes through the data register to the RX stream, which raises its half
+ *              and complete flags; fake_hal_line_idle() raises IDLE after received bytes;
+ *              fake_hal_rx_flagged() a byte with a noise, framing, parity flag or an overrun
+ *   interrupts: the NVIC: after each step, the UART's and the RX stream's pending enabled
+ *              flags call the application's handlers (fake_app_uart_irq,
+ *              fake_app_dma_rx_irq, defined by the test), until none is pending; held
+ *              (fake_hal_irq_hold) they wait for fake_hal_irq_service()
+ *   timer:     fake_hal_tim_fire() / fake_hal_tim_run() / fake_hal_tim_advance_at()
+ * F4 specifics modelled: SR's rc_w0 write, IDLE and the error flags cleared by SR then DR
+ * (a DR read also takes a byte still waiting for the DMA: it is lost), the stream's enable
+ * bit clearing at the end of a normal transfer. G4: ICR clears, a flagged byte not handed to
+ * the DMA (DDRE = 0), the channel's enable bit staying set.
  */
 #ifndef J288_FAKE_HAL_H
 #define J288_FAKE_HAL_H
@@ -26,14 +30,7 @@
 #include "stm32_hal_stub.h"
 
 typedef enum {
-    FAKE_HALFDUPLEX_TX = 0,
-    FAKE_HALFDUPLEX_RX,
-    FAKE_TRANSMIT_DMA,
-    FAKE_RECEIVE_TO_IDLE_DMA,
-    FAKE_ABORT_RECEIVE,
-    FAKE_ABORT_TRANSMIT,
-    FAKE_DMA_ABORT,
-    FAKE_GPIO_WRITE,
+    FAKE_GPIO_WRITE = 0,
     FAKE_CRC_CALCULATE,
     FAKE_CRC_ACCUMULATE,
     FAKE_CACHE_CLEAN,
@@ -43,13 +40,13 @@ typedef enum {
 
 typedef struct {
     fake_hal_fn_t fn;
-    const void *handle; /* huart, GPIO port, hcrc or buffer address */
-    uint32_t arg;       /* size, pin state, word count */
+    const void *handle; /* GPIO port, hcrc or buffer address */
+    uint32_t arg;       /* pin state, word count, size */
 } fake_hal_call_t;
 
 #define FAKE_HAL_LOG_SIZE 256u
 
-/* Forget everything (log, counters, armed transfers, failure injections). */
+/* Forget everything (log, counters, UART models, timer hooks). */
 void fake_hal_reset(void);
 
 /* The call log since the last reset or clear. */
@@ -60,38 +57,54 @@ void fake_hal_log_clear(void);
 long fake_hal_log_find(fake_hal_fn_t fn, const void *handle, size_t from);
 unsigned fake_hal_count(fake_hal_fn_t fn);
 
-/* Make the next call of fn (TRANSMIT_DMA, RECEIVE_TO_IDLE_DMA, HALFDUPLEX_*, ABORT_*) return
- * HAL_ERROR. */
-void fake_hal_fail_next(fake_hal_fn_t fn);
+/* The application's IRQ handlers for huart's UART and RX stream (the test defines them). */
+void fake_app_uart_irq(UART_HandleTypeDef *huart);
+void fake_app_dma_rx_irq(UART_HandleTypeDef *huart);
 
-/* The last frame handed to HAL_UART_Transmit_DMA on huart (copied at the call), and whether
- * a transmit is in flight. */
+/* Give huart a UART and two DMA streams (channels on the G4) as HAL_HalfDuplex_Init and
+ * HAL_DMA_Init leave them: UART on in half-duplex mode, handles linked, flag addresses set. */
+void fake_hal_uart_setup(UART_HandleTypeDef *huart);
+
+/* The line does not hear our transmit (a transceiver with /RE tied to DE). */
+void fake_hal_line_deaf(UART_HandleTypeDef *huart, bool deaf);
+
+/* The last frame transmitted on huart, and whether a transmit is loaded and not finished. */
 const uint8_t *fake_hal_tx_data(const UART_HandleTypeDef *huart, size_t *len);
 bool fake_hal_tx_busy(const UART_HandleTypeDef *huart);
-
-/* The transmit finished: TxCpltCallback. Returns false if none was in flight. */
+/* The TX stream sends what it was loaded with (the line hears it back unless deaf); TC rises;
+ * then the line idles (then_idle), or the reply follows at once (false). false if nothing was
+ * loaded. fake_hal_tx_complete: then_idle. */
 bool fake_hal_tx_complete(UART_HandleTypeDef *huart);
+bool fake_hal_tx_complete_ex(UART_HandleTypeDef *huart, bool then_idle);
 
-/* Bytes arrive on huart's pin. Stored only while a reception is armed and the receiver is
- * enabled; fires the half-transfer event at half the buffer and ends the reception when full.
- * Returns how many bytes were stored. */
+/* Bytes on the line; returns how many the receiver took into the data register. */
 size_t fake_hal_rx_bytes(UART_HandleTypeDef *huart, const uint8_t *data, size_t len);
+/* One byte with line flags: FAKE_NOISE (right value, noise seen), FAKE_FRAMING (no stop
+ * bit), FAKE_PARITY, or FAKE_OVERRUN (the byte is lost behind a full data register). */
+#define FAKE_NOISE 0x1u
+#define FAKE_FRAMING 0x2u
+#define FAKE_PARITY 0x4u
+#define FAKE_OVERRUN 0x8u
+bool fake_hal_rx_flagged(UART_HandleTypeDef *huart, uint8_t byte, unsigned flags);
+/* The line idles for a frame: IDLE rises if bytes came since the last idle. */
+bool fake_hal_line_idle(UART_HandleTypeDef *huart);
+/* The RX stream lags (true): a received byte waits in the data register (RXNE) through the
+ * interrupt handlers taken meanwhile, and is taken after them or before the next byte. */
+void fake_hal_dma_lag(UART_HandleTypeDef *huart, bool lag);
+/* Received bytes lost to a DR read of the CPU while they waited for the DMA. */
+unsigned fake_hal_bytes_stolen(const UART_HandleTypeDef *huart);
 
-/* Receive streams in circular mode (true) from now on: a full buffer wraps with an RxEvent of
- * the full size and an idle line reports the position; the reception never ends by itself. */
-void fake_hal_rx_circular(bool on);
-
-/* The line went idle: if the armed reception holds bytes, it ends with an RxEvent (circular:
- * it reports the position and goes on). */
-bool fake_hal_rx_idle(UART_HandleTypeDef *huart);
-
-/* A receive error (HAL_UART_ERROR_* bits) in DMA mode: the HAL aborts the reception, then
- * calls the error callback. */
-void fake_hal_rx_error(UART_HandleTypeDef *huart, uint32_t error_code);
-
-bool fake_hal_rx_armed(const UART_HandleTypeDef *huart);
-bool fake_hal_receiver_on(const UART_HandleTypeDef *huart);
-bool fake_hal_transmitter_on(const UART_HandleTypeDef *huart);
+/* Interrupts held (true): pending ones wait; fake_hal_irq_service() runs the UART's handler
+ * (uart = true) or the RX stream's, if its interrupt is pending, and says whether it was. */
+void fake_hal_irq_hold(bool hold);
+bool fake_hal_irq_service(UART_HandleTypeDef *huart, bool uart);
+bool fake_hal_irq_pending(UART_HandleTypeDef *huart, bool uart);
+/* A transfer error on the RX stream: the stream stops, TEIF rises. */
+void fake_hal_dma_rx_error(UART_HandleTypeDef *huart);
+/* The registers (for tests that look at them). */
+USART_TypeDef *fake_hal_usart(const UART_HandleTypeDef *huart);
+J288_STUB_DMA_INSTANCE *fake_hal_rx_stream(const UART_HandleTypeDef *huart);
+J288_STUB_DMA_INSTANCE *fake_hal_tx_stream(const UART_HandleTypeDef *huart);
 
 /* Capture/compare channel ch (TIM_CHANNEL_n) matched: fires the OC callback if its interrupt
  * is enabled. Returns whether it fired. */
@@ -115,8 +128,9 @@ void fake_hal_crc_unclocked(bool off);
 /* Level last written to a GPIO pin (0/1), or -1 if never written. */
 int fake_hal_gpio_level(const GPIO_TypeDef *port, uint16_t pin);
 
-/* Interrupt mask state: current PRIMASK and how often interrupts were disabled. */
+/* Interrupt mask state: current PRIMASK and how often interrupts were disabled; BASEPRI. */
 uint32_t fake_hal_primask(void);
 unsigned fake_hal_irq_disables(void);
+uint32_t fake_hal_basepri(void);
 
 #endif /* J288_FAKE_HAL_H */

@@ -449,7 +449,7 @@ static void test_estop_while_sweeping(void)
     uint8_t i;
     memset(&stop, 0, sizeof stop);
     stop.id = 15u;
-    stop.watchdog = true;
+    stop.watchdog = false; /* the stop clears a trip: watchdog bit 0 */
     setup_all(true, true, 0u);
     add_servos(ids, 4u);
     for (i = 0u; i < 4u; i++) {
@@ -544,7 +544,7 @@ static void test_estop_from_an_event_callback(void)
     j288_cmd_raw_t stop;
     memset(&stop, 0, sizeof stop);
     stop.id = 15u;
-    stop.watchdog = true;
+    stop.watchdog = false;
     setup_all(true, true, 0u);
     sch.cfg.on_event = estop_on_fault;
     add_servos(ids, 3u);
@@ -569,7 +569,7 @@ static void test_estop_from_on_sweep_ends_continuous_sweeps(void)
     j288_cmd_raw_t stop;
     memset(&stop, 0, sizeof stop);
     stop.id = 15u;
-    stop.watchdog = true;
+    stop.watchdog = false;
     setup_all(true, true, 0u);
     add_servos(ids, 3u);
     estop_on_sweep = true;

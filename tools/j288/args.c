@@ -1,13 +1,10 @@
 /* Strict command-line parsing; see args.h. */
 #include "args.h"
 
-#include <ctype.h>
-#include <errno.h>
-#include <math.h>
-#include <stdlib.h>
 #include <string.h>
 
 #include "cli.h"
+#include "j288_number.h"
 
 void cli_args_init(cli_args_t *a, int argc, char **argv)
 {
@@ -79,29 +76,14 @@ int cli_args_next(cli_args_t *a, const cli_opt_t *opts, const char **value)
 
 int cli_parse_int(const char *opt, const char *text, long long lo, long long hi, long long *out)
 {
-    const char *digits = text;
-    char *end = NULL;
     long long v;
-    int base = 10;
+    j288_number_result_t rc = j288_number_int(text, &v);
 
-    if (*digits == '+' || *digits == '-') {
-        digits++;
-    }
-    if (digits[0] == '0' && (digits[1] == 'x' || digits[1] == 'X')) {
-        base = 16;
-    }
-    /* strtoll skips leading spaces and takes a second sign: refuse both. */
-    if (!isxdigit((unsigned char)digits[0])) {
+    if (rc == J288_NUMBER_SYNTAX) {
         cli_error("%s: '%s' is not a whole number", opt, text);
         return -1;
     }
-    errno = 0;
-    v = strtoll(text, &end, base);
-    if (end == text || *end != '\0') {
-        cli_error("%s: '%s' is not a whole number", opt, text);
-        return -1;
-    }
-    if (errno == ERANGE || v < lo || v > hi) {
+    if (rc == J288_NUMBER_RANGE || v < lo || v > hi) {
         cli_error("%s: %s is out of range %lld..%lld", opt, text, lo, hi);
         return -1;
     }
@@ -111,32 +93,16 @@ int cli_parse_int(const char *opt, const char *text, long long lo, long long hi,
 
 int cli_parse_real(const char *opt, const char *text, double *out)
 {
-    char *end = NULL;
-    double v;
-    const char *p = text;
+    j288_number_result_t rc = j288_number_real(text, out);
 
-    if (*p == '+' || *p == '-') {
-        p++;
-    }
-    if (!(isdigit((unsigned char)*p) || (*p == '.' && isdigit((unsigned char)p[1])))) {
+    if (rc == J288_NUMBER_SYNTAX) {
         cli_error("%s: '%s' is not a number", opt, text);
         return -1;
     }
-    errno = 0;
-    v = strtod(text, &end);
-    if (end == text || *end != '\0') {
-        cli_error("%s: '%s' is not a number", opt, text);
-        return -1;
-    }
-    if (errno == ERANGE && (v > 1.0 || v < -1.0)) {
+    if (rc == J288_NUMBER_RANGE) {
         cli_error("%s: %s is out of range", opt, text);
         return -1;
     }
-    if (!isfinite(v)) {
-        cli_error("%s: '%s' is not a finite number", opt, text);
-        return -1;
-    }
-    *out = v;
     return 0;
 }
 

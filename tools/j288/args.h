@@ -43,10 +43,12 @@ void cli_args_init(cli_args_t *a, int argc, char **argv);
  */
 int cli_args_next(cli_args_t *a, const cli_opt_t *opts, const char **value);
 
-/* Whole number in [lo, hi]; decimal or 0x-prefixed hexadecimal, optional sign. */
+/* Whole number in [lo, hi]: j288_number_int()'s syntax (host/j288_number.h, the robot config
+ * file's too): decimal or 0x-prefixed hexadecimal, optional sign. */
 int cli_parse_int(const char *opt, const char *text, long long lo, long long hi, long long *out);
 
-/* Finite real number (strtod syntax, no trailing characters). */
+/* Finite real number: j288_number_real()'s decimal syntax (host/j288_number.h, the robot
+ * config file's too): "1.5", "-.5", "2e-3"; not "0x1p1", "inf" or "nan". */
 int cli_parse_real(const char *opt, const char *text, double *out);
 
 /* Finite real number in [lo, hi] ("OPT: TEXT is out of range LO..HI" otherwise). */

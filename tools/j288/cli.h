@@ -65,6 +65,7 @@ int cli_cmd_log(int argc, char **argv, const cli_global_t *g);
 int cli_cmd_plot(int argc, char **argv, const cli_global_t *g);
 int cli_cmd_zero(int argc, char **argv, const cli_global_t *g);
 int cli_cmd_calibrate(int argc, char **argv, const cli_global_t *g);
+int cli_cmd_top(int argc, char **argv, const cli_global_t *g);
 /* log, status, hold, stop over every bus of a robot config (cmd_robot.c): taken instead of
  * the one-servo command when cli_robot_takes() says so (a --config, no --id or --joint). */
 int cli_cmd_robot(int argc, char **argv, const cli_global_t *g);

@@ -77,6 +77,22 @@ static int write_back(const cli_joint_sel_t *sel, const j288_robot_config_update
     return 0;
 }
 
+/* Before any motion: a value that could not be written back would be a motion for nothing
+ * (a read-only config, a folder that cannot take the temporary file). 0, or -1 after an
+ * error line. */
+static int check_write_back(const cli_joint_sel_t *sel)
+{
+    char err[J288_ROBOT_CONFIG_ERROR_MAX];
+    if (sel->rj == NULL || g_robot.path == NULL) {
+        return 0;
+    }
+    if (j288_robot_config_check_writable(g_robot.path, err, sizeof err) != 0) {
+        cli_error("%s; nothing was sent", err);
+        return -1;
+    }
+    return 0;
+}
+
 /* ---- zero ----------------------------------------------------------------------------------- */
 
 static const char zero_help[] =
@@ -117,6 +133,9 @@ int cli_cmd_zero(int argc, char **argv, const cli_global_t *g)
         cli_joint_select(&g_robot, a.joint, a.id, &o, &sel) != 0 ||
         j288_joint_init(&joint, &sel.jc) != J288_OK) {
         return CLI_EXIT_USAGE;
+    }
+    if (check_write_back(&sel) != 0) {
+        return CLI_EXIT_FAIL;
     }
     cli_signals_install();
     if ((ec = cli_bus_open(&b, &o, 2)) != CLI_EXIT_OK) {
@@ -463,6 +482,9 @@ int cli_cmd_calibrate(int argc, char **argv, const cli_global_t *g)
     if (cli_robot_load(&g_robot, o.config) != 0 ||
         cli_joint_select(&g_robot, a.joint, a.id, &o, &sel) != 0) {
         return CLI_EXIT_USAGE;
+    }
+    if (check_write_back(&sel) != 0) {
+        return CLI_EXIT_FAIL;
     }
     /* The motion runs uncalibrated: an old phase that no longer fits must not stop it. The
      * fit labels the turns as this configuration does, which is what the phase goes with. */

@@ -1,7 +1,7 @@
 /*
  * j288 - the command-line tool: an offline frame calculator (encode, decode) and, with
- * --port, a bus master for J288/S288 servos (scan, status, hold, move, torque, stop, log),
- * plus plot for the CSV that log writes.
+ * --port, a bus master for J288/S288 servos (scan, status, hold, move, torque, stop, log,
+ * top), plus plot for the CSV that log writes.
  */
 #include <stdio.h>
 #include <stdlib.h>
@@ -31,6 +31,7 @@ static const command_t commands[] = {
     {"plot", cli_cmd_plot, "plot a log CSV to PNG with gnuplot"},
     {"zero", cli_cmd_zero, "make a joint's current pose its zero (written to --config)"},
     {"calibrate", cli_cmd_calibrate, "fit a joint's rotor phase (written to --config)"},
+    {"top", cli_cmd_top, "live view of every joint and the bus counters (q quits)"},
     {NULL, NULL, NULL}};
 
 static void usage(FILE *f)

@@ -80,7 +80,7 @@ void HAL_UART_MspInit(UART_HandleTypeDef *huart)
     dma_stream_init(&hdma_usart1_rx, DMA2_Stream2, DMA_PERIPH_TO_MEMORY, DMA_CIRCULAR);
     __HAL_LINKDMA(huart, hdmarx, hdma_usart1_rx);
 
-    board_bus_irqs_enable(DMA2_Stream7_IRQn, DMA2_Stream2_IRQn);
+    board_bus_irqs_enable(DMA2_Stream2_IRQn);
 }
 
 /* ---- peripherals ------------------------------------------------------------------------ */
@@ -134,5 +134,4 @@ void board_init(void)
 /* ---- interrupt handlers (the names of ST's startup_stm32f446xx.s vector table; USART1's and
  * TIM2's are in board_common.c, SysTick's and HardFault's in nucleo_common/board_nucleo.c) - */
 
-void DMA2_Stream7_IRQHandler(void) { HAL_DMA_IRQHandler(&hdma_usart1_tx); }
-void DMA2_Stream2_IRQHandler(void) { HAL_DMA_IRQHandler(&hdma_usart1_rx); }
+void DMA2_Stream2_IRQHandler(void) { board_bus_dma_rx_irq(); } /* TX stream: no interrupt */

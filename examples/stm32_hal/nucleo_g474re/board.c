@@ -88,7 +88,7 @@ void HAL_UART_MspInit(UART_HandleTypeDef *huart)
                      DMA_CIRCULAR);
     __HAL_LINKDMA(huart, hdmarx, hdma_usart1_rx);
 
-    board_bus_irqs_enable(DMA1_Channel1_IRQn, DMA1_Channel2_IRQn);
+    board_bus_irqs_enable(DMA1_Channel2_IRQn);
 }
 
 /* ---- peripherals ------------------------------------------------------------------------ */
@@ -144,5 +144,4 @@ void board_init(void)
 /* ---- interrupt handlers (the names of ST's startup_stm32g474xx.s vector table; USART1's and
  * TIM2's are in board_common.c, SysTick's and HardFault's in nucleo_common/board_nucleo.c) - */
 
-void DMA1_Channel1_IRQHandler(void) { HAL_DMA_IRQHandler(&hdma_usart1_tx); }
-void DMA1_Channel2_IRQHandler(void) { HAL_DMA_IRQHandler(&hdma_usart1_rx); }
+void DMA1_Channel2_IRQHandler(void) { board_bus_dma_rx_irq(); } /* TX channel: no interrupt */

@@ -123,3 +123,20 @@ void SCB_InvalidateDCache_by_Addr(volatile void *addr, int32_t dsize)
     (void)dsize;
 }
 #endif
+
+/* BASEPRI on a bare variable: the link check does not run. */
+static uint32_t stub_basepri;
+uint32_t __get_BASEPRI(void) { return stub_basepri; }
+void __set_BASEPRI(uint32_t basePri) { stub_basepri = basePri; }
+void __set_BASEPRI_MAX(uint32_t basePri)
+{
+    if ((basePri != 0u) && ((stub_basepri == 0u) || (basePri < stub_basepri))) {
+        stub_basepri = basePri;
+    }
+}
+
+#if !defined(J288_STUB_G4)
+/* The F4's SR (rc_w0) and DR accesses, plain. */
+void stub_usart_sr_clear(USART_TypeDef *u, uint32_t bits) { u->SR = ~bits; }
+uint32_t stub_usart_dr_read(USART_TypeDef *u) { return u->DR; }
+#endif

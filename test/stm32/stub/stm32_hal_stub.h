@@ -26,6 +26,7 @@ typedef enum { HAL_OK = 0x00u, HAL_ERROR = 0x01u, HAL_BUSY = 0x02u, HAL_TIMEOUT 
 
 /* ---- GPIO ------------------------------------------------------------------------------ */
 typedef struct {
+    volatile uint32_t OTYPER;
     volatile uint32_t ODR;
     volatile uint32_t BSRR;
 } GPIO_TypeDef;
@@ -35,11 +36,129 @@ typedef enum { GPIO_PIN_RESET = 0u, GPIO_PIN_SET } GPIO_PinState;
 void HAL_GPIO_WritePin(GPIO_TypeDef *GPIOx, uint16_t GPIO_Pin, GPIO_PinState PinState);
 GPIO_PinState HAL_GPIO_ReadPin(GPIO_TypeDef *GPIOx, uint16_t GPIO_Pin);
 
-/* ---- DMA ------------------------------------------------------------------------------- */
+/* ---- DMA and USART registers: two families -------------------------------------------- */
+/* The port drives each transaction through the registers. Two register models cover ST's
+ * families: the F4's (USART SR/DR, DMA streams with NDTR and flags in LISR/HISR), the default,
+ * and the G4's (USART ISR/ICR/RDR/TDR, DMA channels with CNDTR and flags in ISR/IFCR), with
+ * -DJ288_STUB_G4. Bit values are the silicon's (RM0390, RM0440); the layouts are not. */
+/* Address registers hold a host pointer here (they are 32 bits on the silicon). */
+#define J288_STM32_DMA_ADDR(a) ((uintptr_t)(a))
+#if defined(J288_STUB_G4)
+#define STM32G4
+typedef struct {
+    volatile uint32_t CCR;
+    volatile uint32_t CNDTR;
+    volatile uintptr_t CPAR;
+    volatile uintptr_t CMAR;
+} DMA_Channel_TypeDef;
+typedef struct {
+    volatile uint32_t ISR;
+    volatile uint32_t IFCR;
+} DMA_TypeDef;
+#define DMA_CCR_EN 0x00000001u
+#define DMA_CCR_TCIE 0x00000002u
+#define DMA_CCR_HTIE 0x00000004u
+#define DMA_CCR_TEIE 0x00000008u
+#define DMA_CCR_CIRC 0x00000020u
+#define DMA_ISR_GIF1 0x00000001u
+#define DMA_ISR_TCIF1 0x00000002u
+#define DMA_ISR_HTIF1 0x00000004u
+#define DMA_ISR_TEIF1 0x00000008u
+#define J288_STUB_DMA_INSTANCE DMA_Channel_TypeDef
+
+typedef struct {
+    volatile uint32_t CR1;
+    volatile uint32_t CR2;
+    volatile uint32_t CR3;
+    volatile uint32_t BRR;
+    volatile uint32_t ISR;
+    volatile uint32_t ICR;
+    volatile uint32_t RDR;
+    volatile uint32_t TDR;
+} USART_TypeDef;
+#define USART_ISR_PE 0x00000001u
+#define USART_ISR_FE 0x00000002u
+#define USART_ISR_NE 0x00000004u
+#define USART_ISR_ORE 0x00000008u
+#define USART_ISR_IDLE 0x00000010u
+#define USART_ISR_RXNE_RXFNE 0x00000020u
+#define USART_ISR_TC 0x00000040u
+#define USART_ICR_PECF 0x00000001u
+#define USART_ICR_FECF 0x00000002u
+#define USART_ICR_NECF 0x00000004u
+#define USART_ICR_ORECF 0x00000008u
+#define USART_ICR_IDLECF 0x00000010u
+#define USART_ICR_TCCF 0x00000040u
+#define USART_CR1_UE 0x00000001u
+#define USART_CR3_OVRDIS 0x00001000u
+#define USART_CR3_DDRE 0x00002000u
+#else
+/* -DJ288_STUB_H7: the same registers under the H7's name (its DMA1/2 are streams as the F4's),
+ * for what the port decides by family rather than by register model (reachable RAM). */
+#if defined(J288_STUB_H7)
+#define STM32H7
+#else
+#define STM32F4
+#endif
 typedef struct {
     volatile uint32_t CR;
     volatile uint32_t NDTR;
+    volatile uintptr_t PAR;
+    volatile uintptr_t M0AR;
 } DMA_Stream_TypeDef;
+typedef struct {
+    volatile uint32_t LISR;
+    volatile uint32_t HISR;
+    volatile uint32_t LIFCR;
+    volatile uint32_t HIFCR;
+} DMA_TypeDef;
+#define DMA_SxCR_EN 0x00000001u
+#define DMA_SxCR_DMEIE 0x00000002u
+#define DMA_SxCR_TEIE 0x00000004u
+#define DMA_SxCR_HTIE 0x00000008u
+#define DMA_SxCR_TCIE 0x00000010u
+#define DMA_SxCR_CIRC 0x00000100u
+/* Stream 0's flags in LISR; the HAL's StreamIndex shifts them to the stream's. */
+#define DMA_LISR_FEIF0 0x00000001u
+#define DMA_LISR_DMEIF0 0x00000004u
+#define DMA_LISR_TEIF0 0x00000008u
+#define DMA_LISR_HTIF0 0x00000010u
+#define DMA_LISR_TCIF0 0x00000020u
+#define J288_STUB_DMA_INSTANCE DMA_Stream_TypeDef
+
+typedef struct {
+    volatile uint32_t SR;
+    volatile uint32_t DR;
+    volatile uint32_t BRR;
+    volatile uint32_t CR1;
+    volatile uint32_t CR2;
+    volatile uint32_t CR3;
+} USART_TypeDef;
+#define USART_SR_PE 0x00000001u
+#define USART_SR_FE 0x00000002u
+#define USART_SR_NE 0x00000004u
+#define USART_SR_ORE 0x00000008u
+#define USART_SR_IDLE 0x00000010u
+#define USART_SR_RXNE 0x00000020u
+#define USART_SR_TC 0x00000040u
+#define USART_CR1_UE 0x00002000u
+/* The fake HAL sees the two accesses whose side effects the F4 defines: SR's rc_w0 write,
+ * and the DR read that ends the SR-then-DR sequence clearing IDLE, NE, FE and ORE. */
+void stub_usart_sr_clear(USART_TypeDef *u, uint32_t bits);
+uint32_t stub_usart_dr_read(USART_TypeDef *u);
+#define J288_STM32_SR_CLEAR(u, bits) stub_usart_sr_clear((u), (bits))
+#define J288_STM32_DR_READ(u) stub_usart_dr_read(u)
+#endif
+#define USART_CR1_RE 0x00000004u
+#define USART_CR1_TE 0x00000008u
+#define USART_CR1_IDLEIE 0x00000010u
+#define USART_CR1_TCIE 0x00000040u
+#define USART_CR1_PEIE 0x00000100u
+#define USART_CR3_EIE 0x00000001u
+#define USART_CR3_HDSEL 0x00000008u
+#define USART_CR3_DMAR 0x00000040u
+#define USART_CR3_DMAT 0x00000080u
+#define USART_CR3_ONEBIT 0x00000800u
 
 typedef enum {
     HAL_DMA_STATE_RESET = 0x00u,
@@ -50,10 +169,26 @@ typedef enum {
     HAL_DMA_STATE_ABORT = 0x05u
 } HAL_DMA_StateTypeDef;
 
+#define DMA_NORMAL 0x00000000u
+#define DMA_CIRCULAR 0x00000100u
+typedef struct {
+    uint32_t Mode;
+} DMA_InitTypeDef;
+
+/* The fields HAL_DMA_Init fills in that the port reads: where the stream's or channel's
+ * flags live. */
 typedef struct __DMA_HandleTypeDef {
-    DMA_Stream_TypeDef *Instance;
+    J288_STUB_DMA_INSTANCE *Instance;
+    DMA_InitTypeDef Init;
     void *Parent;
     volatile HAL_DMA_StateTypeDef State;
+#if defined(J288_STUB_G4)
+    DMA_TypeDef *DmaBaseAddress;
+    uint32_t ChannelIndex;
+#else
+    uintptr_t StreamBaseAddress;
+    uint32_t StreamIndex;
+#endif
 } DMA_HandleTypeDef;
 
 void HAL_DMA_IRQHandler(DMA_HandleTypeDef *hdma);
@@ -61,15 +196,6 @@ HAL_DMA_StateTypeDef HAL_DMA_GetState(DMA_HandleTypeDef *hdma);
 HAL_StatusTypeDef HAL_DMA_Abort(DMA_HandleTypeDef *hdma);
 
 /* ---- UART ------------------------------------------------------------------------------ */
-typedef struct {
-    volatile uint32_t SR;
-    volatile uint32_t DR;
-    volatile uint32_t BRR;
-    volatile uint32_t CR1;
-    volatile uint32_t CR2;
-    volatile uint32_t CR3;
-} USART_TypeDef;
-
 typedef struct {
     uint32_t BaudRate;
     uint32_t WordLength;
@@ -88,14 +214,6 @@ typedef uint32_t HAL_UART_StateTypeDef;
 #define HAL_UART_STATE_BUSY_TX 0x21u
 #define HAL_UART_STATE_BUSY_RX 0x22u
 #define HAL_UART_STATE_ERROR 0xE0u
-
-/* UART ErrorCode bits. */
-#define HAL_UART_ERROR_NONE 0x00000000u
-#define HAL_UART_ERROR_PE 0x00000001u
-#define HAL_UART_ERROR_NE 0x00000002u
-#define HAL_UART_ERROR_FE 0x00000004u
-#define HAL_UART_ERROR_ORE 0x00000008u
-#define HAL_UART_ERROR_DMA 0x00000010u
 
 typedef struct __UART_HandleTypeDef {
     USART_TypeDef *Instance;
@@ -298,6 +416,14 @@ uint32_t HAL_GetTick(void);
 uint32_t __get_PRIMASK(void);
 void __set_PRIMASK(uint32_t priMask);
 void __disable_irq(void);
+/* BASEPRI (ARMv7-M and later): the lowest-urgency priority still taken, 0 = none masked;
+ * __set_BASEPRI_MAX only ever raises the mask. Priorities sit in the top __NVIC_PRIO_BITS. */
+#ifndef __NVIC_PRIO_BITS
+#define __NVIC_PRIO_BITS 4U
+#endif
+uint32_t __get_BASEPRI(void);
+void __set_BASEPRI(uint32_t basePri);
+void __set_BASEPRI_MAX(uint32_t basePri);
 /* Cache maintenance exists only on a core with a data cache (CMSIS: the device header sets
  * __DCACHE_PRESENT, core_cm7.h declares the functions). The stub models such a core unless
  * told otherwise with -D__DCACHE_PRESENT=0U, which models a Cortex-M4. */

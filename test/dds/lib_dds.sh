@@ -1,0 +1,147 @@
+# Helpers for the DDS test scripts (sourced): keep every packet on this machine. dds_netns
+# re-runs the calling script inside a private network namespace (`unshare -rn`: a user and a
+# network namespace, no privilege needed, only a loopback interface, brought up here), and
+# points Cyclone DDS at a loopback-only configuration as well, on a test-specific domain id
+# (DDS_DOMAIN). Without unshare (or user namespaces), the script is skipped with a notice;
+# with CI=true that is a failure.
+# shellcheck shell=bash
+
+DDS_DOMAIN=${DDS_DOMAIN:-87}
+
+# dds_netns "$0" "$@": call first thing; returns inside the namespace.
+dds_netns() {
+    if [ "${J288_DDS_NETNS:-}" != 1 ]; then
+        if ! unshare -rn true 2>/dev/null; then
+            if [ "${CI:-}" = true ]; then
+                echo "error: unshare -rn fails here (CI=true: a failure): user namespaces needed" >&2
+                exit 1
+            fi
+            echo "notice: skipping $1: unshare -rn (user namespaces) not available" >&2
+            exit 0
+        fi
+        J288_DDS_NETNS=1 exec unshare -rn bash "$@"
+    fi
+    # multicast on lo: the namespace is ours alone, and Cyclone's discovery then runs as usual
+    ip link set lo up multicast on 2>/dev/null || { echo "cannot bring lo up in the namespace"; exit 1; }
+    export CYCLONEDDS_URI='<CycloneDDS><Domain><General><Interfaces><NetworkInterface name="lo"/></Interfaces></General></Domain></CycloneDDS>'
+    export DDS_DOMAIN
+}
+
+# ---- the bridge against simulators ----
+
+# dds_e2e_setup: after dds_netns, for the end-to-end scripts: BUILD, BIN, the e2e and
+# simulator helpers (test/e2e/lib_e2e.sh, lib_sim.sh; SIM_DIR is E2E_TMP), PEER and DDS, and
+# the traps (every process stopped, a frozen simulator resumed first, at exit).
+dds_e2e_setup() {
+    BUILD=${BUILD:-build}
+    BIN=${BIN:-$BUILD/bin}
+    . test/e2e/lib_e2e.sh
+    SIM_DIR=$E2E_TMP
+    . test/e2e/lib_sim.sh
+    PEER=$BUILD/test/dds_peer
+    PEER_ARGS=()
+    DDS=$BIN/j288-dds
+    trap 'kill -CONT "${SIM_PID_1:-}" 2>/dev/null; sim_cleanup TERM' EXIT
+    trap 'exit 130' INT TERM
+    need_built "$DDS" "$PEER" "$SIM"
+}
+
+# near A B TOL: |A - B| <= TOL, angles compared modulo 2 pi.
+near() {
+    awk -v a="$1" -v b="$2" -v t="$3" 'BEGIN { p = 6.283185307179586; d = a - b; d -= p * int(d / p)
+        if (d < 0) d += p; if (d > p / 2) d = p - d; exit !(d <= t) }'
+}
+
+# truth K ID: servo ID's true output angle on simulator K (asks for it with SIGWINCH and waits
+# until the truth file is rewritten).
+truth() {
+    local f=$SIM_DIR/truth.$1 seq pid i
+    eval "pid=\$SIM_PID_$1"
+    seq=$(sed -n '1s/.*seq=\([0-9]*\).*/\1/p' "$f" 2>/dev/null)
+    kill -s WINCH "$pid"
+    for i in $(seq 1 400); do
+        [ "$(sed -n '1s/.*seq=\([0-9]*\).*/\1/p' "$f" 2>/dev/null)" != "$seq" ] && break
+        sleep 0.02
+    done
+    awk -v id="$2" '$1 == "id=" id { sub("theta=", "", $2); print $2 }' "$f"
+}
+
+# start_bridge OPTIONS...: j288-dds on $SIM_DIR/robot.yaml (stderr in $SIM_DIR/bridge.err), once
+# it publishes known angles (diagnostics in unitree mode: LowState_ cannot say) (up to 30 s; the peer reads with PEER_ARGS, e.g. --ns NS); sets
+# BRIDGE_PID. A bridge still running from a failed check is stopped first.
+start_bridge() {
+    [ -n "${BRIDGE_PID:-}" ] && kill -0 "$BRIDGE_PID" 2>/dev/null && stop_bridge
+    "$DDS" --config "$SIM_DIR/robot.yaml" --domain "$DDS_DOMAIN" "$@" 2>"$SIM_DIR/bridge.err" &
+    BRIDGE_PID=$!
+    BG_PIDS+=("$BRIDGE_PID")
+    local i
+    for i in $(seq 1 30); do
+        if [ "${UNITREE:-0}" = 1 ]; then
+            "$PEER" "${PEER_ARGS[@]}" diag --timeout 2 >"$SIM_DIR/first" 2>/dev/null &&
+                grep -q 'angle_known=true' "$SIM_DIR/first" &&
+                ! grep -q 'angle_known=false' "$SIM_DIR/first" && return 0
+        else
+            "$PEER" "${PEER_ARGS[@]}" states --timeout 1 >"$SIM_DIR/first" 2>/dev/null &&
+                ! grep -q nan "$SIM_DIR/first" && return 0
+        fi
+        kill -0 "$BRIDGE_PID" 2>/dev/null || break
+    done
+    echo "the bridge did not publish: $(cat "$SIM_DIR/bridge.err")"
+    return 1
+}
+
+# stop_bridge: SIGINT, and its exit status (124: still running after 30 s).
+stop_bridge() {
+    kill -INT "$BRIDGE_PID" 2>/dev/null
+    wait_exit "$BRIDGE_PID" 30
+}
+
+# wait_err PATTERN [SECONDS]: the bridge's stderr matches the extended regex (up to 10 s).
+wait_err() {
+    local i
+    for i in $(seq 1 $((${2:-10} * 20))); do
+        grep -Eq "$1" "$SIM_DIR/bridge.err" && return 0
+        sleep 0.05
+    done
+    echo "not on the bridge's stderr: $1"; cat "$SIM_DIR/bridge.err"; return 1
+}
+
+# reported_once CAUSE: exactly one stderr line for that refusal cause.
+reported_once() {
+    local n
+    n=$(grep -c "command refused: $1" "$SIM_DIR/bridge.err")
+    [ "$n" -eq 1 ] || { echo "'$1' reported $n times"; return 1; }
+}
+
+# wait_truth K ID TARGET [SECONDS]: servo ID of simulator K reaches TARGET (0.01 rad) and
+# stays there (two readings 0.2 s apart).
+wait_truth() {
+    local i t near_before=0
+    for i in $(seq 1 $((${4:-20} * 5))); do
+        t=$(truth "$1" "$2")
+        if near "$t" "$3" 0.01; then
+            [ $near_before = 1 ] && return 0
+            near_before=1
+        else
+            near_before=0
+        fi
+        sleep 0.2
+    done
+    echo "servo $2 on simulator $1 at $t, not $3"; return 1
+}
+
+# still K ID: servo ID of simulator K does not move over half a second (0.005 rad).
+still() {
+    local a b
+    a=$(truth "$1" "$2"); sleep 0.5; b=$(truth "$1" "$2")
+    near "$a" "$b" 0.005 || { echo "servo $2 on simulator $1 moved: $a -> $b"; return 1; }
+}
+
+# locked_all K...: simulator K's log got the broadcast lock (id 15, status 0) with the
+# watchdog bit 0 (a locked servo needs no watchdog; the runner's policy).
+locked_all() {
+    local k
+    for k in "$@"; do
+        grep -q ' id=15 status=0 wd=0' "$SIM_DIR/log.$k" || { echo "no broadcast lock on bus $k"; return 1; }
+    done
+}

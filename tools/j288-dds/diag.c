@@ -1,0 +1,175 @@
+/* diag.c - rt/diagnostics: one DiagnosticStatus for the bridge, one per bus, one per joint
+ * (its servo), each with key/value pairs. Strings live in a fixed pool owned here. */
+#include <stdarg.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "bridge.h"
+
+#define DIAG_MAX_STATUS (1u + J288_ROBOT_MAX_BUSES + J288_ROBOT_MAX_JOINTS)
+#define DIAG_MAX_VALUES 24u
+#define DIAG_POOL (64u * 1024u)
+
+enum { LEVEL_OK = 0, LEVEL_WARN = 1, LEVEL_ERROR = 2, LEVEL_STALE = 3 };
+
+static struct {
+    diagnostic_msgs_msg_dds__DiagnosticStatus_ status[DIAG_MAX_STATUS];
+    diagnostic_msgs_msg_dds__KeyValue_ kv[DIAG_MAX_STATUS][DIAG_MAX_VALUES];
+    char pool[DIAG_POOL];
+    size_t used;
+} d;
+
+/* A formatted string in the pool ("" once the pool is full: a diagnostic is never worth a
+ * crash). */
+static char *str(const char *fmt, ...)
+{
+    va_list ap;
+    char *s = d.pool + d.used;
+    size_t room = DIAG_POOL - d.used;
+    int n;
+    if (room < 2u)
+        return d.pool + DIAG_POOL - 1u;
+    va_start(ap, fmt);
+    n = vsnprintf(s, room, fmt, ap);
+    va_end(ap);
+    if (n < 0 || (size_t)n >= room) {
+        s[0] = '\0';
+        return s;
+    }
+    d.used += (size_t)n + 1u;
+    return s;
+}
+
+static diagnostic_msgs_msg_dds__DiagnosticStatus_ *status(diagnostic_msgs_msg_dds__DiagnosticArray_ *m,
+                                                          uint8_t level, char *name, char *hw)
+{
+    uint32_t i = m->status._length++;
+    diagnostic_msgs_msg_dds__DiagnosticStatus_ *s = &d.status[i];
+    memset(s, 0, sizeof *s);
+    s->level = level;
+    s->name = name;
+    s->hardware_id = hw;
+    s->message = str("");
+    s->values._buffer = d.kv[i];
+    return s;
+}
+
+static void kv(diagnostic_msgs_msg_dds__DiagnosticStatus_ *s, const char *key, char *value)
+{
+    diagnostic_msgs_msg_dds__KeyValue_ *p;
+    if (s->values._length >= DIAG_MAX_VALUES)
+        return;
+    p = &s->values._buffer[s->values._length++];
+    p->key = (char *)(uintptr_t)key;
+    p->value = value;
+    s->values._maximum = s->values._length;
+}
+
+static void bridge_status(bridge_t *b, diagnostic_msgs_msg_dds__DiagnosticArray_ *m)
+{
+    unsigned c, timed_out = 0, j;
+    uint32_t total = 0, refused;
+    diagnostic_msgs_msg_dds__DiagnosticStatus_ *s;
+    for (c = 0; c < BRIDGE_NCAUSES; c++)
+        total += b->refused[c];
+    refused = total - b->refused_reported; /* a warning while refusals go on, not forever */
+    b->refused_reported = total;
+    for (j = 0; j < j288_robot_njoints(b->robot); j++)
+        timed_out += b->joint[j].mode == JOINT_TIMED_OUT;
+    s = status(m, b->stopped ? LEVEL_ERROR : (timed_out != 0u || refused != 0u) ? LEVEL_WARN : LEVEL_OK,
+               str("j288-dds: bridge"), str("j288-dds"));
+    s->message = b->stopped ? str("stopped: %s", b->stop_reason)
+                 : timed_out != 0u ? str("%u joint(s) timed out", timed_out)
+                 : refused != 0u ? str("%lu command(s) refused since the last report",
+                                       (unsigned long)refused)
+                                : str("ok");
+    kv(s, "messages", str("%lu", (unsigned long)b->messages));
+    kv(s, "timeout_ms", str("%lu", (unsigned long)(b->timeout_us / 1000u)));
+    kv(s, "refused", str("%lu", (unsigned long)total));
+    kv(s, "timeout_policy", str("%s", b->policy == TIMEOUT_HOLD ? "hold" : "lock"));
+    for (c = 0; c < BRIDGE_NCAUSES; c++)
+        if (b->refused[c] != 0u)
+            kv(s, bridge_cause_name((bridge_cause_t)c), str("%lu", (unsigned long)b->refused[c]));
+}
+
+static void bus_status(bridge_t *b, unsigned bus, diagnostic_msgs_msg_dds__DiagnosticArray_ *m)
+{
+    j288_robot_bus_stats_t bs;
+    const char *name = j288_robot_bus_name(b->robot, bus);
+    diagnostic_msgs_msg_dds__DiagnosticStatus_ *s;
+    (void)j288_robot_bus_stats(b->robot, bus, &bs);
+    s = status(m, bs.gone ? LEVEL_ERROR : bs.up ? LEVEL_OK : LEVEL_ERROR,
+               str("j288-dds: bus %s", name), str("bus:%s", name));
+    s->message = str("%s", bs.gone ? "gone (device vanished)" : bs.up ? "up" : "down (no reply)");
+    kv(s, "sweeps", str("%lu", (unsigned long)bs.sweeps));
+    kv(s, "empty_sweeps", str("%lu", (unsigned long)bs.empty_sweeps));
+    kv(s, "down_events", str("%lu", (unsigned long)bs.down_events));
+    kv(s, "last_sweep_us", str("%lu", (unsigned long)bs.last_sweep_us));
+    kv(s, "worst_sweep_us", str("%lu", (unsigned long)bs.worst_sweep_us));
+}
+
+static const char *mode_name(bridge_joint_mode_t mo)
+{
+    switch (mo) {
+    case JOINT_FOLLOWING: return "following";
+    case JOINT_TIMED_OUT: return "timed out";
+    case JOINT_LOCKED: return "locked by command";
+    default: return "idle (lock)";
+    }
+}
+
+static void joint_status(bridge_t *b, unsigned j, diagnostic_msgs_msg_dds__DiagnosticArray_ *m)
+{
+    j288_robot_state_t st;
+    j288_robot_joint_stats_t js;
+    const char *name = j288_robot_joint_name(b->robot, j);
+    const char *bus = j288_robot_bus_name(b->robot, (unsigned)j288_robot_joint_bus(b->robot, j));
+    uint8_t level;
+    diagnostic_msgs_msg_dds__DiagnosticStatus_ *s;
+    (void)j288_robot_read(b->robot, j, &st);
+    (void)j288_robot_joint_stats(b->robot, j, &js);
+    level = !st.online ? LEVEL_STALE
+            : st.faults != 0u ? LEVEL_ERROR
+            : (st.warnings != 0u || b->joint[j].mode == JOINT_TIMED_OUT) ? LEVEL_WARN
+                                                                        : LEVEL_OK;
+    s = status(m, level, str("j288-dds: joint %s", name),
+               str("bus:%s id:%d", bus, j288_robot_joint_id(b->robot, j)));
+    s->message = str("%s, %s%s", st.online ? "online" : "offline", mode_name(b->joint[j].mode),
+                     st.faults != 0u ? ", faults" : "");
+    kv(s, "online", str("%s", st.online ? "true" : "false"));
+    kv(s, "command", str("%s", mode_name(b->joint[j].mode)));
+    kv(s, "commands_accepted", str("%lu", (unsigned long)b->joint[j].accepted));
+    kv(s, "timeouts", str("%lu", (unsigned long)b->joint[j].timeouts));
+    kv(s, "watchdog_trips", str("%lu", (unsigned long)b->joint[j].watchdog));
+    kv(s, "faults", str("0x%06lx", (unsigned long)st.faults));
+    kv(s, "warnings", str("0x%02x", (unsigned)st.warnings));
+    kv(s, "case_temp_c", str("%.1f", st.case_temp_c));
+    kv(s, "winding_temp_c", str("%.1f", st.winding_temp_c));
+    kv(s, "voltage_v", str("%.2f", st.voltage_v));
+    kv(s, "angle_known", str("%s", st.known ? "true" : "false"));
+    kv(s, "fresh_cycles", str("%lu", (unsigned long)js.fresh_cycles));
+    kv(s, "stale_cycles", str("%lu", (unsigned long)js.stale_cycles));
+    kv(s, "transactions", str("%lu", (unsigned long)js.servo.transactions));
+    kv(s, "timeouts_wire", str("%lu", (unsigned long)js.servo.timeouts));
+    kv(s, "crc_errors", str("%lu", (unsigned long)js.servo.crc_errors));
+    kv(s, "wrong_id", str("%lu", (unsigned long)js.servo.wrong_id));
+    kv(s, "other_errors", str("%lu", (unsigned long)js.servo.other_errors));
+    kv(s, "latency_us", str("%lu", (unsigned long)js.servo.last_latency_us));
+    kv(s, "worst_latency_us", str("%lu", (unsigned long)js.servo.worst_latency_us));
+}
+
+void bridge_fill_diagnostics(bridge_t *b, diagnostic_msgs_msg_dds__DiagnosticArray_ *m)
+{
+    unsigned i;
+    d.used = 0;
+    memset(m, 0, sizeof *m);
+    bridge_stamp_now(&m->header.stamp);
+    m->header.frame_id = str("");
+    m->status._buffer = d.status;
+    bridge_status(b, m);
+    for (i = 0; i < j288_robot_nbuses(b->robot); i++)
+        bus_status(b, i, m);
+    for (i = 0; i < j288_robot_njoints(b->robot); i++)
+        joint_status(b, i, m);
+    m->status._maximum = m->status._length;
+}
