@@ -134,8 +134,8 @@ install:
 	@$(call REQUIRE,cmake,cmake); \
 	 cmake -S . -B $(CMAKE_BUILD) -DCMAKE_INSTALL_PREFIX=$(PREFIX) $(CMAKE_FLAGS) >/dev/null && \
 	 cmake --build $(CMAKE_BUILD) -j2 && DESTDIR=$(DESTDIR) cmake --install $(CMAKE_BUILD) && \
-	 { sed 's|^|$(DESTDIR)|' $(CMAKE_BUILD)/install_manifest.txt; cat $(INSTALLED_EXTRA) 2>/dev/null; } \
-	     >$(INSTALLED); rm -f $(INSTALLED_EXTRA)
+	 { sed 's|^|$(DESTDIR)|' $(CMAKE_BUILD)/install_manifest.txt; echo; cat $(INSTALLED_EXTRA) 2>/dev/null; } | \
+	     grep . >$(INSTALLED); rm -f $(INSTALLED_EXTRA)
 
 uninstall:
 	@[ -f $(INSTALLED) ] || { echo "uninstall: $(INSTALLED) missing: nothing installed from here"; exit 1; }
