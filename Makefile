@@ -121,10 +121,9 @@ test: $(HOST_TESTS) $(TEST_DEPS)
 	$(call RUN_TESTS,$(HOST_TESTS) $(TEST_SCRIPTS))
 
 # ---- install ---------------------------------------------------------------------------------
-# CMake's install (cmake/j288_install.cmake) from a tree in $(CMAKE_BUILD), for PREFIX, under
-# DESTDIR; `make uninstall` removes the files it listed (in $(INSTALLED), with DESTDIR), then
-# the j288 directories they leave empty. A fragment that installs a program CMake does not
-# build (mk/dds.mk) makes it a prerequisite of install and lists it in $(INSTALLED_EXTRA).
+# CMake's install (cmake/j288_install.cmake) from $(CMAKE_BUILD) for PREFIX under DESTDIR;
+# uninstall removes what it listed ($(INSTALLED)) and the j288 directories left empty. A program
+# CMake does not build (mk/dds.mk): a prerequisite of install, listed in $(INSTALLED_EXTRA).
 PREFIX ?= /usr/local
 BINDIR ?= $(PREFIX)/bin
 CMAKE_BUILD := $(BUILD)/cmake

@@ -1,12 +1,10 @@
 #!/usr/bin/env bash
 # usage: [BUILD=build] scripts/deb.sh build|check    (make deb, make deb-check; CI step deb)
-# build: the Debian packages libj288-0, libj288-dev, j288-tools and python3-j288 into
-#   $BUILD/deb/ with debhelper (debian/), from a copy of the tree whose debian/changelog is
-#   written here with the one version (J288_VERSION_STRING); lintian must report no error.
-# check: build, then install them for real with apt (root, or sudo; a CI container or a
-#   machine you may change), check j288 --version, pkg-config --modversion j288, a
-#   find_package(j288) consumer (test/cmake_consumer), python3 -c 'import j288' and the bash
-#   completion, then purge them and check that none of their files is left.
+# build: libj288-0, libj288-dev, j288-tools, python3-j288 into $BUILD/deb/ with debhelper, from
+#   a copy of the tree with a debian/changelog of the one version; lintian without errors.
+# check: then apt install them for real (root or sudo: CI, or a machine you may change), check
+#   j288 --version, pkg-config, find_package(j288) (test/cmake_consumer), import j288 and the
+#   completion, purge them and check that none of their files is left.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 mode=${1:-build}

@@ -1,11 +1,9 @@
 #!/usr/bin/env bash
 # usage: [BUILD=build] scripts/pip-check.sh   (make pip-check; CI step pip)
-# The Python package as pip installs it, without network (Debian's setuptools and wheel, hence
-# --system-site-packages): a fresh virtual environment, `pip install --no-build-isolation .`,
-# then from outside the tree `import j288` (the venv's copy, with the libj288.so built into it,
-# the header's version) scanning j288-sim's servos, the pytest suite against that installed
-# package (J288_LIB unset, python/ not on the path), and a wheel from `python3 -m build`
-# holding the library.
+# pip without network (Debian's setuptools and wheel: --system-site-packages): a fresh venv,
+# `pip install --no-build-isolation .`, `import j288` from outside the tree (the venv's copy
+# with its libj288.so, the header's version) scanning j288-sim, pytest against that installed
+# package (no J288_LIB, no python/ on the path), a wheel from `python3 -m build` with the library.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 /usr/bin/python3 -c 'import venv, build, pytest, wheel, setuptools' 2>/dev/null ||
