@@ -74,7 +74,7 @@ ALL_TARGETS := $(LIB_A) $(UNIT_TESTS)
 # Each fragment may use what the ones before it define.
 include $(sort $(wildcard mk/cpu/*.mk))
 include mk/tools.mk mk/tests.mk mk/target.mk mk/bench.mk mk/hardening.mk mk/firmware.mk
-include mk/robot.mk mk/release.mk mk/python.mk mk/dds.mk
+include mk/robot.mk mk/release.mk mk/python.mk mk/dds.mk mk/windows.mk
 
 all: $(ALL_TARGETS)
 
@@ -154,6 +154,8 @@ help:
 	@echo "make uninstall      removes what make install installed"
 	@echo "make shared python  libj288.so; and a copy in python/j288 (the Python package in place)"
 	@echo "make arm            lib/ for each Cortex-M, size table, STM32 example, port template"
+	@echo "make windows        j288.exe, j288.dll, libraries and tests for Windows (mingw-w64)"
+	@echo "make test-windows   those tests and j288.exe against the simulator under Wine"
 	@echo "make firmware       STM32 firmware per board against ST's HAL (bash scripts/fetch-st.sh first)"
 	@echo "make test-target    unit tests on each CPU under QEMU ($(CPUS))"
 	@echo "make size           flash, RAM and stack per module on Cortex-M0 and M4F"

@@ -22,6 +22,7 @@ endif()
 if(TARGET j288_shared)
     install(TARGETS j288_shared EXPORT j288Targets LIBRARY DESTINATION "${CMAKE_INSTALL_LIBDIR}")
     install(FILES "${PROJECT_SOURCE_DIR}/port/linux/j288_linux.h"
+                  "${PROJECT_SOURCE_DIR}/host/j288_host_port.h"
                   "${PROJECT_SOURCE_DIR}/host/j288_robot.h"
                   "${PROJECT_SOURCE_DIR}/host/j288_robot_config.h"
             DESTINATION "${CMAKE_INSTALL_INCLUDEDIR}/j288")

@@ -23,7 +23,13 @@
 /* With a stop flag, never sleep longer than this. */
 #define STOP_SLICE_US 20000u
 
+/* Formats checked as C99's (%zu); mingw-w64's "printf" would check Microsoft's. */
+#ifdef __MINGW_PRINTF_FORMAT
+static void set_err(j288_robot_t *r, const char *fmt, ...)
+    __attribute__((format(__MINGW_PRINTF_FORMAT, 2, 3)));
+#else
 static void set_err(j288_robot_t *r, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+#endif
 
 static void set_err(j288_robot_t *r, const char *fmt, ...)
 {
@@ -248,6 +254,20 @@ static int check_config(j288_robot_t *r, const j288_robot_config_t *cfg)
 /* Two names for one device (a symlink and its target) would open it twice: the second open
  * would fail as "in use" by this very process, which says less than this. Checked before
  * opening bus i; a path that cannot be examined is left to the open to report. */
+#ifdef _WIN32
+static int check_same_device(j288_robot_t *r, unsigned i, const char *port)
+{
+    unsigned k;
+    for (k = 0; k < i; k++) {
+        if (j288_windows_same_device(port, j288_windows_device(&r->bus[k].lp))) {
+            set_err(r, "buses '%s' and '%s' are the same device", r->bus[k].name,
+                    r->bus[i].name);
+            return J288_ERR_BAD_CONFIG;
+        }
+    }
+    return J288_OK;
+}
+#else
 static int check_same_device(j288_robot_t *r, unsigned i, const char *port)
 {
     struct stat si, sk;
@@ -264,6 +284,7 @@ static int check_same_device(j288_robot_t *r, unsigned i, const char *port)
     }
     return J288_OK;
 }
+#endif
 
 static int open_bus(j288_robot_t *r, unsigned i, const char *name, const char *port,
                     const j288_robot_config_bus_t *cb)

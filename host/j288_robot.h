@@ -68,7 +68,7 @@
 #include <stdint.h>
 
 #include "j288/j288.h"
-#include "j288_linux.h"
+#include "j288_host_port.h"
 #include "j288_robot_config.h"
 
 #if !J288_CONFIG_SI

@@ -21,9 +21,15 @@
 #include <yaml.h>
 #endif
 
+/* Formats checked as C99's (%zu); mingw-w64's "printf" would check Microsoft's. */
+#ifdef __MINGW_PRINTF_FORMAT
+#define PRINTF_LIKE(f, a) __attribute__((format(__MINGW_PRINTF_FORMAT, f, a)))
+#else
+#define PRINTF_LIKE(f, a) __attribute__((format(printf, f, a)))
+#endif
+
 /* One line of error text: "prefix" then the formatted message. */
-static int set_error(char *err, size_t errlen, const char *fmt, ...)
-    __attribute__((format(printf, 3, 4)));
+static int set_error(char *err, size_t errlen, const char *fmt, ...) PRINTF_LIKE(3, 4);
 
 static int set_error(char *err, size_t errlen, const char *fmt, ...)
 {
@@ -235,7 +241,7 @@ typedef struct {
     size_t errlen;
 } ctx_t;
 
-static int fail(ctx_t *x, size_t line, const char *fmt, ...) __attribute__((format(printf, 3, 4)));
+static int fail(ctx_t *x, size_t line, const char *fmt, ...) PRINTF_LIKE(3, 4);
 
 /* "FILE:LINE: <label>message"; LINE counts from 1. */
 static int fail(ctx_t *x, size_t line, const char *fmt, ...)
@@ -1176,6 +1182,26 @@ int j288_robot_config_edit(const char *text, size_t len, const char *name, const
     return rc;
 }
 
+#ifdef _WIN32
+/* Writing back is POSIX (permissions, a hidden temporary file renamed over the config, stale
+ * ones found by process id): on Windows it is refused, before anything is sent, so that
+ * j288 zero and calibrate say so instead of moving a joint for nothing. */
+#define NO_WRITE_BACK "writing a config back (j288 zero, calibrate) is not available on Windows " \
+                      "yet: run it on Linux, or edit zero:/phase: by hand"
+
+int j288_robot_config_check_writable(const char *path, char *err, size_t errlen)
+{
+    return set_error(err, errlen, "%s: %s", path, NO_WRITE_BACK);
+}
+
+int j288_robot_config_write_joint(const char *path, const char *joint,
+                                  const j288_robot_config_update_t *upd, char *err, size_t errlen)
+{
+    (void)joint;
+    (void)upd;
+    return set_error(err, errlen, "%s: %s", path, NO_WRITE_BACK);
+}
+#else
 /* The temporary file of a write-back: hidden, beside the config (rename is atomic within a
  * folder), named after the config and the writing process: ".robot.yaml.j288-PID.XXXXXX". */
 #define TEMP_TAG ".j288-"
@@ -1325,5 +1351,6 @@ int j288_robot_config_write_joint(const char *path, const char *joint, const j28
     free(text);
     return rc;
 }
+#endif /* _WIN32 */
 
 #endif /* J288_HAVE_LIBYAML */

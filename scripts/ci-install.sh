@@ -31,6 +31,9 @@ packages=(
                                     # under CI=true, skipped with a notice elsewhere)
     cyclonedds-dev cyclonedds-tools # j288-dds (mk/dds.mk): libddsc, its pkg-config file, idlc
     iproute2 util-linux             # the DDS tests' private network namespace (ip, unshare)
+    # Windows (mk/windows.mk): make windows cross-builds with mingw-w64, make test-windows runs
+    # the programs under Wine (64-bit only: no i386 packages, no X server; ~200 MB)
+    gcc-mingw-w64-x86-64-win32 wine wine64
     help2man                        # the man pages of j288 and j288-sim (cmake/j288_tools.cmake)
     python3-venv python3-setuptools python3-wheel python3-build  # make pip-check (no network)
     debhelper dpkg-dev fakeroot lintian  # make deb, make deb-check (debian/)

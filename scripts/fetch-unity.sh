@@ -29,27 +29,10 @@ if [ -n "${UNITY_DIR:-}" ]; then
 fi
 if have; then exit 0; fi
 
-command -v apt-get >/dev/null || { echo "unity: no apt-get; set UNITY_DIR to a Unity checkout" >&2; exit 1; }
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
-mkdir -p "$work/lists/partial" "$work/parts" "$work/src"
-# deb-src lines derived from this system's own sources (no mirror host hard-coded).
-{
-    for f in /etc/apt/sources.list /etc/apt/sources.list.d/*.list; do
-        [ -f "$f" ] && grep -E '^[[:space:]]*deb[[:space:]]' "$f" | sed -E 's/^[[:space:]]*deb[[:space:]]/deb-src /'
-    done
-} > "$work/sources.list" 2>/dev/null || true
-for f in /etc/apt/sources.list.d/*.sources; do
-    [ -f "$f" ] || continue
-    # deb822: rewrite "Types: deb" stanzas to deb-src.
-    sed -E 's/^Types:.*/Types: deb-src/' "$f" > "$work/parts/$(basename "$f")"
-done
-opts=(-o Dir::Etc::SourceList="$work/sources.list" -o Dir::Etc::SourceParts="$work/parts"
-      -o Dir::State::Lists="$work/lists" -o Dir::Cache::pkgcache= -o Dir::Cache::srcpkgcache=
-      -o APT::Sandbox::User="$(id -un)" -o Debug::NoLocking=1)
-apt-get "${opts[@]}" -qq update >"$work/update.log" 2>&1 || { cat "$work/update.log" >&2; echo "unity: apt-get update failed" >&2; exit 1; }
-(cd "$work/src" && apt-get "${opts[@]}" -qq source --download-only cjson >"$work/src.log" 2>&1) ||
-    { cat "$work/src.log" >&2; echo "unity: could not fetch Debian's cjson source (it carries Unity)" >&2; exit 1; }
+bash "$(dirname "$0")/apt-source.sh" cjson "$work/src" ||
+    { echo "unity: could not fetch Debian's cjson source (it carries Unity); or set UNITY_DIR" >&2; exit 1; }
 tarball=$(ls "$work"/src/cjson_*.orig.tar.* 2>/dev/null | head -n1)
 [ -n "$tarball" ] || { echo "unity: cjson source has no orig tarball" >&2; exit 1; }
 tar -xf "$tarball" -C "$work/src" --wildcards '*/tests/unity/src/*'

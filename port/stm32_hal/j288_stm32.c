@@ -143,6 +143,10 @@ static void dma_point(dma_regs_t *s, const volatile uint32_t *periph, const void
     s->PAR = J288_STM32_DMA_ADDR(periph);
     s->M0AR = J288_STM32_DMA_ADDR(mem);
 }
+/* Direct mode: in FIFO mode the counter moves when a byte leaves the UART, but the byte
+ * reaches memory only at the FIFO's threshold, so positions read from the counter would
+ * point past what is in the buffer. */
+static void dma_direct(dma_regs_t *s) { s->FCR &= ~(uint32_t)DMA_SxFCR_DMDIS; }
 #else /* channels: F0, F1, F3, G0, G4, L4, ... */
 typedef DMA_Channel_TypeDef dma_regs_t;
 #define DMA_CTRL(s) ((s)->CCR)
@@ -163,6 +167,7 @@ static void dma_point(dma_regs_t *s, const volatile uint32_t *periph, const void
     s->CPAR = J288_STM32_DMA_ADDR(periph);
     s->CMAR = J288_STM32_DMA_ADDR(mem);
 }
+static void dma_direct(dma_regs_t *s) { (void)s; } /* a channel has no FIFO */
 #endif
 
 /* Stop a stream: clear its enable bit and wait, a bounded number of reads, for the stream to
@@ -531,6 +536,9 @@ static int check_config(const j288_stm32_config_t *cfg, const j288_bus_config_t 
         (J288_STM32_CACHE_OPS && (((uintptr_t)cfg->dma % J288_STM32_DCACHE_LINE) != 0u))) {
         return J288_ERR_BAD_CONFIG;
     }
+    if (cfg->irq_priority >= (1u << __NVIC_PRIO_BITS)) {
+        return J288_ERR_BAD_CONFIG; /* shifted into BASEPRI it would mask the wrong level, or none */
+    }
     if ((bus_cfg != NULL) && bus_cfg->echo && cfg->deaf_while_transmitting) {
         return J288_ERR_BAD_CONFIG; /* the line cannot hear the echo the bus would wait for */
     }
@@ -580,8 +588,9 @@ static void take_registers(j288_stm32_t *p)
 /* The UART as the port runs it: one-bit sampling (written with the UART off, as the newer
  * USART requires), the error interrupt off, both directions and both DMA requests on for
  * good, the idle-line interrupt. Then the streams: TX pointed at its buffer with no
- * interrupt (the UART's transmit complete ends a transmit); RX circular over its buffer,
- * started before the receiver is on, with its half/complete/error interrupts. */
+ * interrupt (the UART's transmit complete ends a transmit); RX circular and direct (no FIFO)
+ * over its buffer, started before the receiver is on, with its half/complete/error
+ * interrupts. */
 static bool take_line(j288_stm32_t *p)
 {
     USART_TypeDef *u = p->uart;
@@ -597,6 +606,7 @@ static bool take_line(j288_stm32_t *p)
     DMA_CTRL(tx) &= ~(uint32_t)(DMA_IT_ALL | DMA_CIRC);
     *p->tx_ifcr = (uint32_t)DMA_F_ALL << p->tx_shift;
     dma_point(rx, UART_DATA_ADDR(u), p->cfg.dma->rx);
+    dma_direct(rx);
     DMA_COUNT(rx) = J288_STM32_RX_BUF_SIZE;
     cache_invalidate(p->cfg.dma->rx, J288_STM32_RX_BUF_SIZE);
     *p->rx_ifcr = (uint32_t)DMA_F_ALL << p->rx_shift;

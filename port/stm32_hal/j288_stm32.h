@@ -166,7 +166,8 @@ typedef struct {
     /* The NVIC preemption priority of the bus's interrupts (UART, RX stream, timer: one
      * priority). The bus lock raises BASEPRI to it, masking those and anything less urgent
      * while other interrupts keep their latency. 0, or a core without BASEPRI (Cortex-M0/M0+/
-     * M23): the lock masks every interrupt (PRIMASK); BASEPRI cannot mask priority 0. */
+     * M23): the lock masks every interrupt (PRIMASK); BASEPRI cannot mask priority 0.
+     * At most (1 << __NVIC_PRIO_BITS) - 1 (15 on the F4, G4 and H7): init refuses more. */
     uint8_t irq_priority;
 
     /* The line does not hear our own transmit: a transceiver whose receiver is switched off

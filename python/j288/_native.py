@@ -7,9 +7,10 @@ here: the calls are few and coarse (one per cycle), so their per-call cost is wh
 and it is measured in docs/performance.md.
 
 The library is looked for, in order: $J288_LIB (a path), libj288.so next to this file (what
-``make python`` puts there), the one of the prefix ``make install`` put this package in (the
-path _installed.py holds, relative to this directory, so that DESTDIR and a moved prefix
-work), then the system's (ldconfig's libj288.so.0).
+``make python`` puts there; j288.dll on Windows, libj288.dylib on macOS), the one of the
+prefix ``make install`` put this package in (the path _installed.py holds, relative to this
+directory, so that DESTDIR and a moved prefix work), then the system's (ldconfig's
+libj288.so.0; on Windows a j288.dll on PATH).
 """
 
 from __future__ import annotations
@@ -19,6 +20,7 @@ import ctypes.util
 import numbers
 import os
 import signal
+import sys
 import threading
 from ctypes import (POINTER, Structure, c_bool, c_char_p, c_double, c_int, c_size_t, c_uint,
                     c_uint8, c_uint32, c_void_p)
@@ -103,12 +105,17 @@ class Options(Structure):
                 ("stop_on_bus_loss", c_bool), ("echo", c_bool), ("retries", c_uint8)]
 
 
-def _find() -> str:
+# The shared library's file name on each platform (Windows: what `make windows` builds).
+_LIB_FILE = {"win32": "j288.dll", "cygwin": "j288.dll", "darwin": "libj288.dylib"}
+
+
+def _find(platform: str = sys.platform, pkg: Optional[str] = None) -> str:
     env = os.environ.get("J288_LIB")
     if env:
         return env
-    pkg = os.path.dirname(os.path.abspath(__file__))
-    here = os.path.join(pkg, "libj288.so")
+    pkg = pkg or os.path.dirname(os.path.abspath(__file__))
+    name = _LIB_FILE.get(platform, "libj288.so")
+    here = os.path.join(pkg, name)
     if os.path.exists(here):
         return here
     try:  # written by `make install` only
@@ -120,7 +127,7 @@ def _find() -> str:
     found = ctypes.util.find_library("j288")
     if found:
         return found
-    raise ImportError("libj288.so not found: run `make python` (in place) or `make install`, "
+    raise ImportError(f"{name} not found: run `make python` (in place) or `make install`, "
                       "or set J288_LIB to its path")
 
 

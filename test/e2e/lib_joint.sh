@@ -30,23 +30,6 @@ start_sim() {
     sim_start_linked "$1" --exit-after "$(e2e_scaled 300)" --truth "$TRUTH" "${@:2}"
 }
 
-truth_seq() { sed -n '1s/^# j288-sim truth seq=\([0-9]*\) .*/\1/p' "$TRUTH" 2>/dev/null; }
-# truth_now: ask the simulator for its truth (SIGWINCH) and wait until it is written.
-truth_now() {
-    local seq i
-    seq=$(truth_seq)
-    kill -s WINCH "$SIM_PID"
-    for i in $(seq 1 "$(e2e_scaled 400)"); do
-        [ "$(truth_seq)" != "$seq" ] && return 0
-        sleep 0.05
-    done
-    echo "no truth written"; return 1
-}
-# truth_val ID KEY: the value of KEY on servo ID's line of the truth file.
-truth_val() {
-    awk -v id="$1" -v key="$2" '$1 == "id=" id {
-        for (i = 2; i <= NF; i++) { n = index($i, "="); if (substr($i, 1, n - 1) == key) print substr($i, n + 1) } }' "$TRUTH"
-}
 # wait_settled ID: up to 20 s for servo ID's true angle to stop changing.
 wait_settled() {
     local prev= cur i
@@ -74,19 +57,8 @@ wait_power_on() {
 jget() {
     sed -n 's/.*"'"$2"'": \([^,}]*\).*/\1/p' "$1" | sed 's/^true$/True/; s/^false$/False/; s/^null$//'
 }
-# near A B TOL [PERIOD]: |A - B| <= TOL, modulo PERIOD when given (angles); a value that is
-# not a number fails.
-near() {
-    awk -v a="$1" -v b="$2" -v tol="$3" -v p="${4:-0}" 'BEGIN {
-        num = "^[-+]?([0-9]+[.]?[0-9]*|[.][0-9]+)([eE][-+]?[0-9]+)?$"
-        if (a !~ num || b !~ num) exit 1
-        d = a - b
-        if (p > 0) { k = d / p; d -= p * (k >= 0 ? int(k + 0.5) : -int(-k + 0.5)) }
-        exit !(d <= tol && -d <= tol) }' || { echo "|$1 - $2| > $3${4:+ (mod $4)}"; return 1; }
-}
 # calc EXPR: a number (awk arithmetic).
 calc() { awk "BEGIN { printf \"%.12g\\n\", $1 }"; }
-TWO_PI=6.283185307179586
 # status_json ID [more options]: status --json into $E2E_TMP/st.json.
 status_json() {
     local id=$1; shift

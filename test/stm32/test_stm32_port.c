@@ -256,6 +256,20 @@ static void test_init_takes_the_line(void)
     TEST_ASSERT_EQUAL_INT(0, fake_hal_gpio_level(&gpioa, DE_PIN));
 }
 
+/* A stream in FIFO mode (CubeMX offers it) counts a byte in NDTR when it leaves the UART,
+ * but writes it to memory only at the FIFO's threshold: the port, reading positions from the
+ * counter, would hand the bus stale bytes. Init puts the RX stream in direct mode. */
+static void test_init_puts_the_rx_stream_in_direct_mode(void)
+{
+#if defined(J288_STUB_G4)
+    TEST_IGNORE_MESSAGE("DMA channels have no FIFO");
+#else
+    fake_hal_rx_stream(&huart1)->FCR = DMA_SxFCR_DMDIS | 0x1u; /* FIFO mode, threshold 1/2 */
+    init_port1(NULL, false, true);
+    TEST_ASSERT_EQUAL_HEX32(0u, fake_hal_rx_stream(&huart1)->FCR & DMA_SxFCR_DMDIS);
+#endif
+}
+
 static void test_registry_is_bounded(void)
 {
     static j288_stm32_t extra[J288_STM32_MAX_BUSES + 1u];
@@ -369,6 +383,20 @@ static void test_bus_lock_masks_only_the_bus_interrupts(void)
     ops->unlock(&port1);
     TEST_ASSERT_EQUAL_UINT32(2u << (8u - __NVIC_PRIO_BITS), fake_hal_basepri());
     __set_BASEPRI(0u);
+}
+
+/* A priority the NVIC cannot hold (its top __NVIC_PRIO_BITS bits) is refused at init: shifted
+ * into BASEPRI it would keep only its low bits, and 1 << __NVIC_PRIO_BITS would write 0, a
+ * lock that masks nothing. */
+static void test_init_rejects_a_priority_the_nvic_cannot_hold(void)
+{
+    j288_stm32_config_t c = base_config(&huart1, &dma1);
+    c.irq_priority = (uint8_t)(1u << __NVIC_PRIO_BITS);
+    TEST_ASSERT_EQUAL_INT(J288_ERR_BAD_CONFIG, j288_stm32_init(&port1, &c, NULL));
+    c.irq_priority = 0xFFu;
+    TEST_ASSERT_EQUAL_INT(J288_ERR_BAD_CONFIG, j288_stm32_init(&port1, &c, NULL));
+    c.irq_priority = (uint8_t)((1u << __NVIC_PRIO_BITS) - 1u); /* the least urgent: fine */
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_stm32_init(&port1, &c, NULL));
 }
 
 static void test_bus_lock_without_priority_masks_all(void)
@@ -1017,11 +1045,13 @@ int main(void)
     RUN_TEST(test_init_rejects_echo_on_a_deaf_line);
     RUN_TEST(test_init_takes_the_line);
     RUN_TEST(test_registry_is_bounded);
+    RUN_TEST(test_init_puts_the_rx_stream_in_direct_mode);
     RUN_TEST(test_init_refuses_buffers_the_dma_cannot_reach);
     RUN_TEST(test_init_rejects_uart_without_dma_streams);
     RUN_TEST(test_tx_pin_drive_option);
     RUN_TEST(test_bus_lock_masks_only_the_bus_interrupts);
     RUN_TEST(test_bus_lock_without_priority_masks_all);
+    RUN_TEST(test_init_rejects_a_priority_the_nvic_cannot_hold);
     RUN_TEST(test_full_transaction_registers_and_bytes);
     RUN_TEST(test_many_transactions_across_the_wraps);
     RUN_TEST(test_echo_option_checks_the_echo);

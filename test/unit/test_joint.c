@@ -490,8 +490,10 @@ static void test_reversed_joint_at_rest_is_plus_zero(void)
     r.speed = 0;
     r.torque = 0;
     TEST_ASSERT_EQUAL_INT(J288_OK, j288_joint_take_reply(&joint, &r, NULL));
-    TEST_ASSERT_FALSE(signbit(j288_joint_state(&joint)->speed));
-    TEST_ASSERT_FALSE(signbit(j288_joint_state(&joint)->torque));
+    /* copysign, not signbit: mingw-w64's signbit macro converts a double to float in its
+     * float branch, which -Wconversion rejects. */
+    TEST_ASSERT_TRUE(copysign(1.0, (double)j288_joint_state(&joint)->speed) > 0.0);
+    TEST_ASSERT_TRUE(copysign(1.0, (double)j288_joint_state(&joint)->torque) > 0.0);
 }
 
 /* A start with the joint moving, and one where a sample disagrees: the start restarts. */

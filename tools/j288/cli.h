@@ -47,7 +47,9 @@ void cli_set_error_stream(FILE *f);
 
 /* One line on stderr, prefixed and newline-terminated. */
 void cli_error(const char *fmt, ...)
-#if defined(__GNUC__)
+#if defined(__MINGW_PRINTF_FORMAT)
+    __attribute__((format(__MINGW_PRINTF_FORMAT, 1, 2))) /* C99 formats (%zu) on Windows */
+#elif defined(__GNUC__)
     __attribute__((format(printf, 1, 2)))
 #endif
     ;

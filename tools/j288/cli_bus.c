@@ -71,6 +71,24 @@ static void on_signal(int sig)
     }
 }
 
+#ifdef _WIN32
+/* Ctrl-C and Ctrl-Break (and closing the console) run this on a thread of their own: record
+ * the stop as SIGINT (SIGTERM for the others) for the command loops, which lock every bus
+ * they drove. Closing the console ends the process a few seconds after this returns, so it
+ * waits a little for the locks to go out. */
+static BOOL WINAPI on_console_event(DWORD type)
+{
+    on_signal(type == CTRL_C_EVENT || type == CTRL_BREAK_EVENT ? SIGINT : SIGTERM);
+    if (type == CTRL_CLOSE_EVENT || type == CTRL_LOGOFF_EVENT || type == CTRL_SHUTDOWN_EVENT)
+        Sleep(2000);
+    return TRUE; /* handled: the process goes on to its safe stop */
+}
+
+void cli_signals_install(void)
+{
+    (void)SetConsoleCtrlHandler(on_console_event, TRUE);
+}
+#else
 void cli_signals_install(void)
 {
     struct sigaction sa;
@@ -81,12 +99,20 @@ void cli_signals_install(void)
     sigaction(SIGINT, &sa, NULL);
     sigaction(SIGTERM, &sa, NULL);
 }
+#endif
 
 int cli_signal_exit_code(void)
 {
     return cli_stop_signal == SIGTERM ? CLI_EXIT_SIGTERM : CLI_EXIT_SIGINT;
 }
 
+#ifdef _WIN32
+static bool is_pseudo_terminal(const char *dev)
+{
+    (void)dev; /* COM ports only (Wine maps them onto ptys, but says nothing of it) */
+    return false;
+}
+#else
 static bool is_pseudo_terminal(const char *dev)
 {
     char real[PATH_MAX];
@@ -95,6 +121,7 @@ static bool is_pseudo_terminal(const char *dev)
     }
     return strncmp(real, "/dev/pts/", 9) == 0;
 }
+#endif
 
 void cli_print_notices(const char *notices)
 {
@@ -122,6 +149,8 @@ int cli_bus_open(cli_bus_t *b, const cli_bus_opts_t *o, int default_retries)
     static j288_robot_t robot; /* large, and one bus per process */
     j288_robot_options_t ro;
     const char *dev = o->port;
+    uint32_t baud = o->baud;
+    long long env_baud;
     int rc;
 
     memset(b, 0, sizeof *b);
@@ -133,9 +162,14 @@ int cli_bus_open(cli_bus_t *b, const cli_bus_opts_t *o, int default_retries)
         return CLI_EXIT_USAGE;
     }
     b->dev = dev;
+    if (baud == 0u && getenv("J288_BAUD") != NULL && getenv("J288_BAUD")[0] != '\0') {
+        if (cli_parse_int("$J288_BAUD", getenv("J288_BAUD"), 9600, 100000000, &env_baud) != 0)
+            return CLI_EXIT_USAGE;
+        baud = (uint32_t)env_baud;
+    }
     b->robot = &robot;
     memset(&ro, 0, sizeof ro);
-    ro.baud = o->baud;
+    ro.baud = baud;
     ro.echo = o->echo;
     ro.margin_us =
         o->margin_us != 0u ? o->margin_us : (is_pseudo_terminal(dev) ? PTY_MARGIN_US : 0u);

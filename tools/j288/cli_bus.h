@@ -21,7 +21,7 @@
 
 #include "args.h"
 #include "cli.h"
-#include "j288_linux.h"
+#include "j288_host_port.h"
 #include "j288_robot.h"
 #include "j288_robot_config.h"
 #include "json.h"
@@ -48,7 +48,7 @@ enum {
 #define CLI_BUS_COMMON_HELP                                                                        \
     "common options:\n"                                                                            \
     "  --port DEV       serial device (or give it before the command; default $J288_PORT)\n"       \
-    "  --baud N         line rate, default 6000000\n"                                              \
+    "  --baud N         line rate, default $J288_BAUD, else 6000000\n"                            \
     "  --margin-us N    reply deadline margin for host latency; default 20000 for a USB\n"         \
     "                   adapter, 5000 for a pseudo-terminal (the simulator)\n"                     \
     "  --echo           the adapter hears its own transmit (skip and check the echo)\n"            \

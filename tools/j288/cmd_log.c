@@ -6,7 +6,9 @@
 #include <stdlib.h>
 #include <string.h>
 
+#ifdef __linux__
 #include <sys/prctl.h>
+#endif
 
 #include "cli_bus.h"
 #include "frameview.h"
@@ -543,7 +545,9 @@ static int log_open(log_run_t *r)
     cli_signals_install();
     /* Best effort: wake from the tick sleeps within a microsecond rather than the default
      * 50 us timer slack. */
+#ifdef __linux__
     (void)prctl(PR_SET_TIMERSLACK, 1ul, 0ul, 0ul, 0ul);
+#endif
     if ((ec = cli_bus_open(&r->b, &r->o, 0)) != CLI_EXIT_OK) {
         return ec;
     }

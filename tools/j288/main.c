@@ -48,7 +48,7 @@ static void usage(FILE *f)
     fputs("\n"
           "global options (bus commands also take them after the command):\n"
           "  --port DEV   serial device of the bus (default: $J288_PORT)\n"
-          "  --baud N     line rate in bit/s (default 6000000)\n"
+          "  --baud N     line rate in bit/s (default: $J288_BAUD, else 6000000)\n"
           "  --config F   robot config: log, status, hold, stop without --id/--joint drive\n"
           "               every bus and joint in it (j288 --config F log --help)\n"
           "  --version    print the library version\n"

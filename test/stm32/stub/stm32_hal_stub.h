@@ -105,6 +105,8 @@ typedef struct {
     volatile uint32_t NDTR;
     volatile uintptr_t PAR;
     volatile uintptr_t M0AR;
+    volatile uintptr_t M1AR;
+    volatile uint32_t FCR;
 } DMA_Stream_TypeDef;
 typedef struct {
     volatile uint32_t LISR;
@@ -118,6 +120,7 @@ typedef struct {
 #define DMA_SxCR_HTIE 0x00000008u
 #define DMA_SxCR_TCIE 0x00000010u
 #define DMA_SxCR_CIRC 0x00000100u
+#define DMA_SxFCR_DMDIS 0x00000004u /* FIFO mode (direct mode disabled) */
 /* Stream 0's flags in LISR; the HAL's StreamIndex shifts them to the stream's. */
 #define DMA_LISR_FEIF0 0x00000001u
 #define DMA_LISR_DMEIF0 0x00000004u

@@ -1,0 +1,343 @@
+/*
+ * The Windows port against j288-sim through Wine's COM mapping (scripts/windows-test.sh
+ * starts the simulators, points the prefix's dosdevices/comN at their pseudo-terminals and
+ * runs this under wine):
+ *
+ *   test_windows_port.exe CLEAN SILENT ECHO VANISH TXLOG
+ *     CLEAN   servos 1, 2, 3                    SILENT  servo 1 that never answers (--drop 1)
+ *     ECHO    servo 1 behind an echoing line    VANISH  servo 1, stopped once it hears us
+ *     TXLOG   a file: every command frame the byte-exact test sent, one hex line each (the
+ *             script compares it with the simulator's log of what it received)
+ *
+ * Correctness and timeouts only (no timing thresholds: Wine's serial layer is not
+ * Windows'). Exchanges that must succeed use a 250 ms margin. The rate is 4,000,000: Wine
+ * leaves a pseudo-terminal at 38400 for anything faster (and says success), which the port's
+ * read-back refuses (test_6mbps_refused_when_not_applied).
+ */
+#include "unity.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "j288/j288.h"
+#include "j288_windows.h"
+
+#define WINE_MAX_BAUD            4000000u
+#define LOADED_MACHINE_MARGIN_US 250000u
+#define EXACT_TRANSACTIONS       2000
+
+static const char *g_clean, *g_silent, *g_echo, *g_vanish, *g_txlog;
+static j288_windows_t g_wp;
+static j288_bus_t g_bus;
+
+void setUp(void)
+{
+    memset(&g_wp, 0, sizeof g_wp);
+    g_wp.h = INVALID_HANDLE_VALUE;
+}
+
+void tearDown(void)
+{
+    j288_windows_close(&g_wp);
+}
+
+static void open_port(const char *com, uint32_t margin_us, bool echo)
+{
+    j288_windows_options_t o;
+    int rc;
+    memset(&o, 0, sizeof o);
+    o.margin_us = margin_us;
+    o.echo = echo;
+    rc = j288_windows_open(&g_wp, com, WINE_MAX_BAUD, &o);
+    TEST_ASSERT_EQUAL_INT_MESSAGE(J288_OK, rc, j288_windows_error(&g_wp));
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_windows_bus_init(&g_wp, &g_bus, NULL));
+}
+
+static j288_cmd_raw_t lock_cmd(uint8_t id)
+{
+    j288_cmd_raw_t c;
+    memset(&c, 0, sizeof c);
+    c.id = id;
+    c.status = J288_MODE_LOCK;
+    c.watchdog = true;
+    return c;
+}
+
+/* ---- pure helpers --------------------------------------------------------------------------- */
+
+static void test_device_path(void)
+{
+    char out[16];
+    TEST_ASSERT_TRUE(j288_windows_device_path("COM5", out, sizeof out));
+    TEST_ASSERT_EQUAL_STRING("\\\\.\\COM5", out);
+    TEST_ASSERT_TRUE(j288_windows_device_path("COM12", out, sizeof out));
+    TEST_ASSERT_EQUAL_STRING("\\\\.\\COM12", out);
+    TEST_ASSERT_TRUE(j288_windows_device_path("\\\\.\\COM7", out, sizeof out));
+    TEST_ASSERT_EQUAL_STRING("\\\\.\\COM7", out);
+    TEST_ASSERT_FALSE(j288_windows_device_path("COM123456789012", out, sizeof out));
+    TEST_ASSERT_TRUE(j288_windows_same_device("COM5", "\\\\.\\com5"));
+    TEST_ASSERT_TRUE(j288_windows_same_device("com12", "COM12"));
+    TEST_ASSERT_FALSE(j288_windows_same_device("COM1", "COM12"));
+    TEST_ASSERT_FALSE(j288_windows_same_device("COM1", NULL));
+}
+
+static void test_baud_read_back_tolerance(void)
+{
+    TEST_ASSERT_TRUE(j288_windows_baud_ok(6000000u, 6180000u)); /* +3 % exactly */
+    TEST_ASSERT_FALSE(j288_windows_baud_ok(6000000u, 6180001u));
+    TEST_ASSERT_TRUE(j288_windows_baud_ok(6000000u, 5820000u));
+    TEST_ASSERT_FALSE(j288_windows_baud_ok(6000000u, 38400u)); /* Wine above 4 Mbps */
+    TEST_ASSERT_FALSE(j288_windows_baud_ok(6000000u, 0u));
+    TEST_ASSERT_FALSE(j288_windows_baud_ok(0u, 0u));
+    TEST_ASSERT_FALSE(j288_windows_baud_ok(4294967295u, 1u));
+}
+
+static void test_clock_is_monotonic(void)
+{
+    uint32_t a = j288_windows_now_us(), b;
+    Sleep(20);
+    b = j288_windows_now_us();
+    TEST_ASSERT_TRUE((int32_t)(b - a) >= 15000); /* Sleep(20) sleeps at least ~20 ms */
+}
+
+/* ---- open ------------------------------------------------------------------------------------ */
+
+static void test_open_errors(void)
+{
+    char long_name[sizeof g_wp.dev + 1u];
+    TEST_ASSERT_EQUAL_INT(J288_ERR_OFFLINE, j288_windows_open(&g_wp, "COM199", 0, NULL));
+    TEST_ASSERT_NOT_NULL(strstr(j288_windows_error(&g_wp), "no such port"));
+    TEST_ASSERT_EQUAL_INT(J288_ERR_NULL, j288_windows_open(&g_wp, NULL, 0, NULL));
+    TEST_ASSERT_EQUAL_INT(J288_ERR_NULL, j288_windows_open(NULL, "COM1", 0, NULL));
+    memset(long_name, 'C', sizeof long_name - 1u);
+    long_name[sizeof long_name - 1u] = '\0';
+    TEST_ASSERT_EQUAL_INT(J288_ERR_BAD_CONFIG, j288_windows_open(&g_wp, long_name, 0, NULL));
+    TEST_ASSERT_NOT_NULL(strstr(j288_windows_error(&g_wp), "too long"));
+    /* A file is no serial port. */
+    TEST_ASSERT_EQUAL_INT(J288_ERR_BAD_CONFIG,
+                          j288_windows_open(&g_wp, "C:\\windows\\win.ini", 0, NULL));
+    TEST_ASSERT_NOT_NULL(strstr(j288_windows_error(&g_wp), "not a serial port"));
+    TEST_ASSERT_EQUAL_UINT32(0u, j288_windows_baud(&g_wp));
+    j288_windows_close(&g_wp); /* harmless after a failure, and twice */
+    j288_windows_close(&g_wp);
+}
+
+/* Under Wine a pty keeps 38400 for any rate above 4 Mbps while SetCommState says success: the
+ * read-back turns that into a clear error instead of a bus that silently runs at 38400. */
+static void test_6mbps_refused_when_not_applied(void)
+{
+    TEST_ASSERT_EQUAL_INT(J288_ERR_BAD_CONFIG, j288_windows_open(&g_wp, g_clean, 0, NULL));
+    TEST_ASSERT_NOT_NULL(strstr(j288_windows_error(&g_wp), "cannot do 6000000 baud"));
+    open_port(g_clean, 0, false);
+    TEST_ASSERT_EQUAL_UINT32(WINE_MAX_BAUD, j288_windows_baud(&g_wp));
+    TEST_ASSERT_EQUAL_STRING(g_clean, j288_windows_device(&g_wp));
+}
+
+/* ---- transactions ------------------------------------------------------------------------- */
+
+/* Many transactions with changing contents: every one answered by its servo, every byte
+ * counted; the frames sent go to TXLOG for the script's byte-by-byte comparison with what the
+ * simulator received. */
+static void test_transactions_byte_exact(void)
+{
+    FILE *log = fopen(g_txlog, "w");
+    j288_txn_t txn;
+    int i;
+    size_t k;
+    TEST_ASSERT_NOT_NULL(log);
+    open_port(g_clean, LOADED_MACHINE_MARGIN_US, false);
+    for (i = 0; i < EXACT_TRANSACTIONS; i++) {
+        j288_cmd_raw_t c = lock_cmd((uint8_t)(1 + i % 3));
+        uint8_t frame[J288_CMD_LEN];
+        c.status = J288_MODE_FOC;
+        c.pos = (int32_t)(i * 7919) - 500000;
+        c.kp = (uint16_t)(i & 0x7fff);
+        c.kd = (uint16_t)(0x7fff - (i & 0x7fff));
+        c.watchdog = false;
+        TEST_ASSERT_EQUAL_INT(J288_OK, j288_cmd_encode(&c, frame, NULL));
+        for (k = 0; k < sizeof frame; k++)
+            fprintf(log, "%02x", frame[k]);
+        fputc('\n', log);
+        memset(&txn, 0, sizeof txn);
+        TEST_ASSERT_EQUAL_INT(J288_OK, j288_bus_transfer_blocking(&g_bus, &c, &txn));
+        TEST_ASSERT_EQUAL_UINT(c.id, txn.reply.id);
+        TEST_ASSERT_EQUAL_UINT(J288_MODE_FOC, txn.reply.status);
+    }
+    fclose(log);
+    TEST_ASSERT_EQUAL_UINT32(EXACT_TRANSACTIONS * J288_CMD_LEN,
+                             j288_windows_stats(&g_wp)->tx_bytes);
+    TEST_ASSERT_EQUAL_UINT32(EXACT_TRANSACTIONS * J288_REPLY_LEN,
+                             j288_windows_stats(&g_wp)->rx_bytes);
+    TEST_ASSERT_EQUAL_UINT32(0u, j288_windows_stats(&g_wp)->flushed_bytes);
+    TEST_ASSERT_EQUAL_UINT32(0u, j288_bus_stats(&g_bus)->crc_errors);
+}
+
+static void test_scheduler_sweeps(void)
+{
+    j288_sched_t s;
+    uint8_t id;
+    int i;
+    open_port(g_clean, LOADED_MACHINE_MARGIN_US, false);
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_sched_init(&s, &g_bus, NULL));
+    for (id = 1; id <= 3; id++)
+        TEST_ASSERT_EQUAL_INT(J288_OK, j288_sched_enable(&s, id, true));
+    for (i = 0; i < 200; i++)
+        TEST_ASSERT_EQUAL_INT(J288_OK, j288_windows_sweep(&g_wp, &s, 2000000u));
+    TEST_ASSERT_EQUAL_UINT32(200, j288_sched_sweeps(&s));
+    for (id = 1; id <= 3; id++) {
+        const j288_slot_t *sl = j288_sched_slot(&s, id);
+        TEST_ASSERT_TRUE(sl->online);
+        TEST_ASSERT_EQUAL_UINT(id, sl->reply.id);
+        TEST_ASSERT_TRUE(sl->stats.successes >= 190u);
+    }
+}
+
+/* No reply: each transaction ends at its deadline with J288_ERR_TIMEOUT (the read in flight
+ * meanwhile ends on its own timeout, ERROR_TIMEOUT under Wine), and nothing hangs. */
+static void test_timeouts(void)
+{
+    j288_cmd_raw_t c = lock_cmd(1);
+    j288_txn_t txn;
+    int i;
+    open_port(g_silent, 5000u, false);
+    for (i = 0; i < 5; i++)
+        TEST_ASSERT_EQUAL_INT(J288_ERR_TIMEOUT, j288_bus_transfer_blocking(&g_bus, &c, &txn));
+    TEST_ASSERT_EQUAL_UINT32(5u, j288_bus_stats(&g_bus)->timeouts);
+    TEST_ASSERT_EQUAL_UINT32(0u, j288_windows_stats(&g_wp)->rx_bytes);
+    /* An idle port: run() returns at its time, again and again, with the read in flight
+     * (Windows ends it empty every J288_WINDOWS_READ_SLICE_MS; Wine 8 keeps it pending until
+     * a byte comes: both are fine). */
+    for (i = 0; i < 3; i++)
+        TEST_ASSERT_EQUAL_INT(J288_OK,
+                              j288_windows_run(&g_wp, NULL, j288_windows_now_us() + 250000u, 0));
+    TEST_ASSERT_FALSE(j288_windows_offline(&g_wp));
+    /* An id nobody answers on the clean bus: the same (the long margin: the exchange after it
+     * must succeed on a loaded machine too). */
+    j288_windows_close(&g_wp);
+    open_port(g_clean, LOADED_MACHINE_MARGIN_US, false);
+    c.id = 9;
+    TEST_ASSERT_EQUAL_INT(J288_ERR_TIMEOUT, j288_bus_transfer_blocking(&g_bus, &c, &txn));
+    c.id = 2;
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_bus_transfer_blocking(&g_bus, &c, &txn));
+}
+
+static void test_echoing_adapter(void)
+{
+    j288_cmd_raw_t c = lock_cmd(1);
+    j288_txn_t txn;
+    int i;
+    open_port(g_echo, LOADED_MACHINE_MARGIN_US, true);
+    for (i = 0; i < 50; i++) {
+        TEST_ASSERT_EQUAL_INT(J288_OK, j288_bus_transfer_blocking(&g_bus, &c, &txn));
+        TEST_ASSERT_EQUAL_UINT(1, txn.reply.id);
+    }
+    TEST_ASSERT_EQUAL_UINT32(0u, j288_bus_stats(&g_bus)->collisions);
+}
+
+static volatile sig_atomic_t g_stop;
+
+static void test_stop_flag_aborts_run(void)
+{
+    open_port(g_clean, 0, false);
+    g_stop = 1;
+    j288_windows_set_stop_flag(&g_wp, &g_stop);
+    TEST_ASSERT_EQUAL_INT(J288_ERR_ABORTED,
+                          j288_windows_run(&g_wp, NULL, j288_windows_now_us() + 5000000u, 0));
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_windows_run(&g_wp, NULL, j288_windows_now_us() + 1000u,
+                                                    J288_WINDOWS_RUN_IGNORE_STOP));
+}
+
+/* Two ports, one j288_windows_wait_any() (WaitForMultipleObjects over their read events):
+ * the way a host waits for several buses. Both transactions complete, woken by their replies. */
+static void test_two_ports_one_wait(void)
+{
+    j288_windows_t other;
+    j288_bus_t other_bus;
+    j288_windows_options_t o;
+    j288_cmd_raw_t c = lock_cmd(1);
+    uint32_t t0;
+    int rounds = 0;
+    memset(&o, 0, sizeof o);
+    o.echo = true;
+    o.margin_us = LOADED_MACHINE_MARGIN_US;
+    open_port(g_clean, LOADED_MACHINE_MARGIN_US, false);
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_windows_open(&other, g_echo, WINE_MAX_BAUD, &o));
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_windows_bus_init(&other, &other_bus, NULL));
+    t0 = j288_windows_now_us();
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_bus_submit(&g_bus, &c, t0, NULL, NULL));
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_bus_submit(&other_bus, &c, t0, NULL, NULL));
+    j288_windows_t *ports[2];
+    bool ready[2];
+    unsigned woken = 0;
+    ports[0] = &g_wp;
+    ports[1] = &other;
+    while (!(j288_bus_is_idle(&g_bus) && j288_bus_is_idle(&other_bus)) && rounds < 10000) {
+        unsigned k, got = j288_windows_wait_any(ports, 2, 1000u, ready);
+        for (k = 0; k < 2; k++) {
+            if (ready[k]) {
+                TEST_ASSERT_EQUAL_INT(J288_OK, j288_windows_service(ports[k]));
+                woken++;
+            }
+        }
+        TEST_ASSERT_TRUE(got <= 2u);
+        /* (the bus's poll sees its reply deadline itself) */
+        j288_bus_poll(&g_bus, j288_windows_now_us());
+        j288_bus_poll(&other_bus, j288_windows_now_us());
+        rounds++;
+    }
+    TEST_ASSERT_EQUAL_UINT32(1u, j288_bus_stats(&g_bus)->ok);
+    TEST_ASSERT_EQUAL_UINT32(1u, j288_bus_stats(&other_bus)->ok);
+    TEST_ASSERT_TRUE(woken >= 2u); /* both replies woke the wait */
+    /* A closed port is never ready, and the wait is then a bounded sleep. */
+    j288_windows_close(&other);
+    TEST_ASSERT_EQUAL_UINT(0u, j288_windows_wait_any(&ports[1], 1, 1000u, ready));
+    TEST_ASSERT_FALSE(ready[0]);
+    TEST_ASSERT_EQUAL_UINT(0u, j288_windows_wait_any(ports, 0, 1000u, ready));
+}
+
+/* The simulator goes away: the port says the device vanished, once, and then fails fast. */
+static void test_vanished_device(void)
+{
+    j288_cmd_raw_t c = lock_cmd(1);
+    j288_txn_t txn;
+    int rc = J288_OK;
+    int i;
+    open_port(g_vanish, LOADED_MACHINE_MARGIN_US, false);
+    /* The script stops the simulator once it has logged our first frame; bounded. */
+    for (i = 0; i < 200000 && rc != J288_ERR_OFFLINE; i++)
+        rc = j288_bus_transfer_blocking(&g_bus, &c, &txn);
+    TEST_ASSERT_EQUAL_INT(J288_ERR_OFFLINE, rc);
+    TEST_ASSERT_TRUE(j288_windows_offline(&g_wp));
+    TEST_ASSERT_NOT_NULL(strstr(j288_windows_error(&g_wp), "vanished"));
+    TEST_ASSERT_EQUAL_INT(J288_ERR_OFFLINE, j288_bus_transfer_blocking(&g_bus, &c, &txn));
+    TEST_ASSERT_EQUAL_INT(J288_ERR_OFFLINE, j288_windows_port.wait(&g_wp, j288_windows_now_us()));
+    TEST_ASSERT_NULL(j288_windows_read_event(&g_wp));
+}
+
+int main(int argc, char **argv)
+{
+    if (argc != 6) {
+        fprintf(stderr, "usage: %s CLEAN SILENT ECHO VANISH TXLOG (COM names, a file)\n", argv[0]);
+        return 2;
+    }
+    g_clean = argv[1];
+    g_silent = argv[2];
+    g_echo = argv[3];
+    g_vanish = argv[4];
+    g_txlog = argv[5];
+    UNITY_BEGIN();
+    RUN_TEST(test_device_path);
+    RUN_TEST(test_baud_read_back_tolerance);
+    RUN_TEST(test_clock_is_monotonic);
+    RUN_TEST(test_open_errors);
+    RUN_TEST(test_6mbps_refused_when_not_applied);
+    RUN_TEST(test_transactions_byte_exact);
+    RUN_TEST(test_scheduler_sweeps);
+    RUN_TEST(test_timeouts);
+    RUN_TEST(test_echoing_adapter);
+    RUN_TEST(test_stop_flag_aborts_run);
+    RUN_TEST(test_two_ports_one_wait);
+    RUN_TEST(test_vanished_device);
+    return UNITY_END();
+}
