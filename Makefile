@@ -1,7 +1,7 @@
 # j288 - the build and the test suite (GNU Make; CMake in CMakeLists.txt serves consumers).
 #   make            library, tools, example and host tests into build/
 #   make test       every host test          make demo      the CLI against the simulator
-#   make install    PREFIX=/usr/local, DESTDIR honoured
+#   make install    PREFIX=/usr/local, DESTDIR honoured (CMake's install)  make uninstall
 #   make help       the other targets
 # This file holds what every area shares; mk/*.mk add an area each, mk/cpu/*.mk a CPU each.
 
@@ -17,7 +17,10 @@ WARN := -Wall -Wextra -Wpedantic -Wconversion -Wshadow -Werror
 CSTD := -std=c99
 OPT ?= -O2 -g
 CPPFLAGS_LIB := -Ilib/include
-CFLAGS_COMMON := $(CSTD) $(WARN) $(OPT) $(EXTRA_CFLAGS)
+# Every compile writes its object's header dependencies beside it (X.d, included below): touching
+# a header rebuilds the objects that include it, and only those.
+DEPFLAGS := -MMD -MP
+CFLAGS_COMMON := $(CSTD) $(WARN) $(OPT) $(DEPFLAGS) $(EXTRA_CFLAGS)
 LDFLAGS_COMMON := $(EXTRA_LDFLAGS)
 
 BIN := $(BUILD)/bin
@@ -44,7 +47,7 @@ SIM_BIN := $(BIN)/j288-sim
 UNITY := $(BUILD)/unity
 UNITY_OBJ := $(OBJ)/unity/unity.o
 UNITY_DEFS := -DUNITY_INCLUDE_DOUBLE -DUNITY_SUPPORT_64
-UNITY_CFLAGS := -std=c99 -O1 -g -I$(UNITY) $(UNITY_DEFS) $(EXTRA_CFLAGS)
+UNITY_CFLAGS := -std=c99 -O1 -g -I$(UNITY) $(UNITY_DEFS) $(DEPFLAGS) $(EXTRA_CFLAGS)
 
 # Shared test helpers, linked into every host unit test.
 TEST_SUPPORT_SRC := $(sort $(wildcard test/support/*.c))
@@ -64,7 +67,7 @@ TEST_SCRIPTS :=
 TEST_DEPS :=
 ALL_TARGETS := $(LIB_A) $(UNIT_TESTS)
 
-.PHONY: all lib test unit-tests unity clean help install
+.PHONY: all lib test unit-tests unity clean help install uninstall
 .DEFAULT_GOAL := all
 .SECONDARY:
 
@@ -75,9 +78,12 @@ include mk/robot.mk mk/release.mk mk/python.mk mk/dds.mk mk/windows.mk
 
 all: $(ALL_TARGETS)
 
+# The header dependencies of every object built so far (DEPFLAGS).
+-include $(shell find $(BUILD) -name '*.d' 2>/dev/null)
+
 lib: $(LIB_A)
 
-$(OBJ)/lib/%.o: lib/%.c $(LIB_HDR)
+$(OBJ)/lib/%.o: lib/%.c
 	@mkdir -p $(@D)
 	$(CC) $(CPPFLAGS_LIB) $(CFLAGS_COMMON) -c $< -o $@
 
@@ -95,7 +101,7 @@ $(UNITY_OBJ): $(UNITY)/unity.c
 	@mkdir -p $(@D)
 	$(CC) $(UNITY_CFLAGS) -c $< -o $@
 
-$(OBJ)/test/%.o: test/%.c $(TEST_HDR) $(UNITY)/unity.c
+$(OBJ)/test/%.o: test/%.c $(UNITY)/unity.c
 	@mkdir -p $(@D)
 	$(CC) $(TEST_CPPFLAGS) $(CFLAGS_COMMON) -c $< -o $@
 
@@ -104,7 +110,7 @@ $(BUILD)/test/%: $(OBJ)/test/unit/%.o $(TEST_SUPPORT_OBJ) $(UNITY_OBJ) $(LIB_A)
 	$(CC) $(CFLAGS_COMMON) $^ -o $@ $(LDFLAGS_COMMON) -lm
 
 # $(call RUN_TESTS,tests...): the runner, with what the test scripts expect to find.
-TEST_ENV = BUILD=$(BUILD) BIN=$(BIN) CC="$(CC)" J288_CFLAGS="$(CFLAGS_COMMON)" \
+TEST_ENV = BUILD=$(BUILD) BIN=$(BIN) CC="$(CC)" J288_CFLAGS="$(filter-out $(DEPFLAGS),$(CFLAGS_COMMON))" \
     J288_LDFLAGS="$(LDFLAGS_COMMON)"
 RUN_TESTS = $(TEST_ENV) bash scripts/run-tests.sh $(1)
 
@@ -115,22 +121,26 @@ test: $(HOST_TESTS) $(TEST_DEPS)
 	$(call RUN_TESTS,$(HOST_TESTS) $(TEST_SCRIPTS))
 
 # ---- install ---------------------------------------------------------------------------------
-# The static library, the public headers, the CMake package config (the same files
-# `cmake --install` writes, from cmake/*.in) and the two tools.
+# CMake's install (cmake/j288_install.cmake) from $(CMAKE_BUILD) for PREFIX under DESTDIR;
+# uninstall removes what it listed ($(INSTALLED)) and the j288 directories left empty. A program
+# CMake does not build (mk/dds.mk): a prerequisite of install, listed in $(INSTALLED_EXTRA).
 PREFIX ?= /usr/local
 BINDIR ?= $(PREFIX)/bin
-LIBDIR ?= $(PREFIX)/lib
-INCLUDEDIR ?= $(PREFIX)/include
-J288_VERSION := $(shell sed -n 's/.*J288_VERSION_STRING "\(.*\)"/\1/p' lib/include/j288/j288.h)
+CMAKE_BUILD := $(BUILD)/cmake
+INSTALLED := $(CMAKE_BUILD)/installed.txt
+INSTALLED_EXTRA := $(CMAKE_BUILD)/installed-extra.txt
+install:
+	@$(call REQUIRE,cmake,cmake); \
+	 cmake -S . -B $(CMAKE_BUILD) -DCMAKE_INSTALL_PREFIX=$(PREFIX) $(CMAKE_FLAGS) >/dev/null && \
+	 cmake --build $(CMAKE_BUILD) -j2 && DESTDIR=$(DESTDIR) cmake --install $(CMAKE_BUILD) && \
+	 { sed 's|^|$(DESTDIR)|' $(CMAKE_BUILD)/install_manifest.txt; echo; cat $(INSTALLED_EXTRA) 2>/dev/null; } | \
+	     grep . >$(INSTALLED); rm -f $(INSTALLED_EXTRA)
 
-install: $(LIB_A) $(J288_BIN) $(SIM_BIN)
-	install -d $(DESTDIR)$(LIBDIR) $(DESTDIR)$(INCLUDEDIR)/j288 $(DESTDIR)$(BINDIR)
-	install -m 644 $(LIB_A) $(DESTDIR)$(LIBDIR)/
-	install -m 644 $(wildcard lib/include/j288/*.h) $(DESTDIR)$(INCLUDEDIR)/j288/
-	install -m 755 $(J288_BIN) $(SIM_BIN) $(DESTDIR)$(BINDIR)/
-	bash scripts/cmake-config.sh $(DESTDIR)$(LIBDIR)/cmake/j288 $(J288_VERSION) \
-	    $(patsubst $(PREFIX)/%,%,$(LIBDIR)) $(patsubst $(PREFIX)/%,%,$(INCLUDEDIR))
-	@# (mk/release.mk adds the shared library, j288.pc, the port headers, the Python package)
+uninstall:
+	@[ -f $(INSTALLED) ] || { echo "uninstall: $(INSTALLED) missing: nothing installed from here"; exit 1; }
+	tr '\n' '\0' <$(INSTALLED) | xargs -0 rm -f
+	sed -n 's|^\(.*/j288\)/[^/]*$$|\1|p' $(INSTALLED) | sort -u | xargs -r rmdir --ignore-fail-on-non-empty
+	rm $(INSTALLED)
 
 clean:
 	rm -rf $(BUILD)
@@ -139,8 +149,9 @@ help:
 	@echo "make                build library, tools, example and host tests into $(BUILD)/"
 	@echo "make test           every host test (fetches Unity on first use)"
 	@echo "make demo           the CLI against the built-in servo simulator"
-	@echo "make install        static and shared library, headers, CMake package, j288.pc, j288,"
-	@echo "                    j288-sim, Python package (PREFIX, DESTDIR)"
+	@echo "make install        cmake --install: libraries, headers, CMake package, j288.pc, j288,"
+	@echo "                    j288-sim, man pages, completion, Python package (PREFIX, DESTDIR)"
+	@echo "make uninstall      removes what make install installed"
 	@echo "make shared python  libj288.so; and a copy in python/j288 (the Python package in place)"
 	@echo "make arm            lib/ for each Cortex-M, size table, STM32 example, port template"
 	@echo "make windows        j288.exe, j288.dll, libraries and tests for Windows (mingw-w64)"

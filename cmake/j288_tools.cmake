@@ -28,12 +28,13 @@ add_library(j288::robot ALIAS j288_robot)
 file(GLOB _j288_shared_sources CONFIGURE_DEPENDS "${PROJECT_SOURCE_DIR}/lib/src/*.c")
 add_library(j288_shared SHARED ${_j288_shared_sources} "${PROJECT_SOURCE_DIR}/port/linux/j288_linux.c"
             ${_j288_robot_sources})
-target_include_directories(j288_shared PUBLIC "${PROJECT_SOURCE_DIR}/lib/include"
-                           "${PROJECT_SOURCE_DIR}/port/linux" "${PROJECT_SOURCE_DIR}/host")
+target_include_directories(j288_shared PUBLIC
+    "$<BUILD_INTERFACE:${PROJECT_SOURCE_DIR}/lib/include;${PROJECT_SOURCE_DIR}/port/linux;${PROJECT_SOURCE_DIR}/host>"
+    "$<INSTALL_INTERFACE:include;include/j288>")
 get_target_property(_j288_defs j288 INTERFACE_COMPILE_DEFINITIONS)
 target_compile_definitions(j288_shared PUBLIC ${_j288_defs})
 set_target_properties(j288_shared PROPERTIES OUTPUT_NAME j288 VERSION ${PROJECT_VERSION}
-                      SOVERSION ${PROJECT_VERSION_MAJOR})
+                      SOVERSION ${PROJECT_VERSION_MAJOR} EXPORT_NAME robot)
 
 foreach(t j288_robot j288_shared)
     if(J288_YAML_LIB AND J288_YAML_INCLUDE)
@@ -70,3 +71,18 @@ foreach(t j288_linux j288_robot j288_shared j288_cli j288_sim)
         target_link_libraries(${t} PRIVATE ${J288_LIBM})
     endif()
 endforeach()
+
+# Man pages from the tools' --help and --version (Debian's help2man), when it is there.
+find_program(J288_HELP2MAN help2man)
+function(j288_man target name what)
+    add_custom_command(OUTPUT "${name}.1" COMMAND "${J288_HELP2MAN}" --no-info --name "${what}"
+        --output "${PROJECT_BINARY_DIR}/${name}.1" "$<TARGET_FILE:${target}>" DEPENDS ${target} VERBATIM)
+    add_custom_target(${target}_man ALL DEPENDS "${name}.1")
+endfunction()
+if(J288_HELP2MAN)
+    j288_man(j288_cli j288 "Unitree J288/S288 servo bus tool")
+    j288_man(j288_sim j288-sim "simulated J288 servo bus")
+    set(J288_MAN_PAGES "${PROJECT_BINARY_DIR}/j288.1" "${PROJECT_BINARY_DIR}/j288-sim.1")
+else()
+    message(STATUS "j288: help2man not found (Debian: help2man): no man pages")
+endif()

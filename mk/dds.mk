@@ -69,9 +69,11 @@ TEST_SCRIPTS += $(DDS_TESTS)
 test-dds: $(DDS_BIN) $(DDS_TEST_PEER) $(DDS_GOLDEN) $(SIM_BIN)
 	$(call RUN_TESTS,$(DDS_TESTS))
 
+# (beside CMake's install, which does not build the bridge: listed for make uninstall)
 install-dds: $(DDS_BIN)
 	install -d $(DESTDIR)$(BINDIR)
 	install -m 755 $(DDS_BIN) $(DESTDIR)$(BINDIR)/
+	mkdir -p $(CMAKE_BUILD) && echo $(DESTDIR)$(BINDIR)/j288-dds >>$(INSTALLED_EXTRA)
 
 bench-dds: $(DDS_BIN) $(DDS_TEST_PEER) $(SIM_BIN) $(J288_BIN) $(BUILD)/bench/write_stamp.so
 	BUILD=$(BUILD) bash scripts/bench-dds.sh

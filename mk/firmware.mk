@@ -37,17 +37,17 @@ FW_$(1)_STARTUP := $$(FW_$(1)_DEVDIR)/Source/Templates/gcc/startup_$(shell echo 
 FW_$(1)_CC := $(call TC,m4f,CC) $(CPU_m4f_FLAGS) $(CPU_m4f_DEFS) -D$(FW_$(1)_DEVICE) -DUSE_HAL_DRIVER \
     -Iexamples/stm32_hal/$(1) -Iexamples/stm32_hal -Iport/stm32_hal $(CPPFLAGS_LIB) \
     -isystem $$(FW_$(1)_HALDIR)/Inc -isystem $$(FW_$(1)_DEVDIR)/Include -isystem $(ST_DIR)/cmsis_core/Include \
-    -Os -g -ffunction-sections -fdata-sections
+    -Os -g $(DEPFLAGS) -ffunction-sections -fdata-sections
 FW_$(1)_OBJ := $(FW_APP_SRC:%.c=$(BUILD)/firmware/$(1)/obj/%.o) $(BUILD)/firmware/$(1)/obj/board.o \
     $$(patsubst $(ST_DIR)/%.c,$(BUILD)/firmware/$(1)/st/%.o,$$(FW_$(1)_ST_SRC)) $(BUILD)/firmware/$(1)/st/startup.o
 
-$(BUILD)/firmware/$(1)/obj/%.o: %.c $(LIB_HDR) $(wildcard port/stm32_hal/*.h examples/stm32_hal/*.h examples/stm32_hal/nucleo_common/*.h examples/stm32_hal/$(1)/*.h)
+$(BUILD)/firmware/$(1)/obj/%.o: %.c
 	@mkdir -p $$(@D)
 	$$(FW_$(1)_CC) $(CSTD) $(WARN) -c $$< -o $$@
-$(BUILD)/firmware/$(1)/obj/board.o: examples/stm32_hal/$(1)/board.c $(wildcard examples/stm32_hal/*.h examples/stm32_hal/nucleo_common/*.h examples/stm32_hal/$(1)/*.h)
+$(BUILD)/firmware/$(1)/obj/board.o: examples/stm32_hal/$(1)/board.c
 	@mkdir -p $$(@D)
 	$$(FW_$(1)_CC) $(CSTD) $(WARN) -c $$< -o $$@
-$(BUILD)/firmware/$(1)/st/%.o: $(ST_DIR)/%.c $(wildcard examples/stm32_hal/$(1)/*.h) examples/stm32_hal/hal_conf_common.h
+$(BUILD)/firmware/$(1)/st/%.o: $(ST_DIR)/%.c
 	@mkdir -p $$(@D)
 	$$(FW_$(1)_CC) -std=gnu11 -w -c $$< -o $$@
 $(BUILD)/firmware/$(1)/st/startup.o: $$(FW_$(1)_STARTUP)
@@ -99,11 +99,11 @@ HB_APP := test/stm32/hal_bench.c port/stm32_hal/j288_stm32.c $(LIB_SRC) $(call T
 HB_CC = $(call CPU_CC,m4f) -D$(FW_$(HB_$(1)_BOARD)_DEVICE) -DUSE_HAL_DRIVER \
     -Iexamples/stm32_hal/$(HB_$(1)_BOARD) -Iport/stm32_hal -Itest/support $(CPPFLAGS_LIB) \
     -isystem $(ST_DIR)/stm32$(1)xx_hal_driver/Inc -isystem $(ST_DIR)/cmsis_device_$(1)/Include \
-    -isystem $(ST_DIR)/cmsis_core/Include -ffunction-sections -fdata-sections -g
+    -isystem $(ST_DIR)/cmsis_core/Include -ffunction-sections -fdata-sections -g $(DEPFLAGS)
 
 # $(call HB_RULES,opt,family)
 define HB_RULES
-$(BUILD)/bench-stm32-hal/$(2)-$(1)/app/%.o: %.c $(LIB_HDR) $(wildcard port/stm32_hal/*.h test/support/*.h)
+$(BUILD)/bench-stm32-hal/$(2)-$(1)/app/%.o: %.c
 	@mkdir -p $$(@D)
 	$(call HB_CC,$(2)) -$(1) $(CSTD) $(WARN) -c $$< -o $$@
 $(BUILD)/bench-stm32-hal/$(2)-$(1)/st/%.o: $(ST_DIR)/%.c

@@ -120,7 +120,7 @@ SOAK_TXNS ?= 100000
 SOAK_SHORT_TXNS ?= 10000
 SOAK_BIN := $(BUILD)/soak/soak
 
-$(OBJ)/test/soak/%.o: test/soak/%.c $(LIB_HDR) port/linux/j288_linux.h
+$(OBJ)/test/soak/%.o: test/soak/%.c
 	@mkdir -p $(@D)
 	$(CC) $(LINUX_CPPFLAGS) $(CFLAGS_COMMON) -c $< -o $@
 

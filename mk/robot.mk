@@ -5,15 +5,13 @@
 #   test/e2e/host_stack.sh    a second session after a stop, every front end (TEST_SCRIPTS)
 # (the runner, and its one OS-specific call, the wait over every bus: host/j288_host_wait.c)
 ROBOT_OBJ := $(OBJ)/host/j288_robot.o $(OBJ)/host/j288_host_wait.o
-ROBOT_HDR := host/j288_robot.h host/j288_robot_config.h host/j288_host_wait.h \
-    port/linux/j288_linux.h
 
-$(ROBOT_OBJ): $(OBJ)/host/%.o: host/%.c $(ROBOT_HDR) $(LIB_HDR)
+$(ROBOT_OBJ): $(OBJ)/host/%.o: host/%.c
 	@mkdir -p $(@D)
 	$(CC) $(HOST_CPPFLAGS) $(CFLAGS_COMMON) -c $< -o $@
 
 ROBOT_TEST := $(BUILD)/test/test_robot
-$(OBJ)/test/linux/test_robot.o: test/linux/test_robot.c $(ROBOT_HDR) $(TEST_HDR) $(UNITY)/unity.c
+$(OBJ)/test/linux/test_robot.o: test/linux/test_robot.c $(UNITY)/unity.c
 	@mkdir -p $(@D)
 	$(CC) $(TEST_CPPFLAGS) -Iport/linux -Ihost -DJ288_SIM_DEFAULT='"$(SIM_BIN)"' $(CFLAGS_COMMON) -c $< -o $@
 
@@ -27,7 +25,6 @@ ALL_TARGETS += $(ROBOT_TEST)
 TEST_DEPS += $(SIM_BIN)
 
 # The j288 tool's bus commands use the runner (cli_bus.h includes it) and the config reader.
-$(J288_SRC:%.c=$(OBJ)/%.o): $(ROBOT_HDR)
 $(J288_BIN): $(ROBOT_OBJ) $(CONFIG_OBJ)
 # (the archives again after them: the tool's link rule lists its own prerequisites first)
 $(J288_BIN): LDFLAGS_COMMON += $(LINUX_A) $(LIB_A) $(call yaml_var,YAML_LIBS)

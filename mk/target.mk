@@ -26,8 +26,7 @@ TC = $(TC_$(CPU_$(1)_TOOLCHAIN)_$(2))
 # The compiler for a CPU with its core flags and configuration, and the flags of every
 # target build.
 CPU_CC = $(call TC,$(1),CC) $(CPU_$(1)_FLAGS) $(CPU_$(1)_DEFS)
-TGT_CFLAGS := $(CSTD) $(WARN) -ffunction-sections -fdata-sections
-TGT_HDRS := $(STM32_HDRS)
+TGT_CFLAGS := $(CSTD) $(WARN) $(DEPFLAGS) -ffunction-sections -fdata-sections
 # $(call TGT_LINK_FLAGS,cpu,SEMIHOST|BARE,memory map in test/target/)
 TGT_LINK_FLAGS = $(CPU_$(1)_FLAGS) $(call TC,$(1),$(2)_LDFLAGS) -Wl,--gc-sections -Ltest/target -T $(3)
 # $(call QEMU_CMD,cpu,machine:model): the CPU's QEMU with semihosting on.
@@ -41,7 +40,7 @@ REQUIRE_TC = $(foreach t,$(sort $(foreach c,$(1),$(CPU_$(c)_TOOLCHAIN))),\
 # $(call TGT_OBJ_RULE,dir,cpu,flags): objects $(BUILD)/dir/obj/X.o from X.c for cpu, with flags
 # on top of the CPU's and TGT_CFLAGS.
 define TGT_OBJ_RULE
-$(BUILD)/$(1)/obj/%.o: %.c $(TGT_HDRS)
+$(BUILD)/$(1)/obj/%.o: %.c
 	@mkdir -p $$(@D)
 	$(call CPU_CC,$(2)) $(TGT_CFLAGS) $(3) -c $$< -o $$@
 endef
@@ -123,7 +122,7 @@ define TGT_CPU_RULES
 $(eval $(call TGT_OBJ_RULE,target/$(1),$(1),-O2 -g $(TGT_CPPFLAGS)))
 $(BUILD)/target/$(1)/obj/unity.o: $(UNITY)/unity.c
 	@mkdir -p $$(@D)
-	$(call CPU_CC,$(1)) -std=c99 -O2 -g -ffunction-sections -I$(UNITY) $(UNITY_DEFS) -c $$< -o $$@
+	$(call CPU_CC,$(1)) -std=c99 -O2 -g $(DEPFLAGS) -ffunction-sections -I$(UNITY) $(UNITY_DEFS) -c $$< -o $$@
 
 TGT_$(1)_LIBOBJ := $(patsubst %.c,$(BUILD)/target/$(1)/obj/%.o,$(TGT_COMMON_SRC) $(call TC,$(1),STARTUP)) \
     $(BUILD)/target/$(1)/obj/unity.o

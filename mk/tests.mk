@@ -12,13 +12,12 @@
 
 # ---- the j288 tool's helpers -----------------------------------------------------------------
 CLI_TEST := $(BUILD)/test/test_cli_helpers
-$(OBJ)/test/cli/%.o: test/cli/%.c $(J288_HDR) $(TEST_HDR) $(UNITY)/unity.c
+$(OBJ)/test/cli/%.o: test/cli/%.c $(UNITY)/unity.c
 	@mkdir -p $(@D)
 	$(CC) $(TEST_CPPFLAGS) -Itools/j288 $(TOOL_CPPFLAGS) $(CFLAGS_COMMON) -c $< -o $@
 
 # The captured error stream both tool tests check (test/cli/cli_capture.c).
 CLI_CAPTURE_OBJ := $(OBJ)/test/cli/cli_capture.o
-$(CLI_CAPTURE_OBJ) $(OBJ)/test/cli/test_cli_helpers.o $(OBJ)/test/cli/test_cli_joint.o: test/cli/cli_capture.h
 
 $(CLI_TEST): $(OBJ)/test/cli/test_cli_helpers.o $(CLI_CAPTURE_OBJ) \
     $(addprefix $(OBJ)/tools/j288/,args.o hexparse.o json.o frameview.o report.o) $(NUMBER_OBJ) \
@@ -28,8 +27,7 @@ $(CLI_TEST): $(OBJ)/test/cli/test_cli_helpers.o $(CLI_CAPTURE_OBJ) \
 
 # The tool's robot config and joint selection (cli_joint.c), with the bus plumbing it calls.
 CLI_JOINT_TEST := $(BUILD)/test/test_cli_joint
-$(OBJ)/test/cli/test_cli_joint.o: test/cli/test_cli_joint.c $(J288_HDR) $(TEST_HDR) $(UNITY)/unity.c \
-    host/j288_robot_config.h host/j288_robot.h $(YAML_ENV)
+$(OBJ)/test/cli/test_cli_joint.o: test/cli/test_cli_joint.c $(UNITY)/unity.c $(YAML_ENV)
 	@mkdir -p $(@D)
 	$(CC) $(TEST_CPPFLAGS) -Itools/j288 $(TOOL_CPPFLAGS) $(call yaml_var,YAML_CFLAGS) $(CFLAGS_COMMON) -c $< -o $@
 
@@ -75,11 +73,11 @@ FUZZ_LIBS_config := $(call yaml_var,YAML_LIBS)
 $(OBJ)/test/fuzz/fuzz_config.o: host/j288_robot_config.h $(YAML_ENV)
 $(BUILD)/test/fuzz_replay_config: LDFLAGS_COMMON += $(FUZZ_LIBS_config)
 
-$(OBJ)/test/fuzz/replay_%.o: test/fuzz/replay_main.c test/fuzz/fuzz_common.h
+$(OBJ)/test/fuzz/replay_%.o: test/fuzz/replay_main.c
 	@mkdir -p $(@D)
 	$(CC) -Itest/fuzz -DFUZZ_CORPUS_DIR='"test/fuzz/corpus/$*"' $(CFLAGS_COMMON) -c $< -o $@
 
-$(OBJ)/test/fuzz/fuzz_%.o: test/fuzz/fuzz_%.c $(TEST_HDR) $(wildcard test/fuzz/*.h)
+$(OBJ)/test/fuzz/fuzz_%.o: test/fuzz/fuzz_%.c
 	@mkdir -p $(@D)
 	$(CC) $(CPPFLAGS_LIB) -Itest/fuzz -Itest/support $(FUZZ_CPPFLAGS_$*) $(CFLAGS_COMMON) -c $< -o $@
 
@@ -90,21 +88,19 @@ $(foreach n,$(FUZZ_NAMES),$(eval $(BUILD)/test/fuzz_replay_$(n): $(FUZZ_EXTRA_$(
 
 # ---- the Linux port, the simulator's model, the STM32 port -----------------------------------
 LINUX_PORT_TEST := $(BUILD)/test/test_linux_port
-$(OBJ)/test/linux/%.o: test/linux/%.c port/linux/j288_linux.h $(TEST_HDR) $(UNITY)/unity.c
+$(OBJ)/test/linux/%.o: test/linux/%.c $(UNITY)/unity.c
 	@mkdir -p $(@D)
 	$(CC) $(TEST_CPPFLAGS) -Iport/linux -Ihost -DJ288_SIM_DEFAULT='"$(SIM_BIN)"' $(CFLAGS_COMMON) -c $< -o $@
 
 # j288-sim as a child process, for the tests that drive it (test/linux/sim_process.c).
 SIM_PROCESS_OBJ := $(OBJ)/test/linux/sim_process.o
-$(SIM_PROCESS_OBJ) $(OBJ)/test/linux/test_linux_port.o $(OBJ)/test/linux/test_robot.o: test/linux/sim_process.h
 
 $(LINUX_PORT_TEST): $(OBJ)/test/linux/test_linux_port.o $(SIM_PROCESS_OBJ) $(UNITY_OBJ) $(LINUX_A) $(LIB_A)
 	@mkdir -p $(@D)
 	$(CC) $(CFLAGS_COMMON) $^ -o $@ $(LDFLAGS_COMMON) -lm
 
 CONFIG_TEST := $(BUILD)/test/test_robot_config
-$(OBJ)/test/linux/test_robot_config.o: test/linux/test_robot_config.c host/j288_robot_config.h \
-    $(TEST_HDR) $(UNITY)/unity.c $(YAML_ENV)
+$(OBJ)/test/linux/test_robot_config.o: test/linux/test_robot_config.c $(UNITY)/unity.c $(YAML_ENV)
 	@mkdir -p $(@D)
 	$(CC) $(TEST_CPPFLAGS) -Iport/linux -Ihost $(call yaml_var,YAML_CFLAGS) \
 	    -DJ288_EXAMPLE_CONFIG='"examples/robot.yaml"' $(CFLAGS_COMMON) -c $< -o $@
@@ -114,7 +110,7 @@ $(CONFIG_TEST): $(OBJ)/test/linux/test_robot_config.o $(CONFIG_OBJ) $(UNITY_OBJ)
 	$(CC) $(CFLAGS_COMMON) $^ -o $@ $(LDFLAGS_COMMON) $(call yaml_var,YAML_LIBS) -lm
 
 SIM_MODEL_TEST := $(BUILD)/test/test_sim_model
-$(OBJ)/test/sim/%.o: test/sim/%.c tools/j288-sim/servo_model.h $(TEST_HDR) $(UNITY)/unity.c
+$(OBJ)/test/sim/%.o: test/sim/%.c $(UNITY)/unity.c
 	@mkdir -p $(@D)
 	$(CC) $(TEST_CPPFLAGS) -Itools/j288-sim $(CFLAGS_COMMON) -c $< -o $@
 
@@ -128,12 +124,11 @@ $(SIM_MODEL_TEST): $(OBJ)/test/sim/test_sim_model.o $(SIM_MODEL_OBJ) $(UNITY_OBJ
 # Against the F4's USART and DMA registers, the G4's (test_stm32_port_g4), and the F4's under
 # the H7's name (test_stm32_port_h7).
 STM32_TEST_DEFS := -DJ288_STM32_DCACHE=1 -DJ288_STM32_RX_BUF_SIZE=64u -DJ288_STM32_RX_SINK=test_rx_sink
-STM32_HDRS := $(wildcard port/stm32_hal/*.h test/stm32/*.h test/stm32/stub/*.h) $(TEST_HDR)
 STM32_TEST_SRC := port/stm32_hal/j288_stm32.c test/stm32/fake_hal.c test/stm32/test_stm32_port.c
 
 # $(call STM32_HOST_TEST,name,objdir,defs): test_stm32_port built with the stub's defs.
 define STM32_HOST_TEST
-$$(OBJ)/$(2)/%.o: %.c $$(STM32_HDRS) $$(UNITY)/unity.c
+$$(OBJ)/$(2)/%.o: %.c $$(UNITY)/unity.c
 	@mkdir -p $$(@D)
 	$$(CC) $$(TEST_CPPFLAGS) -Iport/stm32_hal -Itest/stm32/stub -Itest/stm32 $$(STM32_TEST_DEFS) $(3) \
 	    $$(CFLAGS_COMMON) -c $$< -o $$@
@@ -157,12 +152,15 @@ HOST_TESTS += $(CLI_TEST) $(foreach v,$(CODEC_CRC_VARIANTS),$(CODEC_CRC_TEST_NAM
     $(STM32_G4_TEST) $(STM32_H7_TEST)
 TEST_SCRIPTS += test/e2e/cli_offline.sh test/e2e/cli_bus.sh tools/vectors/check-drift.sh \
     test/e2e/sim_cli.sh test/e2e/example_linux.sh test/abi/check-abi.sh
-# The joint frame end to end against the simulator's truth (the tool, the config, the sim).
-TEST_SCRIPTS += test/e2e/joint_sim.sh
+# The joint frame end to end against the simulator's truth (the tool, the config, the sim),
+# in three scripts that run side by side (test/e2e/lib_joint.sh).
+TEST_SCRIPTS += test/e2e/joint_seed.sh test/e2e/joint_range.sh test/e2e/joint_refuse.sh
 # j288 top on a terminal (tmux: capture-pane, send-keys) and through a pipe.
 TEST_SCRIPTS += test/e2e/cli_top.sh
 # The scripts' own process helpers (whom they signal, what their cleanup removes).
 TEST_SCRIPTS += test/e2e/lib_sim_check.sh
+# The bash completion (tools/completion/j288.bash) against the tools' --help.
+TEST_SCRIPTS += test/e2e/completion.sh
 TEST_DEPS += $(J288_BIN) $(SIM_BIN) $(EXAMPLE_LINUX) $(LIB_A)
 ALL_TARGETS += $(CLI_TEST) $(FUZZ_REPLAY_TESTS) $(LINUX_PORT_TEST) $(CONFIG_TEST) $(SIM_MODEL_TEST) \
     $(STM32_TEST) $(STM32_G4_TEST) $(STM32_H7_TEST)

@@ -10,7 +10,7 @@
 
 LINUX_CPPFLAGS := $(CPPFLAGS_LIB) -Iport/linux
 HOST_CPPFLAGS := $(LINUX_CPPFLAGS) -Ihost
-$(OBJ)/port/linux/%.o: port/linux/%.c port/linux/j288_linux.h $(LIB_HDR)
+$(OBJ)/port/linux/%.o: port/linux/%.c
 	@mkdir -p $(@D)
 	$(CC) $(LINUX_CPPFLAGS) $(CFLAGS_COMMON) -c $< -o $@
 
@@ -22,9 +22,7 @@ $(LINUX_A): $(OBJ)/port/linux/j288_linux.o
 # The tools are POSIX programs (signals, realpath, popen for gnuplot); lib/ stays pure C99.
 TOOL_CPPFLAGS := $(HOST_CPPFLAGS) -D_XOPEN_SOURCE=700
 J288_SRC := $(sort $(wildcard tools/j288/*.c))
-J288_HDR := $(wildcard tools/j288/*.h)
-$(OBJ)/tools/j288/%.o: tools/j288/%.c $(J288_HDR) $(LIB_HDR) port/linux/j288_linux.h \
-    host/j288_robot_config.h host/j288_number.h
+$(OBJ)/tools/j288/%.o: tools/j288/%.c
 	@mkdir -p $(@D)
 	$(CC) $(TOOL_CPPFLAGS) $(CFLAGS_COMMON) -c $< -o $@
 
@@ -34,7 +32,7 @@ $(J288_BIN): $(J288_SRC:%.c=$(OBJ)/%.o) $(CONFIG_OBJ) $(LINUX_A) $(LIB_A)
 
 # The simulator: servo_model.c (servos and bus, no I/O) and sim_main.c (the pty front end).
 SIM_MODEL_OBJ := $(OBJ)/tools/j288-sim/servo_model.o
-$(OBJ)/tools/j288-sim/%.o: tools/j288-sim/%.c tools/j288-sim/servo_model.h $(LIB_HDR)
+$(OBJ)/tools/j288-sim/%.o: tools/j288-sim/%.c
 	@mkdir -p $(@D)
 	$(CC) $(CPPFLAGS_LIB) -Itools/j288-sim $(CFLAGS_COMMON) -c $< -o $@
 
@@ -43,29 +41,34 @@ $(SIM_BIN): $(SIM_MODEL_OBJ) $(OBJ)/tools/j288-sim/sim_main.o $(LIB_A)
 	$(CC) $(CFLAGS_COMMON) $^ -o $@ $(LDFLAGS_COMMON) -lm
 
 # The robot config reader (host/j288_robot_config.c, not in the archive: it needs
-# libyaml). scripts/libyaml.sh finds libyaml (the system's, else Debian's package fetched into
-# $(BUILD)/libyaml) and writes the flags into $(YAML_ENV); without it the reader builds as
-# stubs that say so. Users: $(CONFIG_OBJ) (the reader and the number syntax it shares with the
-# tool's options, $(NUMBER_OBJ)), and $(call yaml_var,YAML_LIBS) in a recipe.
+# libyaml). pkg-config's yaml-0.1 (Debian's libyaml-dev), checked to link with $(CC), gives the
+# flags written into $(YAML_ENV); without it the reader builds as stubs that say so. Users:
+# $(CONFIG_OBJ) (the reader and the number syntax it shares with the tool's options,
+# $(NUMBER_OBJ)), and $(call yaml_var,YAML_LIBS) in a recipe. Delete the file to look again.
 YAML_ENV := $(BUILD)/libyaml/libyaml.env
 yaml_var = $$(sed -n 's/^$(1)=//p' $(YAML_ENV))
 NUMBER_OBJ := $(OBJ)/host/j288_number.o
 CONFIG_OBJ := $(OBJ)/host/j288_robot_config.o $(NUMBER_OBJ)
 
 $(YAML_ENV):
-	bash scripts/libyaml.sh $(BUILD)/libyaml "$(CC)"
+	@mkdir -p $(@D)
+	@if c=$$(pkg-config --cflags yaml-0.1 2>/dev/null) && l=$$(pkg-config --libs yaml-0.1) && \
+	    printf '#include <yaml.h>\nint main(void) { yaml_parser_t p; return !yaml_parser_initialize(&p); }\n' | \
+	    $(CC) $(EXTRA_CFLAGS) $$c -x c - -x none $(EXTRA_LDFLAGS) $$l -o $(@D)/probe 2>/dev/null; then \
+	    printf 'YAML_CFLAGS=-DJ288_HAVE_LIBYAML %s\nYAML_LIBS=%s\n' "$$c" "$$l" >$@; \
+	else printf 'YAML_CFLAGS=\nYAML_LIBS=\n' >$@; \
+	    echo "libyaml: not found: building without robot config support (install libyaml-dev)"; fi
 
-$(NUMBER_OBJ): host/j288_number.c host/j288_number.h
+$(NUMBER_OBJ): host/j288_number.c
 	@mkdir -p $(@D)
 	$(CC) $(HOST_CPPFLAGS) $(CFLAGS_COMMON) -c $< -o $@
 
-$(OBJ)/host/j288_robot_config.o: host/j288_robot_config.c host/j288_robot_config.h host/j288_number.h \
-    $(YAML_ENV)
+$(OBJ)/host/j288_robot_config.o: host/j288_robot_config.c $(YAML_ENV)
 	@mkdir -p $(@D)
 	$(CC) $(HOST_CPPFLAGS) $(call yaml_var,YAML_CFLAGS) $(CFLAGS_COMMON) -c $< -o $@
 
 EXAMPLE_LINUX := $(BIN)/linux-status
-$(OBJ)/examples/linux/%.o: examples/linux/%.c port/linux/j288_linux.h $(LIB_HDR)
+$(OBJ)/examples/linux/%.o: examples/linux/%.c
 	@mkdir -p $(@D)
 	$(CC) $(TOOL_CPPFLAGS) $(CFLAGS_COMMON) -c $< -o $@
 

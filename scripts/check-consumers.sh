@@ -1,14 +1,14 @@
 #!/usr/bin/env bash
 # usage: scripts/check-consumers.sh   (from anywhere; build trees under $BUILD/consumers)
 # The ways a project takes j288, each built and run (test/cmake_consumer encodes the
-# protocol's worked frame): find_package(j288) after `cmake --install` and after
-# `make install DESTDIR=...` into temporary prefixes (the tools installed with them must run),
+# protocol's worked frame): find_package(j288) after `cmake --install --prefix` and after
+# `make install PREFIX=/usr DESTDIR=...` (the same install; the tools installed with them must
+# run, with their man pages and bash completion), `make uninstall` leaving nothing of it,
 # add_subdirectory, and the library cross-built with cmake/arm-none-eabi.cmake for Cortex-M4F
 # and Cortex-M0 (SI off), and a pkg-config consumer (test/e2e/pkgconfig_consumer.c, against
 # the shared library of both installs). Every install's j288, j288-sim and j288.pc, and the
-# Python package `make install` adds (imported with PYTHONPATH alone), say the header's
-# version. Needs cmake; the cross build needs arm-none-eabi-gcc, the pkg-config consumer
-# pkg-config.
+# Python package (imported with PYTHONPATH alone), say the header's version. Needs cmake; the
+# cross build needs arm-none-eabi-gcc, the pkg-config consumer pkg-config.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/need.sh cmake cmake || exit $(($? == 1 ? 0 : 1))
@@ -51,35 +51,40 @@ EOF
     quiet cmake --build "$root/$name" -j "$jobs"
     echo "$name: $(env -u LD_LIBRARY_PATH "$root/$name/robot_consumer")"
 }
-# installed PREFIX: what an install must hold, then a find_package consumer against it.
+# installed PREFIX LIBDIR: what an install must hold, then a find_package consumer against it.
 installed() {
-    local p=$1 f
+    local p=$1 l=$2 f
     for f in include/j288/j288.h include/j288/j288_robot.h include/j288/j288_host_port.h \
-        lib/libj288.a lib/libj288.so \
-        lib/pkgconfig/j288.pc lib/cmake/j288/j288Config.cmake bin/j288 bin/j288-sim; do
+        $l/libj288.a $l/libj288.so \
+        $l/pkgconfig/j288.pc $l/cmake/j288/j288Config.cmake bin/j288 bin/j288-sim \
+        share/man/man1/j288.1 share/man/man1/j288-sim.1 share/bash-completion/completions/j288; do
         [ -f "$p/$f" ] || { echo "check-consumers: $p/$f not installed" >&2; exit 1; }
     done
+    grep -q '^\.TH J288 "1"' "$p/share/man/man1/j288.1" && grep -q 'calibrate' "$p/share/man/man1/j288.1" ||
+        { echo "check-consumers: $p/share/man/man1/j288.1 is not j288's man page" >&2; exit 1; }
+    out=$(PATH=$p/bin:$PATH bash test/e2e/completion.sh "$p/share/bash-completion/completions/j288" 2>&1) ||
+        { echo "check-consumers: the installed completion: $out" >&2; exit 1; }
     same_version "$p/bin/j288 --version" "$("$p/bin/j288" --version 2>&1)"
     same_version "$p/bin/j288-sim --version" "$("$p/bin/j288-sim" --version 2>&1)"
     consumer "find_package-$(basename "$p")" -DCMAKE_PREFIX_PATH="$p"
     robot_consumer "find_package-robot-$(basename "$p")" -DCMAKE_PREFIX_PATH="$p"
-    pkgconfig_consumer "$p"
+    pkgconfig_consumer "$p" "$l"
 }
 # pkgconfig_consumer PREFIX: build test/e2e/pkgconfig_consumer.c with pkg-config's flags for
 # the j288.pc under PREFIX and run it against that prefix's shared library.
 pkgconfig_consumer() {
-    local p=$1 exe=$root/pkgconfig-$(basename "$1")
+    local p=$1 exe=$root/pkgconfig-$(basename "$1") pc=$1/$2/pkgconfig
     if ! command -v pkg-config >/dev/null 2>&1; then
         bash scripts/need.sh pkg-config pkg-config || { [ $? -eq 1 ] && return 0; exit 1; }
     fi
     quiet ${CC:-cc} -std=c99 -Wall -Wextra -Werror test/e2e/pkgconfig_consumer.c -o "$exe" \
-        $(PKG_CONFIG_PATH="$p/lib/pkgconfig" pkg-config --cflags --libs j288)
+        $(PKG_CONFIG_PATH="$pc" pkg-config --cflags --libs j288)
     local out
-    out=$(LD_LIBRARY_PATH="$p/lib" "$exe")
+    out=$(LD_LIBRARY_PATH="$p/$2" "$exe")
     echo "pkg-config-$(basename "$p"): $out"
-    same_version "$p/lib/pkgconfig/j288.pc" "$(PKG_CONFIG_PATH="$p/lib/pkgconfig" pkg-config --modversion j288)"
+    same_version "$pc/j288.pc" "$(PKG_CONFIG_PATH="$pc" pkg-config --modversion j288)"
 }
-# installed_python PREFIX: the package `make install` puts in PREFIX/lib/python3/dist-packages
+# installed_python PREFIX: the package the install puts in PREFIX/lib/python3/dist-packages
 # loads the shared library of its own prefix, with PYTHONPATH and nothing else set (each of
 # python3 and Debian's /usr/bin/python3 that exists).
 installed_python() {
@@ -95,19 +100,20 @@ installed_python() {
     done
 }
 
-quiet cmake -S . -B "$root/host" -DCMAKE_BUILD_TYPE=RelWithDebInfo
-quiet cmake --build "$root/host" -j "$jobs"
-quiet cmake --install "$root/host" --prefix "$root/cmake-prefix"
-installed "$root/cmake-prefix"
-quiet make -j"$jobs" BUILD="${BUILD:-build}" PREFIX=/usr DESTDIR="$root/make-destdir" install
-installed "$root/make-destdir/usr"
+# make install with Debian's prefix (the libraries in the multiarch directory), the same tree
+# installed with cmake --install --prefix elsewhere, then make uninstall.
+mk=(make -j"$jobs" BUILD="$root/make" PREFIX=/usr DESTDIR="$root/make-destdir")
+quiet "${mk[@]}" install
+libdir=lib/$(gcc -print-multiarch 2>/dev/null || echo .)
+installed "$root/make-destdir/usr" "$libdir"
 installed_python "$root/make-destdir/usr"
-# Both installs hold the same files (`make install` adds the Python package).
-if ! diff <(cd "$root/cmake-prefix" && find . ! -type d | sort) \
-    <(cd "$root/make-destdir/usr" && find . ! -type d ! -path './lib/python3/*' | sort) >&2; then
-    echo "check-consumers: cmake --install and make install differ (<: cmake, >: make)" >&2
-    exit 1
-fi
+quiet cmake --install "$root/make/cmake" --prefix "$root/cmake-prefix"
+installed "$root/cmake-prefix" "$libdir"
+installed_python "$root/cmake-prefix"
+quiet "${mk[@]}" uninstall
+left=$(cd "$root/make-destdir" && find . ! -type d -o -name j288)
+[ -z "$left" ] || { echo "check-consumers: make uninstall left: $left" >&2; exit 1; }
+echo "make uninstall: nothing left of $(wc -l <"$root/make/cmake/install_manifest.txt") files"
 consumer add_subdirectory -DJ288_SOURCE_DIR="$PWD"
 robot_consumer add_subdirectory-robot -DJ288_SOURCE_DIR="$PWD"
 

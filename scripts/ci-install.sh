@@ -26,7 +26,7 @@ packages=(
     # RISC-V (mk/cpu/rv32imac.mk): test-target and bench-bus-target on RV32 under QEMU
     gcc-riscv64-unknown-elf picolibc-riscv64-unknown-elf qemu-system-misc
     python3-pytest python3-numpy    # scripts/python-test.sh (make test: the Python package)
-    pkg-config                      # scripts/check-consumers.sh (a pkg-config consumer); mk/dds.mk
+    pkg-config                      # libyaml (mk/tools.mk); check-consumers.sh; mk/dds.mk
     tmux                            # test/e2e/cli_top.sh: j288 top on a terminal (required
                                     # under CI=true, skipped with a notice elsewhere)
     cyclonedds-dev cyclonedds-tools # j288-dds (mk/dds.mk): libddsc, its pkg-config file, idlc
@@ -34,6 +34,9 @@ packages=(
     # Windows (mk/windows.mk): make windows cross-builds with mingw-w64, make test-windows runs
     # the programs under Wine (64-bit only: no i386 packages, no X server; ~200 MB)
     gcc-mingw-w64-x86-64-win32 wine wine64
+    help2man                        # the man pages of j288 and j288-sim (cmake/j288_tools.cmake)
+    python3-venv python3-setuptools python3-wheel python3-build  # make pip-check (no network)
+    debhelper dpkg-dev fakeroot lintian  # make deb, make deb-check (debian/)
 )
 
 missing=()

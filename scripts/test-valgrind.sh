@@ -7,6 +7,7 @@
 # reports included). The golden-vector checks there take every 20th vector (all of them run
 # in `make test`).
 set -uo pipefail
+export TEST_TIME_SCALE=${TEST_TIME_SCALE:-4} # memcheck runs the programs some 10-50 times slower
 binaries=$1 scripts=$2
 TEST_WRAPPER=$VALGRIND bash scripts/run-tests.sh $binaries
 rc=$?

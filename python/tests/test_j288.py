@@ -22,6 +22,9 @@ import j288
 
 ROOT = Path(__file__).resolve().parents[2]
 SIM = os.environ.get("J288_SIM", str(ROOT / "build" / "bin" / "j288-sim"))
+# Where the package under test was imported from (python/, or an installed one: pip-check),
+# for the child interpreters.
+PKG_PATH = str(Path(j288.__file__).resolve().parents[1])
 MARGIN = 250000
 # A USB adapter's margin, where a check wants short waits; the long one when the simulator
 # runs under valgrind (make test-valgrind), which answers later than 20 ms.
@@ -113,7 +116,7 @@ def test_pinned_scan_command(sims) -> None:
     sim = sims("2,7")
     out = subprocess.run(
         [sys.executable, "-c", f"import j288; print(sorted(j288.Bus({sim.pty!r}).scan()))"],
-        env=dict(os.environ, PYTHONPATH=str(ROOT / "python")), capture_output=True, text=True,
+        env=dict(os.environ, PYTHONPATH=PKG_PATH), capture_output=True, text=True,
         timeout=120)
     assert out.returncode == 0, out.stderr
     assert out.stdout == "[2, 7]\n"
@@ -391,7 +394,7 @@ def test_sigterm_stops_the_servos(sims) -> None:
                 bus.command(1, pos=p, kp=20, kd=1)
         """)
     proc = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE,
-                            env=dict(os.environ, PYTHONPATH=str(ROOT / "python")), text=True)
+                            env=dict(os.environ, PYTHONPATH=PKG_PATH), text=True)
     try:
         assert proc.stdout is not None and proc.stdout.readline() == "ready\n"
         assert sim.logged(" id=1 status=1 wd=1")
@@ -425,7 +428,7 @@ def test_ctrl_c_stops_every_bus(sims, tmp_path: Path, loop: str) -> None:
             LOOP
         """).replace("LOOP", loop)
     proc = subprocess.Popen([sys.executable, "-c", script],
-                            env=dict(os.environ, PYTHONPATH=str(ROOT / "python")),
+                            env=dict(os.environ, PYTHONPATH=PKG_PATH),
                             stderr=subprocess.PIPE, text=True)
     try:
         for _ in range(600):

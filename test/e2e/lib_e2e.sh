@@ -23,10 +23,15 @@ e2e_fail() { # name reason
     echo "$E2E_NAME:$1:FAIL: $2"
 }
 
-# Run a command with a time bound, capturing stdout, stderr and status into E2E_OUT,
-# E2E_ERR, E2E_RC.
+# e2e_scaled N: N times TEST_TIME_SCALE (a whole number, default 1; README "Running the tests"),
+# for every time bound and poll count, so that a slow machine or valgrind raises them all.
+TEST_TIME_SCALE=${TEST_TIME_SCALE:-1}
+e2e_scaled() { echo $(($1 * TEST_TIME_SCALE)); }
+
+# Run a command with a time bound (E2E_CMD_TIMEOUT seconds, default 20, scaled), capturing
+# stdout, stderr and status into E2E_OUT, E2E_ERR, E2E_RC.
 e2e_run() {
-    timeout -k 2 "${E2E_CMD_TIMEOUT:-20}" "$@" >"$E2E_TMP/out" 2>"$E2E_TMP/err"
+    timeout -k 2 "$(e2e_scaled "${E2E_CMD_TIMEOUT:-20}")" "$@" >"$E2E_TMP/out" 2>"$E2E_TMP/err"
     E2E_RC=$?
     E2E_OUT=$(cat "$E2E_TMP/out")
     E2E_ERR=$(cat "$E2E_TMP/err")

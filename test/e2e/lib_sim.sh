@@ -56,7 +56,7 @@ stop_sim() {
 # wait_exit PID [SECONDS]: wait up to SECONDS (default 30) for PID to exit, returning as soon
 # as it does; its exit status, or 124 on time-out.
 wait_exit() {
-    for _ in $(seq 1 $((${2:-30} * 20))); do
+    for _ in $(seq 1 $(e2e_scaled $((${2:-30} * 20)))); do
         if ! kill -0 "$1" 2>/dev/null; then wait "$1"; return $?; fi
         sleep 0.05
     done
@@ -73,7 +73,7 @@ sim_start_linked() {
         >"$SIM_DIR/$name.out" 2>"$SIM_DIR/$name.err" &
     SIM_PID=$!
     SIM_PIDS+=("$SIM_PID")
-    for _ in $(seq 1 600); do
+    for _ in $(seq 1 "$(e2e_scaled 600)"); do
         [ -L "$DEV" ] && [ -s "$SIM_DIR/$name.out" ] && return 0
         sleep 0.05
     done
@@ -92,7 +92,7 @@ start_sims() {
         eval "SIM_PID_$k=$!"
     done
     for k in $(seq 0 $((n - 1))); do
-        for _ in $(seq 1 600); do [ -s "$SIM_DIR/pty.$k" ] && break; sleep 0.05; done
+        for _ in $(seq 1 "$(e2e_scaled 600)"); do [ -s "$SIM_DIR/pty.$k" ] && break; sleep 0.05; done
     done
 }
 
@@ -117,7 +117,7 @@ truth_now() {
     local seq i
     seq=$(truth_seq)
     kill -s WINCH "$SIM_PID"
-    for i in $(seq 1 400); do
+    for i in $(seq 1 "$(e2e_scaled 400)"); do
         [ "$(truth_seq)" != "$seq" ] && return 0
         sleep 0.05
     done
@@ -128,14 +128,14 @@ truth_val() {
     awk -v id="$1" -v key="$2" '$1 == "id=" id {
         for (i = 2; i <= NF; i++) { n = index($i, "="); if (substr($i, 1, n - 1) == key) print substr($i, n + 1) } }' "$TRUTH"
 }
-# near A B TOL [PERIOD]: |A - B| <= TOL, modulo PERIOD when given (angles).
+# near A B TOL [PERIOD]: |A - B| <= TOL, modulo PERIOD when given (angles); a value that is
+# not a number fails.
 near() {
-    python3 -c '
-import math, sys
-a, b, tol = float(sys.argv[1]), float(sys.argv[2]), float(sys.argv[3])
-d = a - b
-if len(sys.argv) > 4:
-    p = float(sys.argv[4]); d = math.remainder(d, p)
-sys.exit(0 if abs(d) <= tol else 1)' "$@" || { echo "|$1 - $2| > $3${4:+ (mod $4)}"; return 1; }
+    awk -v a="$1" -v b="$2" -v tol="$3" -v p="${4:-0}" 'BEGIN {
+        num = "^[-+]?([0-9]+[.]?[0-9]*|[.][0-9]+)([eE][-+]?[0-9]+)?$"
+        if (a !~ num || b !~ num) exit 1
+        d = a - b
+        if (p > 0) { k = d / p; d -= p * (k >= 0 ? int(k + 0.5) : -int(-k + 0.5)) }
+        exit !(d <= tol && -d <= tol) }' || { echo "|$1 - $2| > $3${4:+ (mod $4)}"; return 1; }
 }
 TWO_PI=6.283185307179586

@@ -191,8 +191,9 @@ t_power_cycle_signal() {
     rm -f "$f"
     start_sim --ids 1,2 --truth "$f" --power-off-ms 200 --exit-after 120 || return 1
     k0=$(truth_val "$f" 1 k)
+    # (watchdog off: a loaded machine that starves the tool for 1 s must not trip it here)
     timeout 30 "$J288" --port "$SIM_PTY" move --id 1 --pos 20 --side rotor --speed 50 --duration 1.5 \
-        --retries 1 --margin-us 250000 >/dev/null 2>"$E2E_TMP/st" || { echo "move failed: $(cat "$E2E_TMP/st")"; return 1; }
+        --watchdog off --retries 1 --margin-us 250000 >/dev/null 2>"$E2E_TMP/st" || { echo "move failed: $(cat "$E2E_TMP/st")"; return 1; }
     status_json 1 || return 1
     [ "$(json_int pos_raw)" -gt 32768 ] || { echo "the move did not turn the rotor: $(json_int pos_raw)"; return 1; }
     kill -s PWR "$SIM_PID"
@@ -200,7 +201,9 @@ t_power_cycle_signal() {
     wait_file "$f" 'reason=power-on$' || { echo "no power-on truth"; return 1; }
     [ "$(truth_val "$f" 1 powered)" = 1 ] && [ "$(truth_val "$f" 1 cycles)" = 1 ] &&
         [ "$(truth_val "$f" 2 cycles)" = 1 ] || { cat "$f"; return 1; }
-    [ "$(truth_val "$f" 1 k)" -gt $((k0 + 1)) ] || { echo "k $k0 -> $(truth_val "$f" 1 k)"; return 1; }
+    # (the rotor was past one turn, pos_raw above: at least that turn is lost; on a loaded
+    # machine the move may end short of its 3 turns)
+    [ "$(truth_val "$f" 1 k)" -gt "$k0" ] || { echo "k $k0 -> $(truth_val "$f" 1 k)"; return 1; }
     status_json 1 || { echo "status failed after the power cycle: $(cat "$E2E_TMP/st")"; return 1; }
     [ "$(json_int pos_raw)" -ge 0 ] && [ "$(json_int pos_raw)" -lt 32768 ] || { echo "pos_raw $(json_int pos_raw)"; return 1; }
     [ "$(json_int pos_raw)" = "$(pos_raw_of "$(truth_val "$f" 1 p)")" ] &&
