@@ -249,7 +249,7 @@ static int open_bus_ids(j288_robot_t *r, const cli_bus_opts_t *o, const top_args
         j288_robot_joint_stats_t js;
         (void)j288_robot_joint_stats(r, j, &js);
         if (js.servo.successes != 0u)
-            answered |= 1ul << (unsigned)j288_robot_joint_id(r, j);
+            answered |= (uint32_t)1u << (unsigned)j288_robot_joint_id(r, j);
     }
     j288_robot_close(r);
     if (cli_stop_signal != 0)
