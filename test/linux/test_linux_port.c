@@ -83,6 +83,8 @@ void setUp(void)
 void tearDown(void)
 {
     j288_linux_close(&g_lp);
+    if (g_sim > 0)
+        (void)kill(g_sim, SIGCONT); /* a test that failed with it frozen */
     (void)sim_stop();
     (void)unlink(g_log);
 }
@@ -430,27 +432,77 @@ static void test_injected_faults_give_bus_errors(void)
         TEST_ASSERT_EQUAL_INT(J288_OK, j288_bus_transfer_blocking(&g_bus, &c, NULL));
 }
 
-static void test_late_replies_never_credited(void)
+/* Whether process pid is stopped (state T in /proc/pid/stat). */
+static bool process_stopped(pid_t pid)
 {
-    j288_cmd_raw_t c = lock_cmd(1);
+    char path[64], line[256];
+    const char *state;
+    FILE *f;
+    bool stopped = false;
+    (void)snprintf(path, sizeof path, "/proc/%ld/stat", (long)pid);
+    f = fopen(path, "r");
+    if (f == NULL)
+        return false;
+    if (fgets(line, sizeof line, f) != NULL) {
+        state = strrchr(line, ')'); /* the command name may hold spaces */
+        stopped = (state != NULL) && (state[1] == ' ') && (state[2] == 'T');
+    }
+    (void)fclose(f);
+    return stopped;
+}
+
+/* SIGSTOP to the simulator, returning once it is stopped (bounded: 30 s): from then on it
+ * cannot answer, however long this host is held up. */
+static void freeze_sim(void)
+{
+    const struct timespec ms = {0, 1000000L};
     int i;
+    TEST_ASSERT_EQUAL_INT(0, kill(g_sim, SIGSTOP));
+    for (i = 0; i < 30000 && !process_stopped(g_sim); i++)
+        (void)nanosleep(&ms, NULL);
+    TEST_ASSERT_TRUE_MESSAGE(process_stopped(g_sim), "the simulator did not stop");
+}
+
+static void thaw_sim(void)
+{
+    TEST_ASSERT_EQUAL_INT(0, kill(g_sim, SIGCONT));
+}
+
+/* The bytes the bus and the port have discarded as stale, once there are want of them or
+ * 30 s have passed. */
+static uint32_t wait_discarded(uint32_t want)
+{
     uint32_t discarded = 0;
-    /* Every reply comes 300 ms late, far after the 10 ms margin (only a host frozen for that
-     * long between the deadline and reading could see one in time): each must count as
-     * stale (by the bus, or by the port before a transmit), never as a reply. */
-    sim_start("--late", "1", "--late-us", "300000", NULL);
-    open_sim_port();
-    for (i = 0; i < 6; i++)
-        TEST_ASSERT_EQUAL_INT(J288_ERR_TIMEOUT, j288_bus_transfer_blocking(&g_bus, &c, NULL));
-    /* Until all six have arrived (bounded: 30 s). */
-    for (i = 0; i < 300 && discarded < 6u * J288_REPLY_LEN; i++) {
+    int i;
+    for (i = 0; i < 300 && discarded < want; i++) {
         (void)j288_linux_run(&g_lp, NULL, j288_linux_now_us() + 100000u, 0);
         discarded = j288_bus_stats(&g_bus)->stale_bytes + j288_linux_stats(&g_lp)->flushed_bytes;
     }
-    TEST_ASSERT_EQUAL_UINT32(6u * J288_REPLY_LEN, discarded);
+    return discarded;
+}
+
+static void test_late_replies_never_credited(void)
+{
+    j288_cmd_raw_t c = lock_cmd(1);
+    uint32_t i;
+    /* Every reply comes late: the simulator is stopped while a transfer waits (so no reply
+     * can come before its deadline, however long this host is held up: a reply merely 300 ms
+     * late is found in time by a host frozen that long before it reads, and then rightly
+     * taken), and once resumed answers 300 ms after reading the command. Each must count as
+     * stale (by the bus, or by the port before a transmit), never as a reply. */
+    sim_start("--late", "1", "--late-us", "300000", NULL);
+    open_sim_port();
+    for (i = 1; i <= 6; i++) {
+        freeze_sim();
+        TEST_ASSERT_EQUAL_INT(J288_ERR_TIMEOUT, j288_bus_transfer_blocking(&g_bus, &c, NULL));
+        thaw_sim();
+        TEST_ASSERT_EQUAL_UINT32(i * J288_REPLY_LEN, wait_discarded(i * J288_REPLY_LEN));
+    }
     TEST_ASSERT_EQUAL_UINT32(0, j288_bus_stats(&g_bus)->ok);
     /* One more transfer: the stale bytes do not answer it either. */
+    freeze_sim();
     TEST_ASSERT_EQUAL_INT(J288_ERR_TIMEOUT, j288_bus_transfer_blocking(&g_bus, &c, NULL));
+    thaw_sim();
     TEST_ASSERT_EQUAL_UINT32(0, j288_bus_stats(&g_bus)->ok);
 }
 
