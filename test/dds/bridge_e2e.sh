@@ -57,7 +57,7 @@ t_command_moves_a_joint() {
     wait_truth 0 2 0.5 20 || { kill $p; return 1; }
     kill $p; wait $p 2>/dev/null
     wait_err 'joint leg0_2: no command for 100 ms' || return 1
-    sleep 0.3 # held: at rest
+    comes_to_rest 0 2 || return 1 # held: at rest
     "$PEER" states >"$SIM_DIR/states" || return 1
     local got want
     got=$(awk '$1 == "leg0_2" { print $2 }' "$SIM_DIR/states")
@@ -71,8 +71,7 @@ t_silence_holds() {
     wait_err 'joint leg1_1: no command for 100 ms: holding where it is' || return 1
     b=$(truth 1 1) || return 1
     near "$a" "$b" 0.1 && { echo "the speed command did not move leg1_1 ($a -> $b)"; return 1; }
-    sleep 0.5 # it was moving: let the hold bring it to rest
-    still 1 1 || return 1
+    comes_to_rest 1 1 || return 1 # it was moving: the hold brings it to rest
     "$PEER" diag >"$SIM_DIR/diag" || return 1
     grep -q '^j288-dds: joint leg1_1|command=timed out' "$SIM_DIR/diag" &&
         grep -q '^status j288-dds: bridge|1|' "$SIM_DIR/diag"

@@ -161,6 +161,17 @@ still() {
     near "$a" "$b" 0.005 || { echo "servo $2 on simulator $1 moved: $a -> $b"; return 1; }
 }
 
+# comes_to_rest K ID: servo ID of simulator K is still (as above) within about 10 s: a held
+# joint that was moving settles, however slowly a loaded machine runs the simulator; one that
+# keeps moving fails with still's message.
+comes_to_rest() {
+    local i
+    for i in $(seq 1 19); do
+        still "$1" "$2" >/dev/null && return 0
+    done
+    still "$1" "$2"
+}
+
 # locked_all K...: simulator K's log got the broadcast lock (id 15, status 0) with the
 # watchdog bit 0 (a locked servo needs no watchdog; the runner's policy).
 locked_all() {

@@ -37,8 +37,7 @@ t_lowcmd_moves_a_motor() {
 }
 t_silence_holds() {
     wait_err 'joint leg0_2: no command for 100 ms: holding where it is' || return 1
-    sleep 0.3
-    still 0 2
+    comes_to_rest 0 2
 }
 # bad_lowcmd CAUSE ARGS...: sent 10 times, refused, reported once, motor 2 does not move.
 bad_lowcmd() {
