@@ -185,17 +185,23 @@ static void print_exchange_stats(int i, int rc, uint32_t took_us)
            (unsigned long)bs->stale_bytes);
 }
 
-/* Every reply byte the simulator sent, read or dropped as stale: waits (bounded) for the late
- * reply of a last retried exchange, then checks that none is missing or extra. */
-static void assert_every_reply_byte_accounted(uint32_t replies)
+/* Every byte the simulator sent back (bytes_each per frame sent: a reply, and our echo on an
+ * echoing line), read or dropped as stale: waits (bounded) for the late reply of a last
+ * retried exchange, then checks that none is missing or extra. */
+static void assert_every_byte_back_accounted(uint32_t frames, uint32_t bytes_each)
 {
     const j288_windows_stats_t *ps = j288_windows_stats(&g_wp);
     int round;
-    for (round = 0; round < 400 && ps->rx_bytes + ps->flushed_bytes < replies * J288_REPLY_LEN;
+    for (round = 0; round < 400 && ps->rx_bytes + ps->flushed_bytes < frames * bytes_each;
          round++)
         TEST_ASSERT_EQUAL_INT(J288_OK,
                               j288_windows_run(&g_wp, NULL, j288_windows_now_us() + 10000u, 0));
-    TEST_ASSERT_EQUAL_UINT32(replies * J288_REPLY_LEN, ps->rx_bytes + ps->flushed_bytes);
+    TEST_ASSERT_EQUAL_UINT32(frames * bytes_each, ps->rx_bytes + ps->flushed_bytes);
+}
+
+static void assert_every_reply_byte_accounted(uint32_t replies)
+{
+    assert_every_byte_back_accounted(replies, J288_REPLY_LEN);
 }
 
 /* Many transactions with changing contents: every one answered by its servo (a late one
@@ -334,17 +340,39 @@ static void test_timeouts(void)
     TEST_ASSERT_EQUAL_INT(J288_OK, j288_bus_transfer_blocking(&g_bus, &c, &txn));
 }
 
+/* On a loaded machine the echo too can come back after the deadline, which the bus reports
+ * as a collision ("our own frame never came back whole") when the exchange has lasted the
+ * whole margin: such a late exchange is retried and counted, like a late reply in the
+ * byte-exact test. A differing echo ends the exchange when it comes, within the margin, and
+ * fails the test. */
 static void test_echoing_adapter(void)
 {
     j288_cmd_raw_t c = lock_cmd(1);
     j288_txn_t txn;
-    int i;
+    int i, rc, attempt;
+    uint32_t sent = 0, late = 0;
     open_port(g_echo, LOADED_MACHINE_MARGIN_US, true);
+    time_the_writes();
     for (i = 0; i < 50; i++) {
-        TEST_ASSERT_EQUAL_INT(J288_OK, j288_bus_transfer_blocking(&g_bus, &c, &txn));
+        rc = J288_ERR_TIMEOUT;
+        for (attempt = 0; attempt <= LATE_RETRIES_MAX && rc != J288_OK; attempt++) {
+            memset(&txn, 0, sizeof txn);
+            rc = j288_bus_transfer_blocking(&g_bus, &c, &txn);
+            sent++;
+            if (rc != J288_OK)
+                print_exchange_stats(i, rc, txn.latency_us);
+            if (!(rc == J288_ERR_TIMEOUT ||
+                  (rc == J288_ERR_COLLISION && txn.latency_us >= LOADED_MACHINE_MARGIN_US)))
+                break;
+            late++;
+        }
+        TEST_ASSERT_EQUAL_INT(J288_OK, rc);
         TEST_ASSERT_EQUAL_UINT(1, txn.reply.id);
     }
-    TEST_ASSERT_EQUAL_UINT32(0u, j288_bus_stats(&g_bus)->collisions);
+    TEST_ASSERT_EQUAL_UINT32(late, j288_bus_stats(&g_bus)->collisions +
+                                       j288_bus_stats(&g_bus)->timeouts);
+    assert_every_byte_back_accounted(sent, J288_CMD_LEN + J288_REPLY_LEN);
+    TEST_ASSERT_EQUAL_UINT32(0u, j288_bus_stats(&g_bus)->crc_errors);
 }
 
 static volatile sig_atomic_t g_stop;
