@@ -30,11 +30,15 @@ unset DISPLAY WAYLAND_DISPLAY
 
 tmp=$(mktemp -d /tmp/j288-wine.XXXXXX)
 SIM_DIR=$tmp BIN=$(dirname "$SIM")
+# lib_sim.sh scales its bounds with lib_e2e.sh's e2e_scaled (TEST_TIME_SCALE).
+# shellcheck source=test/e2e/lib_e2e.sh
+. test/e2e/lib_e2e.sh
 # shellcheck source=test/e2e/lib_sim.sh
 . test/e2e/lib_sim.sh
 stop_wine() {
     local rc=$?
     sim_cleanup TERM
+    e2e_cleanup_tmp
     rm -f "$WINEPREFIX"/dosdevices/com[5-8]
     wineserver -k 2>/dev/null || true
     wineserver -w 2>/dev/null || true
