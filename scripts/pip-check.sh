@@ -33,8 +33,11 @@ out=$(cd / && env -u J288_LIB "$root/v/bin/python" -c \
 echo "installed package scans j288-sim: $out"
 
 # pytest from its own directory, so that only the installed package can be imported.
-(cd python/tests && env -u J288_LIB PYTHONPATH= J288_SIM="$sim" PYTHONDONTWRITEBYTECODE=1 \
-    "$root/v/bin/python" -m pytest -q -p no:cacheprovider --import-mode=append . | tail -n 1)
+# A failure shows its report; a pass, the summary line.
+(cd python/tests && env -u J288_LIB PYTHONPATH= J288_SIM="$sim" BIN="$(dirname "$sim")" PYTHONDONTWRITEBYTECODE=1 \
+    "$root/v/bin/python" -m pytest -q -p no:cacheprovider --import-mode=append . \
+    >"$root/pytest.log" 2>&1) || { cat "$root/pytest.log" >&2; exit 1; }
+tail -n 1 "$root/pytest.log"
 
 quiet /usr/bin/python3 -m build --wheel --no-isolation --outdir "$root/dist" .
 whl=$(ls "$root"/dist/j288-"$version"-*.whl)
