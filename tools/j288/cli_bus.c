@@ -15,10 +15,11 @@ unsigned cli_watchdog_trips = 0;
  * (the port's default). */
 #define PTY_MARGIN_US 5000u
 /* A lock is re-sent until its reply confirms it: at least LOCK_ATTEMPTS times, and for up to
- * LOCK_CONFIRM_US after the lock pass began. A fixed number of attempts (three reply budgets:
- * 15 ms on a pty) was too short for a starved simulator, or a busy computer's USB adapter, to
- * answer, though it answers a moment later; the time bound still reports a servo that never
- * does. Half a second: well inside the servo's own 1 s watchdog. */
+ * LOCK_CONFIRM_US after the lock pass began. A fixed number of attempts (three transactions
+ * of one to four reply budgets: 15-60 ms on a pty) was too short for a starved simulator, or
+ * a busy computer's USB adapter, to answer, though it answers a moment later; the time bound
+ * still reports a servo that never does. Half a second: well inside the servo's own 1 s
+ * watchdog. */
 #define LOCK_ATTEMPTS 3
 #define LOCK_CONFIRM_US 500000u
 
