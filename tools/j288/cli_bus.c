@@ -14,7 +14,14 @@ unsigned cli_watchdog_trips = 0;
  * machine can stall either side for milliseconds; a USB adapter needs its latency timer
  * (the port's default). */
 #define PTY_MARGIN_US 5000u
+/* A lock is re-sent until its reply confirms it: at least LOCK_ATTEMPTS times, and for up to
+ * LOCK_CONFIRM_US after the lock pass began. A fixed number of attempts (three transactions
+ * of one to four reply budgets: 15-60 ms on a pty) was too short for a starved simulator, or
+ * a busy computer's USB adapter, to answer, though it answers a moment later; the time bound
+ * still reports a servo that never does. Half a second: well inside the servo's own 1 s
+ * watchdog. */
 #define LOCK_ATTEMPTS 3
+#define LOCK_CONFIRM_US 500000u
 
 void cli_bus_opts_init(cli_bus_opts_t *o, const cli_global_t *g)
 {
@@ -245,8 +252,15 @@ void cli_lock_cmd(uint8_t id, j288_cmd_raw_t *cmd)
     cmd->watchdog = false;
 }
 
+/* Whether a lock not yet confirmed is sent once more (see LOCK_CONFIRM_US). */
+static bool lock_keeps_trying(int attempts, uint32_t start_us)
+{
+    return attempts < LOCK_ATTEMPTS || j288_linux_now_us() - start_us < LOCK_CONFIRM_US;
+}
+
 int cli_bus_lock_driven(cli_bus_t *b)
 {
+    uint32_t start;
     int silent = 0;
     uint8_t id;
     j288_cmd_raw_t cmd;
@@ -254,13 +268,14 @@ int cli_bus_lock_driven(cli_bus_t *b)
     if (cli_bus_gone(b)) {
         return b->driven != 0u ? 1 : 0;
     }
+    start = j288_linux_now_us();
     for (id = 0; id <= J288_MAX_ID; id++) {
         int attempt, rc = J288_ERR_TIMEOUT;
         if ((b->driven & (1u << id)) == 0u) {
             continue;
         }
         cli_lock_cmd(id, &cmd);
-        for (attempt = 0; attempt < LOCK_ATTEMPTS && rc != J288_OK; attempt++) {
+        for (attempt = 0; rc != J288_OK && lock_keeps_trying(attempt, start); attempt++) {
             rc = j288_robot_transfer(b->robot, 0, &cmd, NULL, NULL);
             if (rc == J288_ERR_OFFLINE) {
                 return 1;

@@ -129,9 +129,11 @@ int cli_bus_transfer(cli_bus_t *b, const j288_cmd_raw_t *cmd, j288_txn_t *txn);
  * watchdog, and the bit 0 also clears a tripped one. */
 void cli_lock_cmd(uint8_t id, j288_cmd_raw_t *cmd);
 
-/* Send lock to every id in b->driven (each confirmed by its reply, re-sent up to three
- * times), then, if any stayed silent, a broadcast lock. Runs even after a stop signal.
- * Returns the number of servos that did not confirm. */
+/* Send lock to every id in b->driven (each confirmed by its reply; one not confirmed is
+ * re-sent at least three times and until 0.5 s after the call began, so that a slow answer
+ * from a busy machine or adapter is still taken), then, if any stayed silent, a broadcast
+ * lock. Runs even after a stop signal. Takes at most 0.5 s plus three transactions per
+ * silent servo. Returns the number of servos that did not confirm. */
 int cli_bus_lock_driven(cli_bus_t *b);
 
 /* A one-line description of a failed transaction for id: "no reply from servo 3 (timeout)"
