@@ -334,7 +334,8 @@ def test_bus_pos_is_the_cli_s_joint_angle(sims) -> None:
     """Bus.status(id).pos is the joint angle, the number `j288 status --id N --json` gives as
     joint_pos (it counted from where the rotor woke up)."""
     sim = sims("1", "--start-angle", "1:2.5")
-    out = subprocess.run([str(J288_BIN), "--port", sim.pty, "status", "--id", "1", "--json"],
+    out = subprocess.run([str(J288_BIN), "--port", sim.pty, "status", "--id", "1", "--json",
+                          "--margin-us", str(MARGIN)],
                          capture_output=True, text=True, timeout=60)
     assert out.returncode == 0, out.stderr
     cli = float(re.search(r'"joint_pos": ([-0-9.e]+)', out.stdout).group(1))

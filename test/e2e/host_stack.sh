@@ -22,6 +22,10 @@ export J288_LIB=${J288_LIB:-$BUILD/lib/libj288.so}
 export PYTHONPATH=${J288_PYTHON_DIR:-$PWD/python}${PYTHONPATH:+:$PYTHONPATH}
 SILENCE=1.5 # longer than the servo's 1 s watchdog: the scenario, not a bound
 SAG_MAX=0.1 # rad: kp 20 against 2 N*m holds within 0.1 rad; a tripped servo falls freely
+# Under memcheck (make test-valgrind sets TEST_TIME_SCALE) the tool's hold loop runs far below
+# its rate, so the joint sags further between commands (0.157 rad seen); a tripped servo still
+# falls by radians.
+[ "${TEST_TIME_SCALE:-1}" -gt 1 ] && SAG_MAX=0.3
 
 logged() { # FILE NEEDLE [FROM_LINE]: wait (bounded, 20 s) until the simulator has logged it
     for _ in $(seq 1 400); do
