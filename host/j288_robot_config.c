@@ -387,6 +387,8 @@ static int get_text(ctx_t *x, const yaml_node_t *v, const char *key, bool is_nam
     if (v->type != YAML_SCALAR_NODE || is_null(v))
         return expected(x, v, key, is_name ? "a name" : "text");
     n = v->data.scalar.length;
+    if (n == 0u) /* quoted "" is not null to YAML, but a port or name it cannot be */
+        return expected(x, v, key, is_name ? "a name" : "text");
     if (n >= cap)
         return fail(x, line_of(v), "%s: longer than %zu bytes", key, cap - 1u);
     for (i = 0; i < n; i++) {

@@ -277,6 +277,12 @@ static void test_errors_types(void)
     check_error("buses:\n  - name: l\n    port: [a]\n", 3, "port: expected text, got a list");
     check_error("joints:\n  - name: {a: 1}\n    id: 1\n", 2,
                 "name: expected a name, got a mapping");
+    /* Quoted empty text is a string to YAML, not null: it was taken as a port (found by
+     * fuzz_config). */
+    check_error("buses:\n  - name: l\n    port: \"\"\n", 3,
+                "port: expected text, got the quoted text ''");
+    check_error("joints:\n  - name: ''\n    id: 1\n", 2,
+                "name: expected a name, got the quoted text ''");
     check_error("joints:\n  - name: 'left hip'\n    id: 1\n", 2, "name: 'left hip' has a blank");
     check_error("joints:\n  - name: abcdefghijabcdefghijabcdefghijabc\n    id: 1\n", 2,
                 "name: longer than 31 bytes");
