@@ -64,12 +64,18 @@ static uint32_t pair16(int16_t lo, int16_t hi)
 static J288_INLINE_HOT void cmd_pack(const j288_cmd_raw_t *cmd, uint8_t out[J288_CMD_LEN],
                                      const j288_crc_t *crc)
 {
-    j288_store_le32(&out[0], CMD_HEAD16 |
-                                 ((uint32_t)mode_pack(cmd->id, cmd->status, cmd->watchdog) << 16));
-    j288_store_le32(&out[CMD_TAU], pair16(cmd->tau, cmd->speed));
-    j288_store_le32(&out[CMD_POS], from_i32(cmd->pos));
-    j288_store_le32(&out[CMD_KP], pair16(cmd->kp, cmd->kd));
-    j288_store_le32(&out[CMD_CRC], j288_crc_frame_hot(crc, out, CMD_CRC_WORDS));
+    uint32_t w[CMD_CRC_WORDS];
+    w[0] = CMD_HEAD16 | ((uint32_t)mode_pack(cmd->id, cmd->status, cmd->watchdog) << 16);
+    w[1] = pair16(cmd->tau, cmd->speed);
+    w[2] = from_i32(cmd->pos);
+    w[3] = pair16(cmd->kp, cmd->kd);
+    j288_store_le32(&out[0], w[0]);
+    j288_store_le32(&out[CMD_TAU], w[1]);
+    j288_store_le32(&out[CMD_POS], w[2]);
+    j288_store_le32(&out[CMD_KP], w[3]);
+    /* The CRC from the words as computed: on cores without unaligned loads, reading them back
+     * from out would cost four byte loads a word. */
+    j288_store_le32(&out[CMD_CRC], j288_crc_cmd_words(crc, out, w));
 }
 
 void j288_cmd_pack(const j288_cmd_raw_t *cmd, uint8_t out[J288_CMD_LEN], const j288_crc_t *crc)

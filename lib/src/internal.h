@@ -61,6 +61,13 @@ static inline void j288_store_le32(uint8_t *p, uint32_t v)
 #endif
 }
 
+#if defined(__BYTE_ORDER__) && defined(__ORDER_LITTLE_ENDIAN__) &&                            \
+    (__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__)
+#define J288_LITTLE_ENDIAN 1
+#else
+#define J288_LITTLE_ENDIAN 0
+#endif
+
 /* Copy a whole frame (J288_CMD_LEN or J288_REPLY_LEN bytes, n a constant at every call).
  * Where the core loads unaligned words, memcpy, which the compiler turns into a few word
  * moves; elsewhere (Cortex-M0, RV32) memcpy is a library call that copies a byte at a time in
@@ -123,20 +130,31 @@ extern const uint32_t j288_crc_slice3[256];
 
 /* One little-endian word into the register, MSB first: XOR it in, then shift the 32 bits out,
  * a byte at a time through T0, or all four bytes at once through T3..T0 (slicing by 4). */
-static inline uint32_t j288_crc_table_word(uint32_t crc, const uint8_t *p)
+static inline uint32_t j288_crc_table_w(uint32_t crc, uint32_t word)
 {
-    uint32_t c = crc ^ j288_get_u32le(p);
+    uint32_t c = crc ^ word;
     c = (c << 8) ^ j288_crc_table256[c >> 24];
     c = (c << 8) ^ j288_crc_table256[c >> 24];
     c = (c << 8) ^ j288_crc_table256[c >> 24];
     return (c << 8) ^ j288_crc_table256[c >> 24];
 }
 
-static inline uint32_t j288_crc_slice4_word(uint32_t crc, const uint8_t *p)
+static inline uint32_t j288_crc_slice4_w(uint32_t crc, uint32_t word)
 {
-    uint32_t c = crc ^ j288_get_u32le(p);
+    uint32_t c = crc ^ word;
     return j288_crc_slice3[c >> 24] ^ j288_crc_slice2[(c >> 16) & 0xFFu] ^
            j288_crc_slice1[(c >> 8) & 0xFFu] ^ j288_crc_table256[c & 0xFFu];
+}
+
+/* The same, the word read from bytes (p: any alignment). */
+static inline uint32_t j288_crc_table_word(uint32_t crc, const uint8_t *p)
+{
+    return j288_crc_table_w(crc, j288_get_u32le(p));
+}
+
+static inline uint32_t j288_crc_slice4_word(uint32_t crc, const uint8_t *p)
+{
+    return j288_crc_slice4_w(crc, j288_get_u32le(p));
 }
 
 /* One word of the default table backend. */
@@ -149,6 +167,19 @@ static inline uint32_t j288_crc_frame_word(uint32_t crc, const uint8_t *p)
 static inline uint32_t j288_crc_frame_word(uint32_t crc, const uint8_t *p)
 {
     return j288_crc_slice4_word(crc, p);
+}
+#endif
+
+/* One word as a value into the default table backend. */
+#if J288_CONFIG_CRC_BACKEND == J288_CRC_BACKEND_TABLE
+static inline uint32_t j288_crc_frame_w(uint32_t crc, uint32_t word)
+{
+    return j288_crc_table_w(crc, word);
+}
+#elif J288_CONFIG_CRC_BACKEND == J288_CRC_BACKEND_SLICE4
+static inline uint32_t j288_crc_frame_w(uint32_t crc, uint32_t word)
+{
+    return j288_crc_slice4_w(crc, word);
 }
 #endif
 
@@ -186,6 +217,74 @@ static inline uint32_t j288_crc_frame_hot(const j288_crc_t *crc, const uint8_t *
         return crc->fn(crc->ctx, data, nwords);
     }
     return j288_crc_frame_unrolled(data, nwords);
+}
+
+/* A frame's CRC in the hot path from its CRC'd words (nwords 4 or 5, a constant at every
+ * call) already read: w holds them as values (word i: bytes 4i..4i+3 little-endian), bytes
+ * the same words as bytes, for a run-time engine or the CRC unit's function, which read bytes
+ * (word-aligned where the caller can: an inlined function then loads whole words, even on
+ * cores without unaligned loads). The table backends fold the values: no byte is read
+ * again. */
+static J288_INLINE_HOT uint32_t j288_crc_frame_words(const j288_crc_t *crc, const uint8_t *bytes,
+                                                     const uint32_t *w, size_t nwords)
+{
+    if ((crc != NULL) && (crc->fn != NULL)) {
+        return crc->fn(crc->ctx, bytes, nwords);
+    }
+    {
+#if (J288_CONFIG_CRC_BACKEND == J288_CRC_BACKEND_TABLE) ||                                   \
+    (J288_CONFIG_CRC_BACKEND == J288_CRC_BACKEND_SLICE4)
+        /* Straight-line code (gcc -O2 keeps a loop over w, and w on the stack). */
+        uint32_t c = j288_crc_frame_w(J288_CRC32_INIT, w[0]);
+        c = j288_crc_frame_w(c, w[1]);
+        c = j288_crc_frame_w(c, w[2]);
+        c = j288_crc_frame_w(c, w[3]);
+        if (nwords > 4u) {
+            c = j288_crc_frame_w(c, w[4]);
+        }
+        return c;
+#else
+        (void)w;
+        return j288_crc_default(bytes, nwords);
+#endif
+    }
+}
+
+/* Bytes the compiler knows to be word-aligned (the union's other member), filled a word at a
+ * time with j288_le_word_set(): little-endian whatever the core. */
+typedef union {
+    uint32_t w[4];
+    uint8_t b[16];
+} j288_le_words_t;
+
+static inline void j288_le_word_set(j288_le_words_t *u, size_t i, uint32_t v)
+{
+#if J288_LITTLE_ENDIAN
+    u->w[i] = v;
+#else
+    j288_put_u32le(&u->b[4u * i], v);
+#endif
+}
+
+/* A command's CRC from its four words w, just stored at out (any alignment). The CRC unit's
+ * function reads them from an aligned copy instead: inlined, it loads whole words there (on
+ * Cortex-M0 and RV32, four byte loads a word from out). */
+static J288_INLINE_HOT uint32_t j288_crc_cmd_words(const j288_crc_t *crc, const uint8_t *out,
+                                                   const uint32_t *w)
+{
+#if J288_CONFIG_CRC_BACKEND == J288_CRC_BACKEND_HW
+    j288_le_words_t le;
+    if ((crc != NULL) && (crc->fn != NULL)) {
+        return crc->fn(crc->ctx, out, 4u);
+    }
+    j288_le_word_set(&le, 0u, w[0]);
+    j288_le_word_set(&le, 1u, w[1]);
+    j288_le_word_set(&le, 2u, w[2]);
+    j288_le_word_set(&le, 3u, w[3]);
+    return J288_CONFIG_CRC_HW_FUNCTION(le.b, 4u);
+#else
+    return j288_crc_frame_words(crc, out, w, 4u);
+#endif
 }
 
 /* A frame's CRC (nwords at least 4): the run-time engine crc if it has one, else the default

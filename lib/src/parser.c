@@ -5,6 +5,23 @@
 
 #include "internal.h"
 
+/* The frame held: from the second byte of the word-aligned store (parser.h). */
+static uint8_t *buf(j288_parser_t *p)
+{
+    return &p->held.bytes[2];
+}
+
+/* Word i of the store (the frame's bytes 4i-2 .. 4i+1), little-endian: one aligned store
+ * (j288_put_u32le()'s byte stores of a value are not merged back into it by gcc on RV32). */
+static void hold_word(j288_parser_t *p, size_t i, uint32_t v)
+{
+#if J288_LITTLE_ENDIAN
+    p->held.words[i] = v;
+#else
+    j288_put_u32le(&p->held.bytes[4u * i], v);
+#endif
+}
+
 int j288_parser_init(j288_parser_t *p, j288_parse_kind_t kind, const j288_crc_t *crc)
 {
     if (p == NULL) {
@@ -48,14 +65,14 @@ static void resync(j288_parser_t *p)
 {
     uint8_t i;
     for (i = 1u; i < p->len; i++) {
-        if ((p->buf[i] == p->head0) &&
-            (((i + 1u) == p->len) || (p->buf[i + 1u] == J288_REPLY_HEAD1))) {
+        if ((buf(p)[i] == p->head0) &&
+            (((i + 1u) == p->len) || (buf(p)[i + 1u] == J288_REPLY_HEAD1))) {
             break;
         }
     }
     p->stats.dropped_bytes += i;
     p->len = (uint8_t)(p->len - i);
-    (void)memmove(p->buf, &p->buf[i], p->len);
+    (void)memmove(buf(p), &buf(p)[i], p->len);
 }
 
 /* A whole frame held in buf failed its CRC: count it and resynchronise inside it. */
@@ -69,7 +86,7 @@ static void drop_frame(j288_parser_t *p)
  * line, so that the byte path's per-byte work stays short. */
 J288_NOINLINE static bool collected(j288_parser_t *p)
 {
-    if (frame_crc_ok(p, p->buf)) {
+    if (frame_crc_ok(p, buf(p))) {
         p->stats.frames++;
         p->len = 0u;
         return true;
@@ -83,7 +100,7 @@ static bool take_byte(j288_parser_t *p, uint8_t b)
 {
     if (p->len == 0u) {
         if (b == p->head0) {
-            p->buf[0] = b;
+            buf(p)[0] = b;
             p->len = 1u;
         } else {
             p->stats.garbage_bytes++;
@@ -99,7 +116,7 @@ static bool take_byte(j288_parser_t *p, uint8_t b)
         }
         return false;
     }
-    p->buf[p->len] = b;
+    buf(p)[p->len] = b;
     p->len++;
     return (p->len == p->frame_len) && collected(p);
 }
@@ -110,7 +127,7 @@ static bool take_byte(j288_parser_t *p, uint8_t b)
 /* A whole frame at f failed its CRC: into buf, dropped as the byte path drops it. */
 static void drop_whole(j288_parser_t *p, const uint8_t *f)
 {
-    (void)memcpy(p->buf, f, p->frame_len);
+    (void)memcpy(buf(p), f, p->frame_len);
     p->len = p->frame_len;
     drop_frame(p);
 }
@@ -154,7 +171,7 @@ J288_NOINLINE static size_t scan_bytes(j288_parser_t *p, const uint8_t *data, si
         }
         i++;
         if (take_byte(p, *f)) {
-            *frame = p->buf;
+            *frame = buf(p);
             return i;
         }
     }
@@ -194,7 +211,7 @@ static J288_INLINE_HOT int scan(j288_parser_t *p, const uint8_t *data, size_t le
         from++;
         if (take_byte(p, data[from - 1u])) {
             *consumed = from;
-            *frame = p->buf;
+            *frame = buf(p);
             return J288_PARSE_FRAME;
         }
     }
@@ -222,6 +239,30 @@ static bool reply_at_start(const j288_parser_t *p, const uint8_t *data, size_t l
            (j288_get_u16le(data) == J288_REPLY_HEAD16);
 }
 
+/* A whole reply at the start of data (reply_at_start()): each of its words is read once from
+ * data, kept in buf (where the CRC'd words and the CRC field are word-aligned: the compiler
+ * stores whole words) and folded into the CRC, which is checked against the field. Returns
+ * whether it is good; buf holds the reply either way (the bad one is dropped from there). */
+static J288_INLINE_HOT bool take_reply_words(j288_parser_t *p, const uint8_t *data)
+{
+    uint32_t w[5];
+    uint32_t field = j288_get_u32le(&data[22]);
+    w[0] = j288_get_u32le(&data[2]);
+    w[1] = j288_get_u32le(&data[6]);
+    w[2] = j288_get_u32le(&data[10]);
+    w[3] = j288_get_u32le(&data[14]);
+    w[4] = j288_get_u32le(&data[18]);
+    p->held.bytes[2] = J288_REPLY_HEAD0;
+    p->held.bytes[3] = J288_REPLY_HEAD1;
+    hold_word(p, 1u, w[0]);
+    hold_word(p, 2u, w[1]);
+    hold_word(p, 3u, w[2]);
+    hold_word(p, 4u, w[3]);
+    hold_word(p, 5u, w[4]);
+    hold_word(p, 6u, field);
+    return j288_crc_frame_words(p->crc, &p->held.bytes[4], w, 5u) == field;
+}
+
 /* j288_parser_feed() when a reply at the start of data failed its CRC: what scan() does
  * there, with one CRC per frame as there: the frame is dropped as take_whole() drops it, and
  * the scan goes on behind it. (The good case is checked inline in j288_parser_feed(); this
@@ -235,17 +276,32 @@ J288_NOINLINE static int feed_after_bad_reply(j288_parser_t *p, const uint8_t *d
     drop_whole(p, data);
     rc = scan(p, &data[J288_REPLY_LEN], len - J288_REPLY_LEN, consumed, &f);
     *consumed += J288_REPLY_LEN;
-    if ((rc == J288_PARSE_FRAME) && (f != p->buf)) {
-        j288_copy_frame(p->buf, f, J288_REPLY_LEN); /* a reply parser: checked where it lies */
+    if ((rc == J288_PARSE_FRAME) && (f != buf(p))) {
+        j288_copy_frame(buf(p), f, J288_REPLY_LEN); /* a reply parser: checked where it lies */
+    }
+    return rc;
+}
+
+/* j288_parser_feed() but for a whole reply at the start of data, out of line so that the
+ * common case below saves and restores only the registers it needs. */
+J288_NOINLINE static int feed_scan(j288_parser_t *p, const uint8_t *data, size_t len,
+                                   size_t *consumed)
+{
+    const uint8_t *f = NULL;
+    int rc = scan(p, data, len, consumed, &f);
+    if ((rc == J288_PARSE_FRAME) && (f != buf(p))) {
+        /* Checked in the caller's data: the parser keeps its own copy (constant lengths). */
+        if (p->kind == J288_PARSE_REPLY) {
+            j288_copy_frame(buf(p), f, J288_REPLY_LEN);
+        } else {
+            j288_copy_frame(buf(p), f, J288_CMD_LEN);
+        }
     }
     return rc;
 }
 
 int j288_parser_feed(j288_parser_t *p, const uint8_t *data, size_t len, size_t *consumed)
 {
-    const uint8_t *f = NULL;
-    int rc;
-
     if (consumed != NULL) {
         *consumed = 0u;
     }
@@ -253,31 +309,21 @@ int j288_parser_feed(j288_parser_t *p, const uint8_t *data, size_t len, size_t *
         return J288_ERR_NULL;
     }
     if (reply_at_start(p, data, len)) {
-        if (j288_reply_crc_ok(p->crc, data)) {
+        if (take_reply_words(p, data)) {
             p->stats.frames++;
-            j288_copy_frame(p->buf, data, J288_REPLY_LEN);
             *consumed = J288_REPLY_LEN;
             return J288_PARSE_FRAME;
         }
         return feed_after_bad_reply(p, data, len, consumed);
     }
-    rc = scan(p, data, len, consumed, &f);
-    if ((rc == J288_PARSE_FRAME) && (f != p->buf)) {
-        /* Checked in the caller's data: the parser keeps its own copy (constant lengths). */
-        if (p->kind == J288_PARSE_REPLY) {
-            j288_copy_frame(p->buf, f, J288_REPLY_LEN);
-        } else {
-            j288_copy_frame(p->buf, f, J288_CMD_LEN);
-        }
-    }
-    return rc;
+    return feed_scan(p, data, len, consumed);
 }
 
 const uint8_t *j288_parser_frame(const j288_parser_t *p)
 {
     /* A completed frame stays in buf: len went back to 0 but the bytes are untouched until
      * the next byte arrives. */
-    return p->buf;
+    return &p->held.bytes[2];
 }
 
 int j288_parser_flush(j288_parser_t *p)

@@ -43,10 +43,16 @@ typedef struct {
 
 typedef struct {
     /* Private: read through the functions below. */
-    uint8_t len;       /* bytes collected into buf */
+    uint8_t len;       /* bytes of the frame collected */
     uint8_t frame_len;
-    uint8_t buf[J288_REPLY_LEN]; /* 2 bytes into the struct: a reply's CRC'd words align */
     uint8_t head0;
+    /* The frame, from bytes[2]: a reply's CRC'd words and its CRC field are words[1..6], so
+     * that the library reads and writes them as aligned words (the union is what makes the
+     * bytes word-aligned; bytes[0..1] are unused). */
+    union {
+        uint32_t words[7];
+        uint8_t bytes[J288_REPLY_LEN + 2u];
+    } held;
     j288_parse_kind_t kind;
     const j288_crc_t *crc;
     j288_parser_stats_t stats;
