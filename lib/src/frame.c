@@ -75,7 +75,7 @@ static J288_INLINE_HOT void cmd_pack(const j288_cmd_raw_t *cmd, uint8_t out[J288
     j288_store_le32(&out[CMD_KP], w[3]);
     /* The CRC from the words as computed: on cores without unaligned loads, reading them back
      * from out would cost four byte loads a word. */
-    j288_store_le32(&out[CMD_CRC], j288_crc_cmd_words(crc, out, w));
+    j288_store_le32(&out[CMD_CRC], j288_crc_frame_words(crc, out, w, CMD_CRC_WORDS));
 }
 
 void j288_cmd_pack(const j288_cmd_raw_t *cmd, uint8_t out[J288_CMD_LEN], const j288_crc_t *crc)

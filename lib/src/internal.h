@@ -219,42 +219,11 @@ static inline uint32_t j288_crc_frame_hot(const j288_crc_t *crc, const uint8_t *
     return j288_crc_frame_unrolled(data, nwords);
 }
 
-/* A frame's CRC in the hot path from its CRC'd words (nwords 4 or 5, a constant at every
- * call) already read: w holds them as values (word i: bytes 4i..4i+3 little-endian), bytes
- * the same words as bytes, for a run-time engine or the CRC unit's function, which read bytes
- * (word-aligned where the caller can: an inlined function then loads whole words, even on
- * cores without unaligned loads). The table backends fold the values: no byte is read
- * again. */
-static J288_INLINE_HOT uint32_t j288_crc_frame_words(const j288_crc_t *crc, const uint8_t *bytes,
-                                                     const uint32_t *w, size_t nwords)
-{
-    if ((crc != NULL) && (crc->fn != NULL)) {
-        return crc->fn(crc->ctx, bytes, nwords);
-    }
-    {
-#if (J288_CONFIG_CRC_BACKEND == J288_CRC_BACKEND_TABLE) ||                                   \
-    (J288_CONFIG_CRC_BACKEND == J288_CRC_BACKEND_SLICE4)
-        /* Straight-line code (gcc -O2 keeps a loop over w, and w on the stack). */
-        uint32_t c = j288_crc_frame_w(J288_CRC32_INIT, w[0]);
-        c = j288_crc_frame_w(c, w[1]);
-        c = j288_crc_frame_w(c, w[2]);
-        c = j288_crc_frame_w(c, w[3]);
-        if (nwords > 4u) {
-            c = j288_crc_frame_w(c, w[4]);
-        }
-        return c;
-#else
-        (void)w;
-        return j288_crc_default(bytes, nwords);
-#endif
-    }
-}
-
 /* Bytes the compiler knows to be word-aligned (the union's other member), filled a word at a
  * time with j288_le_word_set(): little-endian whatever the core. */
 typedef union {
-    uint32_t w[4];
-    uint8_t b[16];
+    uint32_t w[5];
+    uint8_t b[20];
 } j288_le_words_t;
 
 static inline void j288_le_word_set(j288_le_words_t *u, size_t i, uint32_t v)
@@ -266,25 +235,46 @@ static inline void j288_le_word_set(j288_le_words_t *u, size_t i, uint32_t v)
 #endif
 }
 
-/* A command's CRC from its four words w, just stored at out (any alignment). The CRC unit's
- * function reads them from an aligned copy instead: inlined, it loads whole words there (on
- * Cortex-M0 and RV32, four byte loads a word from out). */
-static J288_INLINE_HOT uint32_t j288_crc_cmd_words(const j288_crc_t *crc, const uint8_t *out,
-                                                   const uint32_t *w)
+/* A frame's CRC in the hot path from its CRC'd words (nwords 4 or 5, a constant at every
+ * call) already read: w holds them as values (word i: bytes 4i..4i+3 little-endian), bytes
+ * the same words as bytes (any alignment), for a run-time engine. The table backends fold
+ * the values (no byte is read again); the CRC unit's function, which reads bytes, gets them
+ * from an aligned copy, which it loads as whole words where it is inlined (even on cores
+ * without unaligned loads: Cortex-M0, RV32), and where the compiler sees through the copy,
+ * writes the values as they are. */
+static J288_INLINE_HOT uint32_t j288_crc_frame_words(const j288_crc_t *crc, const uint8_t *bytes,
+                                                     const uint32_t *w, size_t nwords)
 {
-#if J288_CONFIG_CRC_BACKEND == J288_CRC_BACKEND_HW
-    j288_le_words_t le;
     if ((crc != NULL) && (crc->fn != NULL)) {
-        return crc->fn(crc->ctx, out, 4u);
+        return crc->fn(crc->ctx, bytes, nwords);
     }
-    j288_le_word_set(&le, 0u, w[0]);
-    j288_le_word_set(&le, 1u, w[1]);
-    j288_le_word_set(&le, 2u, w[2]);
-    j288_le_word_set(&le, 3u, w[3]);
-    return J288_CONFIG_CRC_HW_FUNCTION(le.b, 4u);
+    {
+        /* Straight-line code (gcc -O2 keeps a loop over w, and w on the stack). */
+#if (J288_CONFIG_CRC_BACKEND == J288_CRC_BACKEND_TABLE) ||                                   \
+    (J288_CONFIG_CRC_BACKEND == J288_CRC_BACKEND_SLICE4)
+        uint32_t c = j288_crc_frame_w(J288_CRC32_INIT, w[0]);
+        c = j288_crc_frame_w(c, w[1]);
+        c = j288_crc_frame_w(c, w[2]);
+        c = j288_crc_frame_w(c, w[3]);
+        if (nwords > 4u) {
+            c = j288_crc_frame_w(c, w[4]);
+        }
+        return c;
+#elif J288_CONFIG_CRC_BACKEND == J288_CRC_BACKEND_HW
+        j288_le_words_t le;
+        j288_le_word_set(&le, 0u, w[0]);
+        j288_le_word_set(&le, 1u, w[1]);
+        j288_le_word_set(&le, 2u, w[2]);
+        j288_le_word_set(&le, 3u, w[3]);
+        if (nwords > 4u) {
+            j288_le_word_set(&le, 4u, w[4]);
+        }
+        return J288_CONFIG_CRC_HW_FUNCTION(le.b, nwords);
 #else
-    return j288_crc_frame_words(crc, out, w, 4u);
+        (void)w;
+        return j288_crc_default(bytes, nwords);
 #endif
+    }
 }
 
 /* A frame's CRC (nwords at least 4): the run-time engine crc if it has one, else the default

@@ -11,6 +11,7 @@ static uint8_t *buf(j288_parser_t *p)
     return &p->held.bytes[2];
 }
 
+#if J288_STORE32_AS_WORD
 /* Word i of the store (the frame's bytes 4i-2 .. 4i+1), little-endian: one aligned store
  * (j288_put_u32le()'s byte stores of a value are not merged back into it by gcc on RV32). */
 static void hold_word(j288_parser_t *p, size_t i, uint32_t v)
@@ -21,6 +22,17 @@ static void hold_word(j288_parser_t *p, size_t i, uint32_t v)
     j288_put_u32le(&p->held.bytes[4u * i], v);
 #endif
 }
+#else
+/* The same word read back. */
+static uint32_t held_word(const j288_parser_t *p, size_t i)
+{
+#if J288_LITTLE_ENDIAN
+    return p->held.words[i];
+#else
+    return j288_get_u32le(&p->held.bytes[4u * i]);
+#endif
+}
+#endif
 
 int j288_parser_init(j288_parser_t *p, j288_parse_kind_t kind, const j288_crc_t *crc)
 {
@@ -239,14 +251,18 @@ static bool reply_at_start(const j288_parser_t *p, const uint8_t *data, size_t l
            (j288_get_u16le(data) == J288_REPLY_HEAD16);
 }
 
-/* A whole reply at the start of data (reply_at_start()): each of its words is read once from
- * data, kept in buf (where the CRC'd words and the CRC field are word-aligned: the compiler
- * stores whole words) and folded into the CRC, which is checked against the field. Returns
- * whether it is good; buf holds the reply either way (the bad one is dropped from there). */
+/* A whole reply at the start of data (reply_at_start()), into buf, and its CRC checked
+ * against its field there. Returns whether it is good; buf holds the reply either way (a bad
+ * one is dropped from there). Each word of the reply is read from data once: where the core
+ * loads unaligned words, as a word that is folded into the CRC and stored in buf (aligned);
+ * elsewhere (Cortex-M0, RV32) the bytes are moved into buf, where the words are then loaded
+ * aligned (fewer values live at once than assembling each word from four bytes). */
 static J288_INLINE_HOT bool take_reply_words(j288_parser_t *p, const uint8_t *data)
 {
     uint32_t w[5];
-    uint32_t field = j288_get_u32le(&data[22]);
+    uint32_t field;
+#if J288_STORE32_AS_WORD
+    field = j288_get_u32le(&data[22]);
     w[0] = j288_get_u32le(&data[2]);
     w[1] = j288_get_u32le(&data[6]);
     w[2] = j288_get_u32le(&data[10]);
@@ -260,7 +276,16 @@ static J288_INLINE_HOT bool take_reply_words(j288_parser_t *p, const uint8_t *da
     hold_word(p, 4u, w[3]);
     hold_word(p, 5u, w[4]);
     hold_word(p, 6u, field);
-    return j288_crc_frame_words(p->crc, &p->held.bytes[4], w, 5u) == field;
+#else
+    j288_copy_frame(buf(p), data, J288_REPLY_LEN);
+    w[0] = held_word(p, 1u);
+    w[1] = held_word(p, 2u);
+    w[2] = held_word(p, 3u);
+    w[3] = held_word(p, 4u);
+    w[4] = held_word(p, 5u);
+    field = held_word(p, 6u);
+#endif
+    return j288_crc_frame_words(p->crc, &buf(p)[2], w, 5u) == field;
 }
 
 /* j288_parser_feed() when a reply at the start of data failed its CRC: what scan() does
