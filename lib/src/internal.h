@@ -306,6 +306,10 @@ static J288_INLINE_HOT bool j288_cmd_crc_ok(const j288_crc_t *crc, const uint8_t
     return j288_crc_frame_hot(crc, f, 4u) == j288_get_u32le(&f[16]);
 }
 
+/* j288_reply_unpack() from the reply's words 1-5 as values (word i: bytes 4i+2 .. 4i+5,
+ * little-endian), e.g. read aligned from the parser's buffer. */
+void j288_reply_unpack_words(const uint32_t w[5], j288_reply_raw_t *reply);
+
 /* ---- commands */
 
 /* The encoder's checks, in its order: J288_ERR_BAD_ID (id > 15), J288_ERR_BAD_STATUS,

@@ -12,24 +12,13 @@ static uint8_t *buf(j288_parser_t *p)
 }
 
 #if J288_STORE32_AS_WORD
-/* Word i of the store (the frame's bytes 4i-2 .. 4i+1), little-endian: one aligned store
- * (j288_put_u32le()'s byte stores of a value are not merged back into it by gcc on RV32). */
+/* Word i of the store (the frame's bytes 4i-2 .. 4i+1), little-endian: one aligned store. */
 static void hold_word(j288_parser_t *p, size_t i, uint32_t v)
 {
 #if J288_LITTLE_ENDIAN
     p->held.words[i] = v;
 #else
     j288_put_u32le(&p->held.bytes[4u * i], v);
-#endif
-}
-#else
-/* The same word read back. */
-static uint32_t held_word(const j288_parser_t *p, size_t i)
-{
-#if J288_LITTLE_ENDIAN
-    return p->held.words[i];
-#else
-    return j288_get_u32le(&p->held.bytes[4u * i]);
 #endif
 }
 #endif
@@ -259,10 +248,9 @@ static bool reply_at_start(const j288_parser_t *p, const uint8_t *data, size_t l
  * aligned (fewer values live at once than assembling each word from four bytes). */
 static J288_INLINE_HOT bool take_reply_words(j288_parser_t *p, const uint8_t *data)
 {
-    uint32_t w[5];
-    uint32_t field;
 #if J288_STORE32_AS_WORD
-    field = j288_get_u32le(&data[22]);
+    uint32_t w[5];
+    uint32_t field = j288_get_u32le(&data[22]);
     w[0] = j288_get_u32le(&data[2]);
     w[1] = j288_get_u32le(&data[6]);
     w[2] = j288_get_u32le(&data[10]);
@@ -276,16 +264,22 @@ static J288_INLINE_HOT bool take_reply_words(j288_parser_t *p, const uint8_t *da
     hold_word(p, 4u, w[3]);
     hold_word(p, 5u, w[4]);
     hold_word(p, 6u, field);
-#else
-    j288_copy_frame(buf(p), data, J288_REPLY_LEN);
-    w[0] = held_word(p, 1u);
-    w[1] = held_word(p, 2u);
-    w[2] = held_word(p, 3u);
-    w[3] = held_word(p, 4u);
-    w[4] = held_word(p, 5u);
-    field = held_word(p, 6u);
-#endif
     return j288_crc_frame_words(p->crc, &buf(p)[2], w, 5u) == field;
+#elif J288_LITTLE_ENDIAN
+    /* The words are read where the CRC needs them (read before the test for a run-time
+     * engine, they would stay live across its call). */
+    j288_copy_frame(buf(p), data, J288_REPLY_LEN);
+    return j288_crc_frame_words(p->crc, &buf(p)[2], &p->held.words[1], 5u) == p->held.words[6];
+#else
+    uint32_t w[5];
+    j288_copy_frame(buf(p), data, J288_REPLY_LEN);
+    w[0] = j288_get_u32le(&buf(p)[2]);
+    w[1] = j288_get_u32le(&buf(p)[6]);
+    w[2] = j288_get_u32le(&buf(p)[10]);
+    w[3] = j288_get_u32le(&buf(p)[14]);
+    w[4] = j288_get_u32le(&buf(p)[18]);
+    return j288_crc_frame_words(p->crc, &buf(p)[2], w, 5u) == j288_get_u32le(&buf(p)[22]);
+#endif
 }
 
 /* j288_parser_feed() when a reply at the start of data failed its CRC: what scan() does
@@ -349,6 +343,21 @@ const uint8_t *j288_parser_frame(const j288_parser_t *p)
     /* A completed frame stays in buf: len went back to 0 but the bytes are untouched until
      * the next byte arrives. */
     return &p->held.bytes[2];
+}
+
+void j288_parser_reply(const j288_parser_t *p, j288_reply_raw_t *reply)
+{
+#if J288_LITTLE_ENDIAN
+    j288_reply_unpack_words(&p->held.words[1], reply);
+#else
+    uint32_t w[5];
+    w[0] = j288_get_u32le(&p->held.bytes[4]);
+    w[1] = j288_get_u32le(&p->held.bytes[8]);
+    w[2] = j288_get_u32le(&p->held.bytes[12]);
+    w[3] = j288_get_u32le(&p->held.bytes[16]);
+    w[4] = j288_get_u32le(&p->held.bytes[20]);
+    j288_reply_unpack_words(w, reply);
+#endif
 }
 
 int j288_parser_flush(j288_parser_t *p)

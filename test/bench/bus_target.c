@@ -30,10 +30,10 @@
 #define ITERATIONS 300u
 #endif
 /* Rows to run (bits: 1 floors, 2 codec, 4 codec with the CRC unit, 8 poll, 16 sweeps, 32 joint,
- * 64 sweeps with a new command each transaction): a profile of one row under QEMU builds the
+ * 64 sweeps with a new command each transaction, 128 codec with the parser's unpack): a profile of one row under QEMU builds the
  * image with -DBUS_TARGET_ROWS=<bits>. */
 #ifndef BUS_TARGET_ROWS
-#define BUS_TARGET_ROWS 0x7Fu
+#define BUS_TARGET_ROWS 0xFFu
 #endif
 #define RUN_ROW(bit, call) (((BUS_TARGET_ROWS) & (bit)) != 0u ? (call) : 0u)
 #define CAL_LOOPS  100000u
@@ -414,6 +414,31 @@ static uint32_t run_codec(const j288_crc_t *crc)
     return icount_between(t0, t1);
 }
 
+/* The same, the reply unpacked by j288_parser_reply() from the parser's aligned buffer
+ * (j288_reply_unpack() reads bytes of unknown alignment). */
+static uint32_t run_codec_parser_unpacks(void)
+{
+    j288_parser_t parser;
+    j288_cmd_raw_t cmd = worked_cmd();
+    j288_reply_raw_t r;
+    uint8_t frame[J288_CMD_LEN];
+    uint32_t i, t0, t1;
+    (void)j288_parser_init(&parser, J288_PARSE_REPLY, NULL);
+    bench_unit_next = 0u;
+    t0 = icount_now();
+    for (i = 0u; i < ITERATIONS; i++) {
+        size_t used;
+        (void)j288_cmd_encode(&cmd, frame, NULL);
+        if (j288_parser_feed(&parser, replies[3], J288_REPLY_LEN, &used) == J288_PARSE_FRAME) {
+            j288_parser_reply(&parser, &r);
+            done_count++;
+        }
+    }
+    t1 = icount_now();
+    done_expected += ITERATIONS;
+    return icount_between(t0, t1);
+}
+
 static uint32_t run_bus_poll(void)
 {
     j288_cmd_raw_t cmd = worked_cmd();
@@ -563,7 +588,7 @@ static void row(const char *name, uint32_t floor, uint32_t lib)
 int main(void)
 {
     const j288_crc_t unit_engine = {unit_crc32, &bench_unit};
-    uint32_t ipt, f_codec, f_unit, f_engine, codec, codec_unit, poll, isr, isr_new;
+    uint32_t ipt, f_codec, f_unit, f_engine, codec, codec_held, codec_unit, poll, isr, isr_new;
     uint8_t id;
 
     for (id = 0u; id < J288_MAX_SERVOS; id++) {
@@ -589,6 +614,7 @@ int main(void)
     f_unit = per_txn(RUN_ROW(1u, run_floor_codec(true)), ipt);
     f_engine = per_txn(RUN_ROW(1u, run_floor_engine()), ipt);
     codec = per_txn(RUN_ROW(2u, run_codec(NULL)), ipt);
+    codec_held = per_txn(RUN_ROW(128u, run_codec_parser_unpacks()), ipt);
     codec_unit = per_txn(RUN_ROW(4u, run_codec(&unit_engine)), ipt);
     poll = per_txn(RUN_ROW(8u, run_bus_poll()), ipt);
     /* (With the CRC unit as the backend, the model's two answers do not fit 15 servos.) */
@@ -603,6 +629,12 @@ int main(void)
         row("codec, CRC unit (compile-time backend)", f_unit, codec);
     } else {
         row("codec only (encode, parse, unpack)", f_codec, codec);
+    }
+    if (HW_BACKEND) {
+        row("codec, CRC unit (compile-time backend), reply unpacked by the parser", f_unit,
+            codec_held);
+    } else {
+        row("codec, reply unpacked by the parser (j288_parser_reply)", f_codec, codec_held);
     }
     row("codec, CRC unit (port crc32 op)", f_unit, codec_unit);
     row("bus, poll mode", 0u, poll);

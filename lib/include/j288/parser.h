@@ -77,6 +77,13 @@ int j288_parser_feed(j288_parser_t *p, const uint8_t *data, size_t len, size_t *
  * flush or reset. */
 const uint8_t *j288_parser_frame(const j288_parser_t *p);
 
+/* A reply parser's last good reply, unpacked: the same as j288_reply_unpack(
+ * j288_parser_frame(p), reply), read from the parser's own buffer a whole word at a time
+ * (where j288_reply_unpack() reads bytes, not knowing its buffer's alignment: four loads a
+ * word on Cortex-M0 and RV32). Same validity as j288_parser_frame(); a command parser's frame
+ * gives meaningless fields. ISR-safe like the rest of the parser. */
+void j288_parser_reply(const j288_parser_t *p, j288_reply_raw_t *reply);
+
 /* The line went idle (or the caller gives up on this frame): drop a partial frame, counting
  * it as truncated. Returns J288_ERR_TRUNCATED when something was dropped, else J288_OK. */
 int j288_parser_flush(j288_parser_t *p);
