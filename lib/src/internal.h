@@ -61,6 +61,20 @@ static inline void j288_store_le32(uint8_t *p, uint32_t v)
 #endif
 }
 
+/* The same for a load: one word load there, inlined even at -Os (where gcc calls the
+ * header's j288_get_u32le() out of line once it has several callers). */
+static J288_INLINE_HOT uint32_t j288_load_le32(const uint8_t *p)
+{
+#if J288_STORE32_AS_WORD
+    uint32_t v;
+    /* cppcheck-suppress misra-c2012-21.15 ; the bytes of a word from a byte buffer, see above */
+    (void)memcpy(&v, p, sizeof v);
+    return v;
+#else
+    return j288_get_u32le(p);
+#endif
+}
+
 #if defined(__BYTE_ORDER__) && defined(__ORDER_LITTLE_ENDIAN__) &&                            \
     (__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__)
 #define J288_LITTLE_ENDIAN 1

@@ -250,12 +250,12 @@ static J288_INLINE_HOT bool take_reply_words(j288_parser_t *p, const uint8_t *da
 {
 #if J288_STORE32_AS_WORD
     uint32_t w[5];
-    uint32_t field = j288_get_u32le(&data[22]);
-    w[0] = j288_get_u32le(&data[2]);
-    w[1] = j288_get_u32le(&data[6]);
-    w[2] = j288_get_u32le(&data[10]);
-    w[3] = j288_get_u32le(&data[14]);
-    w[4] = j288_get_u32le(&data[18]);
+    uint32_t field = j288_load_le32(&data[22]);
+    w[0] = j288_load_le32(&data[2]);
+    w[1] = j288_load_le32(&data[6]);
+    w[2] = j288_load_le32(&data[10]);
+    w[3] = j288_load_le32(&data[14]);
+    w[4] = j288_load_le32(&data[18]);
     p->held.bytes[2] = J288_REPLY_HEAD0;
     p->held.bytes[3] = J288_REPLY_HEAD1;
     hold_word(p, 1u, w[0]);

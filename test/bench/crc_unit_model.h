@@ -33,25 +33,19 @@ static inline uint32_t bench_unit_result(void)
     return v;
 }
 
-static inline uint32_t bench_unit_word(const uint8_t *p)
-{
-    return (uint32_t)p[0] | ((uint32_t)p[1] << 8) | ((uint32_t)p[2] << 16) |
-           ((uint32_t)p[3] << 24);
-}
-
-/* Reset, one write per little-endian word, one read. A frame has four or five words: the
- * first four are written in straight-line code, so that, inlined where the count is a
- * constant, there is no loop (gcc -O2 does not unroll one with a volatile store in it). */
+/* Reset, one write per little-endian word, one read. Inlined where the word count is a
+ * constant (a frame: four or five), the loop is unrolled: gcc -O2 does not unroll a loop
+ * with a volatile store by itself, and an unrolled body written out would no longer be
+ * inlined at -Os. */
 static inline uint32_t bench_crc_unit_inline(const uint8_t *data, size_t nwords)
 {
     size_t i;
     bench_unit.CR = 1u;
-    bench_unit.DR = bench_unit_word(&data[0]);
-    bench_unit.DR = bench_unit_word(&data[4]);
-    bench_unit.DR = bench_unit_word(&data[8]);
-    bench_unit.DR = bench_unit_word(&data[12]);
-    for (i = 4u; i < nwords; i++) {
-        bench_unit.DR = bench_unit_word(&data[4u * i]);
+#pragma GCC unroll 5
+    for (i = 0u; i < nwords; i++) {
+        const uint8_t *p = &data[4u * i];
+        bench_unit.DR = (uint32_t)p[0] | ((uint32_t)p[1] << 8) | ((uint32_t)p[2] << 16) |
+                        ((uint32_t)p[3] << 24);
     }
     return bench_unit_result();
 }
