@@ -254,10 +254,10 @@ static inline void j288_le_word_set(j288_le_words_t *u, size_t i, uint32_t v)
 /* A frame's CRC in the hot path from its CRC'd words (nwords 4 or 5, a constant at every
  * call) already read: w holds them as values (word i: bytes 4i..4i+3 little-endian), bytes
  * the same words as bytes (any alignment), for a run-time engine. The table backends fold
- * the values (no byte is read again); the CRC unit's function, which reads bytes, gets them
- * from an aligned copy, which it loads as whole words where it is inlined (even on cores
- * without unaligned loads: Cortex-M0, RV32), and where the compiler sees through the copy,
- * writes the values as they are. */
+ * the values (no byte is read again). The CRC unit's function reads bytes: where the core
+ * loads unaligned words, bytes as they are; elsewhere an aligned copy of the words, which an
+ * inlined function loads as whole words (and where the compiler sees through the copy, it
+ * writes the values as they are) instead of four byte loads a word. */
 static J288_INLINE_HOT uint32_t j288_crc_frame_words(const j288_crc_t *crc, const uint8_t *bytes,
                                                      const uint32_t *w, size_t nwords)
 {
@@ -276,6 +276,11 @@ static J288_INLINE_HOT uint32_t j288_crc_frame_words(const j288_crc_t *crc, cons
             c = j288_crc_frame_w(c, w[4]);
         }
         return c;
+#elif (J288_CONFIG_CRC_BACKEND == J288_CRC_BACKEND_HW) && J288_STORE32_AS_WORD
+        /* The core loads unaligned words: the bytes as they are (a copy would cost a function
+         * that is called, not inlined, five stores). */
+        (void)w;
+        return J288_CONFIG_CRC_HW_FUNCTION(bytes, nwords);
 #elif J288_CONFIG_CRC_BACKEND == J288_CRC_BACKEND_HW
         j288_le_words_t le;
         j288_le_word_set(&le, 0u, w[0]);
