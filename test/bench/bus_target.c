@@ -391,7 +391,12 @@ static uint32_t run_floor_engine(void)
     return icount_between(t0, t1);
 }
 
-static uint32_t run_codec(const j288_crc_t *crc)
+/* The codec rows' loop; with parser_unpacks, the reply is unpacked by j288_parser_reply()
+ * from the parser's aligned buffer instead of j288_reply_unpack(j288_parser_frame()), which
+ * reads bytes of unknown alignment. Always inlined, so that each row's loop is compiled for
+ * its own unpack (a test in the loop would count in both rows). */
+static inline __attribute__((always_inline)) uint32_t codec_loop(const j288_crc_t *crc,
+                                                                 bool parser_unpacks)
 {
     j288_parser_t parser;
     j288_cmd_raw_t cmd = worked_cmd();
@@ -405,7 +410,11 @@ static uint32_t run_codec(const j288_crc_t *crc)
         size_t used;
         (void)j288_cmd_encode(&cmd, frame, crc);
         if (j288_parser_feed(&parser, replies[3], J288_REPLY_LEN, &used) == J288_PARSE_FRAME) {
-            j288_reply_unpack(j288_parser_frame(&parser), &r);
+            if (parser_unpacks) {
+                j288_parser_reply(&parser, &r);
+            } else {
+                j288_reply_unpack(j288_parser_frame(&parser), &r);
+            }
             done_count++;
         }
     }
@@ -414,29 +423,14 @@ static uint32_t run_codec(const j288_crc_t *crc)
     return icount_between(t0, t1);
 }
 
-/* The same, the reply unpacked by j288_parser_reply() from the parser's aligned buffer
- * (j288_reply_unpack() reads bytes of unknown alignment). */
+static uint32_t run_codec(const j288_crc_t *crc)
+{
+    return codec_loop(crc, false);
+}
+
 static uint32_t run_codec_parser_unpacks(void)
 {
-    j288_parser_t parser;
-    j288_cmd_raw_t cmd = worked_cmd();
-    j288_reply_raw_t r;
-    uint8_t frame[J288_CMD_LEN];
-    uint32_t i, t0, t1;
-    (void)j288_parser_init(&parser, J288_PARSE_REPLY, NULL);
-    bench_unit_next = 0u;
-    t0 = icount_now();
-    for (i = 0u; i < ITERATIONS; i++) {
-        size_t used;
-        (void)j288_cmd_encode(&cmd, frame, NULL);
-        if (j288_parser_feed(&parser, replies[3], J288_REPLY_LEN, &used) == J288_PARSE_FRAME) {
-            j288_parser_reply(&parser, &r);
-            done_count++;
-        }
-    }
-    t1 = icount_now();
-    done_expected += ITERATIONS;
-    return icount_between(t0, t1);
+    return codec_loop(NULL, true);
 }
 
 static uint32_t run_bus_poll(void)
