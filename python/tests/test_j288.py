@@ -314,6 +314,21 @@ def test_robot_bus_gone(sims, tmp_path: Path) -> None:
                 robot.cycle()
 
 
+def test_robot_stop_on_bus_loss(sims, tmp_path: Path) -> None:
+    """stop_on_bus_loss: one bus vanishing stops the other at once (its servos locked, the
+    watchdog bit 0) and the cycle raises OfflineError, inside the with block."""
+    s0, s1 = sims("1,2,3"), sims("1,2,3")
+    cfg = write_config(tmp_path, [s0.pty, s1.pty])
+    with j288.Robot(str(cfg), stop_on_bus_loss=True) as robot:
+        assert any(robot.cycle().complete for _ in range(20))
+        assert not s0.logged(" id=15 status=0 wd=0", wait=0)
+        s1.stop()
+        with pytest.raises(j288.OfflineError):
+            for _ in range(10):
+                robot.cycle()
+        assert s0.logged(" id=15 status=0 wd=0")
+
+
 def test_robot_without_numpy(sims, tmp_path: Path, monkeypatch) -> None:
     s0 = sims("1,2,3")
     cfg = write_config(tmp_path, [s0.pty])
