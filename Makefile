@@ -122,19 +122,15 @@ test: $(HOST_TESTS) $(TEST_DEPS)
 
 # ---- install ---------------------------------------------------------------------------------
 # CMake's install (cmake/j288_install.cmake) from $(CMAKE_BUILD) for PREFIX under DESTDIR;
-# uninstall removes what it listed ($(INSTALLED)) and the j288 directories left empty. A program
-# CMake does not build (mk/dds.mk): a prerequisite of install, listed in $(INSTALLED_EXTRA).
+# uninstall removes what it listed ($(INSTALLED)) and the j288 directories left empty.
 PREFIX ?= /usr/local
-BINDIR ?= $(PREFIX)/bin
 CMAKE_BUILD := $(BUILD)/cmake
 INSTALLED := $(CMAKE_BUILD)/installed.txt
-INSTALLED_EXTRA := $(CMAKE_BUILD)/installed-extra.txt
 install:
 	@$(call REQUIRE,cmake,cmake); \
 	 cmake -S . -B $(CMAKE_BUILD) -DCMAKE_INSTALL_PREFIX=$(PREFIX) $(CMAKE_FLAGS) >/dev/null && \
 	 cmake --build $(CMAKE_BUILD) -j2 && DESTDIR=$(DESTDIR) cmake --install $(CMAKE_BUILD) && \
-	 { sed 's|^|$(DESTDIR)|' $(CMAKE_BUILD)/install_manifest.txt; echo; cat $(INSTALLED_EXTRA) 2>/dev/null; } | \
-	     grep . >$(INSTALLED); rm -f $(INSTALLED_EXTRA)
+	 { sed 's|^|$(DESTDIR)|' $(CMAKE_BUILD)/install_manifest.txt; echo; } | grep . >$(INSTALLED)
 
 uninstall:
 	@[ -f $(INSTALLED) ] || { echo "uninstall: $(INSTALLED) missing: nothing installed from here"; exit 1; }

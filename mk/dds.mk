@@ -6,10 +6,11 @@
 #                      in a private network namespace (TEST_SCRIPTS)
 #   make test-dds      those tests alone (CI's test-dds step)
 #   make bench-dds     cycles/s with and without DDS, command-to-wire latency, DDS's CPU share
-# Without Cyclone DDS: a one-line notice and nothing else (CI=true: an error).
+# Without Cyclone DDS: a one-line notice and nothing else (CI=true: an error). CMake builds and
+# installs the bridge too (cmake/j288_tools.cmake): make install, make deb (package j288-dds).
 # The IDL in tools/j288-dds/idl is compiled by idlc into $(DDS_GEN) (-t: no XTypes type
 # information, so that peers match on the type name as ROS 2's rmw_cyclonedds does).
-.PHONY: dds dds-missing test-dds bench-dds install-dds
+.PHONY: dds dds-missing test-dds bench-dds
 DDS_FOUND := $(shell pkg-config --exists CycloneDDS 2>/dev/null && command -v idlc >/dev/null 2>&1 && echo yes)
 DDS_BIN := $(BIN)/j288-dds
 DDS_GEN := $(BUILD)/dds/gen
@@ -69,12 +70,6 @@ TEST_SCRIPTS += $(DDS_TESTS)
 test-dds: $(DDS_BIN) $(DDS_TEST_PEER) $(DDS_GOLDEN) $(SIM_BIN)
 	$(call RUN_TESTS,$(DDS_TESTS))
 
-# (beside CMake's install, which does not build the bridge: listed for make uninstall)
-install-dds: $(DDS_BIN)
-	install -d $(DESTDIR)$(BINDIR)
-	install -m 755 $(DDS_BIN) $(DESTDIR)$(BINDIR)/
-	mkdir -p $(CMAKE_BUILD) && echo $(DESTDIR)$(BINDIR)/j288-dds >>$(INSTALLED_EXTRA)
-
 bench-dds: $(DDS_BIN) $(DDS_TEST_PEER) $(SIM_BIN) $(J288_BIN) $(BUILD)/bench/write_stamp.so
 	BUILD=$(BUILD) bash scripts/bench-dds.sh
 else
@@ -82,11 +77,9 @@ dds dds-missing test-dds bench-dds:
 	@if [ "$${CI:-}" = true ]; then \
 	    echo "error: Cyclone DDS not found (CI=true: a failure); install: cyclonedds-dev cyclonedds-tools" >&2; exit 1; fi
 	@echo "notice: skipping j288-dds and its tests, Cyclone DDS not found; install with: apt-get install -y --no-install-recommends cyclonedds-dev cyclonedds-tools" >&2
-install-dds:
 ALL_TARGETS += dds-missing
 TEST_DEPS += dds-missing
 endif
-install: install-dds
 
 # The benchmark's write() stamper (test/bench/write_stamp.c), preloaded into the bridge.
 $(BUILD)/bench/write_stamp.so: test/bench/write_stamp.c

@@ -6,9 +6,10 @@
 # run, with their man pages and bash completion), `make uninstall` leaving nothing of it,
 # add_subdirectory, and the library cross-built with cmake/arm-none-eabi.cmake for Cortex-M4F
 # and Cortex-M0 (SI off), and a pkg-config consumer (test/e2e/pkgconfig_consumer.c, against
-# the shared library of both installs). Every install's j288, j288-sim and j288.pc, and the
-# Python package (imported with PYTHONPATH alone), say the header's version. Needs cmake; the
-# cross build needs arm-none-eabi-gcc, the pkg-config consumer pkg-config.
+# the shared library of both installs). Every install's j288, j288-sim, j288-dds (with Cyclone
+# DDS) and j288.pc, and the Python package (imported with PYTHONPATH alone), say the header's
+# version. Needs cmake; the cross build needs arm-none-eabi-gcc, the pkg-config consumer
+# pkg-config.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/need.sh cmake cmake || exit $(($? == 1 ? 0 : 1))
@@ -66,6 +67,11 @@ installed() {
         { echo "check-consumers: the installed completion: $out" >&2; exit 1; }
     same_version "$p/bin/j288 --version" "$("$p/bin/j288" --version 2>&1)"
     same_version "$p/bin/j288-sim --version" "$("$p/bin/j288-sim" --version 2>&1)"
+    if pkg-config --exists CycloneDDS 2>/dev/null; then # the DDS bridge: built where Cyclone DDS is
+        grep -q '^\.TH J288-DDS "1"' "$p/share/man/man1/j288-dds.1" ||
+            { echo "check-consumers: $p/share/man/man1/j288-dds.1 is not j288-dds's man page" >&2; exit 1; }
+        same_version "$p/bin/j288-dds --version" "$("$p/bin/j288-dds" --version 2>&1)"
+    fi
     consumer "find_package-$(basename "$p")" -DCMAKE_PREFIX_PATH="$p"
     robot_consumer "find_package-robot-$(basename "$p")" -DCMAKE_PREFIX_PATH="$p"
     pkgconfig_consumer "$p" "$l"
