@@ -15,7 +15,8 @@ WIN_CC ?= x86_64-w64-mingw32-gcc
 WIN_AR ?= x86_64-w64-mingw32-ar
 WIN := $(BUILD)/windows
 WIN_OBJ := $(WIN)/obj
-WIN_CFLAGS := $(CSTD) $(WARN) $(OPT)
+# $(DEPFLAGS): each object's header dependencies beside it (X.d, included by the Makefile).
+WIN_CFLAGS := $(CSTD) $(WARN) $(OPT) $(DEPFLAGS)
 WIN_CPPFLAGS := $(CPPFLAGS_LIB) -Iport/windows
 # winmm: timeBeginPeriod (1 ms timer waits) in the port.
 WIN_LIBS := -lwinmm
@@ -24,16 +25,15 @@ WIN_LIB_A := $(WIN)/libj288.a
 WIN_PORT_A := $(WIN)/libj288_windows.a
 WIN_DLL := $(WIN)/j288.dll
 WIN_IMPLIB := $(WIN)/libj288.dll.a
-WIN_PORT_HDR := port/windows/j288_windows.h
 WIN_UNIT_TESTS := $(UNIT_TEST_SRC:test/unit/%.c=$(WIN)/test/%.exe)
 WIN_PORT_TEST := $(WIN)/test/test_windows_port.exe
 WIN_BENCH := $(WIN)/bench/bench_windows_port.exe
 
-$(WIN_OBJ)/lib/%.o: lib/%.c $(LIB_HDR)
+$(WIN_OBJ)/lib/%.o: lib/%.c
 	@mkdir -p $(@D)
 	$(WIN_CC) $(CPPFLAGS_LIB) $(WIN_CFLAGS) -c $< -o $@
 
-$(WIN_OBJ)/port/windows/%.o: port/windows/%.c $(WIN_PORT_HDR) $(LIB_HDR)
+$(WIN_OBJ)/port/windows/%.o: port/windows/%.c
 	@mkdir -p $(@D)
 	$(WIN_CC) $(WIN_CPPFLAGS) $(WIN_CFLAGS) -c $< -o $@
 
@@ -57,7 +57,6 @@ WIN_TOOL_CPPFLAGS := $(WIN_CPPFLAGS) -Ihost -Itools/j288 -D__USE_MINGW_ANSI_STDI
 WIN_TOOL_CFLAGS := $(WIN_CFLAGS) -Wno-float-conversion
 WIN_YAML_ENV := $(WIN)/libyaml/libyaml.env
 win_yaml_var = $$(sed -n 's/^$(1)=//p' $(WIN_YAML_ENV))
-WIN_HOST_HDR := $(wildcard host/*.h) $(WIN_PORT_HDR) $(LIB_HDR)
 WIN_HOST_OBJ := $(WIN_OBJ)/host/j288_robot.o $(WIN_OBJ)/host/j288_robot_config.o \
     $(WIN_OBJ)/host/j288_number.o $(WIN_OBJ)/host/j288_host_wait_win32.o
 # j288 top is a POSIX terminal program: tools/j288/windows/cmd_top.c says so instead.
@@ -68,11 +67,11 @@ WIN_J288 := $(WIN)/j288.exe
 $(WIN_YAML_ENV):
 	bash scripts/libyaml-mingw.sh $(WIN)/libyaml $(WIN_CC)
 
-$(WIN_OBJ)/host/%.o: host/%.c $(WIN_HOST_HDR) $(WIN_YAML_ENV)
+$(WIN_OBJ)/host/%.o: host/%.c $(WIN_YAML_ENV)
 	@mkdir -p $(@D)
 	$(WIN_CC) $(WIN_TOOL_CPPFLAGS) $(call win_yaml_var,YAML_CFLAGS) $(WIN_TOOL_CFLAGS) -c $< -o $@
 
-$(WIN_OBJ)/tools/j288/%.o: tools/j288/%.c $(J288_HDR) $(WIN_HOST_HDR)
+$(WIN_OBJ)/tools/j288/%.o: tools/j288/%.c
 	@mkdir -p $(@D)
 	$(WIN_CC) $(WIN_TOOL_CPPFLAGS) $(WIN_TOOL_CFLAGS) -c $< -o $@
 
@@ -93,9 +92,9 @@ $(WIN_DLL) $(WIN_IMPLIB) &: $(WIN_DLL_OBJ) $(WIN_YAML_ENV)
 WIN_UNITY_OBJ := $(WIN_OBJ)/unity/unity.o
 $(WIN_UNITY_OBJ): $(UNITY)/unity.c
 	@mkdir -p $(@D)
-	$(WIN_CC) -std=c99 -O1 -g -I$(UNITY) $(UNITY_DEFS) -c $< -o $@
+	$(WIN_CC) -std=c99 -O1 -g -I$(UNITY) $(UNITY_DEFS) $(DEPFLAGS) -c $< -o $@
 
-$(WIN_OBJ)/test/%.o: test/%.c $(TEST_HDR) $(WIN_PORT_HDR) $(UNITY)/unity.c
+$(WIN_OBJ)/test/%.o: test/%.c $(UNITY)/unity.c
 	@mkdir -p $(@D)
 	$(WIN_CC) $(TEST_CPPFLAGS) -Iport/windows $(WIN_CFLAGS) -c $< -o $@
 
