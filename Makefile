@@ -83,9 +83,26 @@ all: $(ALL_TARGETS)
 
 lib: $(LIB_A)
 
-$(OBJ)/lib/%.o: lib/%.c
-	@mkdir -p $(@D)
-	$(CC) $(CPPFLAGS_LIB) $(CFLAGS_COMMON) -c $< -o $@
+# Every host object X.c -> $(OBJ)/X.o, and every host program, by these two recipes. An object
+# takes its folder's preprocessor flags from CPPFLAGS_OBJ (pattern-specific, set beside the
+# folder's programs; the most specific pattern wins); an object or program that depends on
+# $(YAML_ENV) gets libyaml's flags.
+CPPFLAGS_OBJ = $(CPPFLAGS_LIB)
+YAML_IF_USED = $(if $(filter $(YAML_ENV),$^),$(call yaml_var,YAML_$(1)))
+define COMPILE
+@mkdir -p $(@D)
+$(CC) $(CPPFLAGS_OBJ) $(call YAML_IF_USED,CFLAGS) $(CFLAGS_COMMON) -c $< -o $@
+endef
+define LINK
+@mkdir -p $(@D)
+$(CC) $(CFLAGS_COMMON) $(filter %.o %.a,$^) -o $@ $(LDFLAGS_COMMON) $(call YAML_IF_USED,LIBS) -lm
+endef
+$(OBJ)/%.o: %.c
+	$(COMPILE)
+# (test objects need Unity's header: fetched first)
+$(OBJ)/test/%.o: test/%.c $(UNITY)/unity.c
+	$(COMPILE)
+$(OBJ)/test/%.o: CPPFLAGS_OBJ = $(TEST_CPPFLAGS)
 
 $(LIB_A): $(LIB_OBJ)
 	@mkdir -p $(@D)
@@ -101,13 +118,8 @@ $(UNITY_OBJ): $(UNITY)/unity.c
 	@mkdir -p $(@D)
 	$(CC) $(UNITY_CFLAGS) -c $< -o $@
 
-$(OBJ)/test/%.o: test/%.c $(UNITY)/unity.c
-	@mkdir -p $(@D)
-	$(CC) $(TEST_CPPFLAGS) $(CFLAGS_COMMON) -c $< -o $@
-
 $(BUILD)/test/%: $(OBJ)/test/unit/%.o $(TEST_SUPPORT_OBJ) $(UNITY_OBJ) $(LIB_A)
-	@mkdir -p $(@D)
-	$(CC) $(CFLAGS_COMMON) $^ -o $@ $(LDFLAGS_COMMON) -lm
+	$(LINK)
 
 # $(call RUN_TESTS,tests...): the runner, with what the test scripts expect to find.
 TEST_ENV = BUILD=$(BUILD) BIN=$(BIN) CC="$(CC)" J288_CFLAGS="$(filter-out $(DEPFLAGS),$(CFLAGS_COMMON))" \
