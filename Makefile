@@ -35,7 +35,6 @@ REQUIRE = $(NEED) $(1) $(2) || { [ $$? -eq 1 ] && exit 0; exit 1; }
 LIB_SRC := $(sort $(wildcard lib/src/*.c))
 LIB_OBJ := $(LIB_SRC:%.c=$(OBJ)/%.o)
 LIB_A := $(BUILD)/lib/libj288.a
-LIB_HDR := $(wildcard lib/include/j288/*.h lib/src/*.h)
 
 # What the fragments build and use (named here so that any fragment can depend on them).
 LINUX_A := $(BUILD)/lib/libj288_linux.a
@@ -53,7 +52,6 @@ UNITY_CFLAGS := -std=c99 -O1 -g -I$(UNITY) $(UNITY_DEFS) $(DEPFLAGS) $(EXTRA_CFL
 TEST_SUPPORT_SRC := $(sort $(wildcard test/support/*.c))
 TEST_SUPPORT_OBJ := $(TEST_SUPPORT_SRC:%.c=$(OBJ)/%.o)
 TEST_CPPFLAGS := $(CPPFLAGS_LIB) -I$(UNITY) -Itest/support -Itest/vectors $(UNITY_DEFS)
-TEST_HDR := $(LIB_HDR) $(wildcard test/support/*.h test/vectors/*.h)
 
 # test/unit/test_*.c -> build/test/test_*: each a plain main() with RUN_TEST lines.
 UNIT_TEST_SRC := $(sort $(wildcard test/unit/test_*.c))
@@ -61,11 +59,12 @@ UNIT_TESTS := $(UNIT_TEST_SRC:test/unit/%.c=$(BUILD)/test/%)
 
 # Fragments append: HOST_TESTS (binaries `make test` runs), TEST_SCRIPTS (shell tests run
 # after them from the repository root, with BUILD, BIN and CC in the environment), TEST_DEPS
-# (what the scripts need), ALL_TARGETS (what `make` builds).
+# (what the scripts need), ALL_TARGETS (what `make` builds besides HOST_TESTS; the CRC
+# variants' sub-builds are left to `make test`).
 HOST_TESTS := $(UNIT_TESTS)
 TEST_SCRIPTS :=
 TEST_DEPS :=
-ALL_TARGETS := $(LIB_A) $(UNIT_TESTS)
+ALL_TARGETS := $(LIB_A)
 
 .PHONY: all lib test unit-tests unity clean help install uninstall
 .DEFAULT_GOAL := all
@@ -76,7 +75,7 @@ include $(sort $(wildcard mk/cpu/*.mk))
 include mk/tools.mk mk/tests.mk mk/target.mk mk/bench.mk mk/hardening.mk mk/firmware.mk
 include mk/robot.mk mk/release.mk mk/python.mk mk/dds.mk mk/windows.mk
 
-all: $(ALL_TARGETS)
+all: $(ALL_TARGETS) $(filter-out $(BUILD)/crc-%,$(HOST_TESTS))
 
 # The header dependencies of every object built so far (DEPFLAGS).
 -include $(shell find $(BUILD) -name '*.d' 2>/dev/null)

@@ -51,10 +51,8 @@ file(GLOB _j288_cli_sources CONFIGURE_DEPENDS "${PROJECT_SOURCE_DIR}/tools/j288/
 add_executable(j288_cli ${_j288_cli_sources})
 # The tools are POSIX programs (signals, realpath, popen); lib/ stays pure C99.
 target_compile_definitions(j288_cli PRIVATE _XOPEN_SOURCE=700)
+# (libyaml comes with the static j288_robot: its private link dependency, LINK_ONLY)
 target_link_libraries(j288_cli PRIVATE j288_robot j288_linux)
-if(J288_YAML_LIB AND J288_YAML_INCLUDE)
-    target_link_libraries(j288_cli PRIVATE ${J288_YAML_LIB})
-endif()
 
 add_executable(j288_sim "${PROJECT_SOURCE_DIR}/tools/j288-sim/servo_model.c"
                         "${PROJECT_SOURCE_DIR}/tools/j288-sim/sim_main.c")
@@ -76,9 +74,6 @@ if(CycloneDDS_FOUND)
     add_executable(j288_dds ${_j288_dds_sources})
     target_compile_definitions(j288_dds PRIVATE _XOPEN_SOURCE=700)
     target_link_libraries(j288_dds PRIVATE j288_dds_types j288_robot j288_linux)
-    if(J288_YAML_LIB AND J288_YAML_INCLUDE)
-        target_link_libraries(j288_dds PRIVATE ${J288_YAML_LIB})
-    endif()
     set_target_properties(j288_dds PROPERTIES OUTPUT_NAME j288-dds)
     list(APPEND _j288_tools j288_dds)
 else()

@@ -25,9 +25,9 @@ FUZZ_SECONDS ?= 30
 FUZZ_CC ?= clang-14
 FUZZ_CFLAGS := -std=c99 -g -O1 -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=undefined \
     -Ilib/include -Itest/fuzz -Itest/support
-FUZZ_BINS := $(FUZZ_NAMES:%=$(BUILD)/fuzz/fuzz_%)
-
-$(BUILD)/fuzz/fuzz_%: test/fuzz/fuzz_%.c $(LIB_SRC) $(TEST_HDR) $(wildcard test/fuzz/*.h tools/j288/*.[ch] host/j288_number.[ch] host/j288_robot_config.[ch])
+# (one compile of every source: the headers listed by hand)
+$(BUILD)/fuzz/fuzz_%: test/fuzz/fuzz_%.c $(LIB_SRC) $(wildcard lib/include/j288/*.h lib/src/*.h test/support/*.h \
+    test/vectors/*.h test/fuzz/*.h tools/j288/*.[ch] host/j288_number.[ch] host/j288_robot_config.[ch])
 	@mkdir -p $(@D)
 	$(FUZZ_CC) $(FUZZ_CFLAGS) $(FUZZ_CPPFLAGS_$*) $(call YAML_IF_USED,CFLAGS) $< $(FUZZ_EXTRA_$*) $(LIB_SRC) -o $@ \
 	    $(call YAML_IF_USED,LIBS) -lm

@@ -12,7 +12,6 @@ $(ROBOT_TEST): $(OBJ)/test/linux/test_robot.o $(SIM_PROCESS_OBJ) $(ROBOT_OBJ) $(
 	$(LINK)
 
 HOST_TESTS += $(ROBOT_TEST)
-ALL_TARGETS += $(ROBOT_TEST)
 TEST_DEPS += $(SIM_BIN)
 
 # The j288 tool's bus commands use the runner (cli_bus.h includes it) and the config reader.

@@ -32,7 +32,6 @@ $(CLI_JOINT_TEST): $(OBJ)/test/cli/test_cli_joint.o $(CLI_CAPTURE_OBJ) \
     $(UNITY_OBJ) $(LINUX_A) $(LIB_A) $(YAML_ENV)
 	$(LINK)
 HOST_TESTS += $(CLI_JOINT_TEST)
-ALL_TARGETS += $(CLI_JOINT_TEST)
 
 # ---- the codec tests with each CRC backend (J288_CONFIG_CRC_BACKEND) -------------------------
 # slice4, nibble, bitwise, and HW through J288_CONFIG_CRC_HW_FUNCTION (a stand-in in
@@ -142,8 +141,6 @@ TEST_SCRIPTS += test/e2e/lib_sim_check.sh
 # The bash completion (tools/completion/j288.bash) against the tools' --help.
 TEST_SCRIPTS += test/e2e/completion.sh
 TEST_DEPS += $(J288_BIN) $(SIM_BIN) $(EXAMPLE_LINUX) $(LIB_A)
-ALL_TARGETS += $(CLI_TEST) $(FUZZ_REPLAY_TESTS) $(LINUX_PORT_TEST) $(CONFIG_TEST) $(SIM_MODEL_TEST) \
-    $(STM32_TEST) $(STM32_G4_TEST) $(STM32_H7_TEST)
 
 .PHONY: check-abi vectors-check
 check-abi: $(LIB_A)
