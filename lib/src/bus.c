@@ -40,6 +40,22 @@ static bool is_active(uint8_t state)
     return (state >= (uint8_t)J288_BUS_TX) && (state <= (uint8_t)J288_BUS_WAIT_REPLY);
 }
 
+/* The flags (J288_BUSF_*, internal.h): one byte, so that "anything pending?" is one test. */
+static bool has_flag(const j288_bus_t *bus, uint8_t f)
+{
+    return (bus->flags & f) != 0u;
+}
+
+static void set_flag(j288_bus_t *bus, uint8_t f)
+{
+    bus->flags = (uint8_t)(bus->flags | f);
+}
+
+static void clear_flags(j288_bus_t *bus, uint8_t f)
+{
+    bus->flags = (uint8_t)(bus->flags & (uint8_t)~f);
+}
+
 static void arm_at(j288_bus_t *bus, uint32_t t)
 {
     bus->timer_at = t;
@@ -208,7 +224,7 @@ static void enter_guard(j288_bus_t *bus, uint32_t end)
     bus->state = (uint8_t)J288_BUS_GUARD;
     bus->guard_end = end;
     arm_at(bus, end);
-    if (bus->estop_pending) {
+    if (has_flag(bus, J288_BUSF_ESTOP_PENDING)) {
         bus->again = true; /* the stop goes out at once, not after the guard */
     }
 }
@@ -231,16 +247,22 @@ static void finish(j288_bus_t *bus, int result, uint32_t now)
     j288_txn_t *t = &bus->txn[bus->cur];
     j288_bus_done_fn done = bus->done;
     void *user = bus->done_user;
-    bool was_estop = bus->estop_active;
+    uint8_t flags = bus->flags;
+    bool was_estop = (flags & J288_BUSF_ESTOP_ACTIVE) != 0u;
 
-    if (!was_estop && bus->estop_pending) {
+    if (!was_estop && ((flags & J288_BUSF_ESTOP_PENDING) != 0u)) {
         result = J288_ERR_ABORTED;
     }
     if (was_estop && (result != J288_OK)) {
         bus->stats.estop_failures++;
-        bus->estop_pending = bus->estop_rearm; /* a request merged into it: a stop of its own */
+        /* a request merged into it: a stop of its own */
+        flags = (uint8_t)(flags & (uint8_t)~J288_BUSF_ESTOP_PENDING);
+        if ((flags & J288_BUSF_ESTOP_REARM) != 0u) {
+            flags |= J288_BUSF_ESTOP_PENDING;
+        }
     }
-    bus->estop_rearm = false;
+    bus->flags = (uint8_t)(flags & (uint8_t)~(J288_BUSF_QUEUED | J288_BUSF_RETRY |
+                                              J288_BUSF_ESTOP_ACTIVE | J288_BUSF_ESTOP_REARM));
     t->result = result;
     t->latency_us = (t->attempts != 0u) ? (uint32_t)(now - t->start_us) : 0u;
     if ((result != J288_OK) || (t->id == J288_BROADCAST_ID)) {
@@ -255,9 +277,6 @@ static void finish(j288_bus_t *bus, int result, uint32_t now)
             bus->stats.failed++;
         }
     }
-    bus->queued = false;
-    bus->retry_pending = false;
-    bus->estop_active = false;
     bus->done = NULL;
     enter_guard(bus, (result == J288_OK) ? (now + bus->cfg.guard_us)
                                          : guard_after_failure(bus, now));
@@ -289,10 +308,10 @@ static bool attempt_is_final(const j288_bus_t *bus, int result, uint8_t attempts
     if ((result == J288_OK) || (result == J288_ERR_OFFLINE)) {
         return true;
     }
-    if (bus->estop_active) {
+    if (has_flag(bus, J288_BUSF_ESTOP_ACTIVE)) {
         return attempts >= J288_ESTOP_ATTEMPTS;
     }
-    return bus->estop_pending || (attempts > bus->cfg.retries);
+    return has_flag(bus, J288_BUSF_ESTOP_PENDING) || (attempts > bus->cfg.retries);
 }
 
 /* An attempt ended: keep its reason, then retry after a guard or finish. */
@@ -307,8 +326,33 @@ static void end_attempt(j288_bus_t *bus, int result, uint32_t now)
         finish(bus, result, now);
         return;
     }
-    bus->retry_pending = true;
+    set_flag(bus, J288_BUSF_RETRY);
     enter_guard(bus, guard_after_failure(bus, now));
+}
+
+/* An attempt ended with its reply taken: end_attempt(J288_OK) and finish() as they go when
+ * no stop is pending or active (the common case, straight through): the transaction is done,
+ * the guard begins, the callback runs. Nothing is queued or waiting to retry while an attempt
+ * is on the wire, and its attempt_result[] entry is J288_OK since begin_txn(). */
+static void end_with_reply(j288_bus_t *bus, uint32_t now)
+{
+    j288_txn_t *t = &bus->txn[bus->cur];
+    j288_bus_done_fn done = bus->done;
+
+    if (bus->flags != 0u) {
+        end_attempt(bus, J288_OK, now);
+        return;
+    }
+    t->result = J288_OK;
+    t->latency_us = (uint32_t)(now - t->start_us);
+    bus->stats.ok++;
+    bus->done = NULL;
+    bus->state = (uint8_t)J288_BUS_GUARD;
+    bus->guard_end = now + bus->cfg.guard_us;
+    arm_at(bus, bus->guard_end);
+    if (done != NULL) {
+        done(bus->done_user, t);
+    }
 }
 
 /* Something recorded that the machine has not looked at yet. */
@@ -393,8 +437,8 @@ J288_NOINLINE static void send_estop(j288_bus_t *bus, uint32_t now)
     j288_cmd_lock(&stop, J288_BROADCAST_ID, false);
     (void)j288_cmd_encode(&stop, bus->tx_buf, &bus->crc); /* constant, valid fields */
     bus->tx_frame = bus->tx_buf;
-    bus->estop_pending = false;
-    bus->estop_active = true;
+    bus->flags = (uint8_t)((bus->flags & (uint8_t)~J288_BUSF_ESTOP_PENDING) |
+                           J288_BUSF_ESTOP_ACTIVE);
     begin_txn(bus, J288_BROADCAST_ID, NULL, NULL);
     bus->stats.estops++; /* not in transactions: the stop is not a user transaction */
     start_attempt(bus, now);
@@ -412,7 +456,7 @@ static void take_frame(j288_bus_t *bus, const uint8_t *frame, uint32_t now)
         return;
     }
     j288_reply_unpack(frame, &bus->txn[bus->cur].reply);
-    end_attempt(bus, J288_OK, now);
+    end_with_reply(bus, now);
 }
 
 /* Reply window: through the parser, which checks a whole frame where it lies. Returns bytes
@@ -595,13 +639,13 @@ static void step_active(j288_bus_t *bus, uint32_t now)
 static void step_quiet(j288_bus_t *bus, uint32_t now)
 {
     consume_all(bus, now); /* late replies and noise: stale */
-    if (bus->retry_pending && (bus->ev_gone != bus->seen_gone)) {
+    if (has_flag(bus, J288_BUSF_RETRY) && (bus->ev_gone != bus->seen_gone)) {
         bus->seen_gone = bus->ev_gone;
         finish(bus, J288_ERR_OFFLINE, now); /* the line went away between two attempts */
         return;
     }
-    if (bus->estop_pending) {
-        if (bus->queued || bus->retry_pending) {
+    if (has_flag(bus, J288_BUSF_ESTOP_PENDING)) {
+        if (has_flag(bus, J288_BUSF_QUEUED | J288_BUSF_RETRY)) {
             finish(bus, J288_ERR_ABORTED, now); /* calls back; the stop goes next time round */
             return;
         }
@@ -609,9 +653,8 @@ static void step_quiet(j288_bus_t *bus, uint32_t now)
         return;
     }
     if ((bus->state == J288_BUS_IDLE) || time_reached(now, bus->guard_end)) {
-        if (bus->queued || bus->retry_pending) {
-            bus->queued = false;
-            bus->retry_pending = false;
+        if (has_flag(bus, J288_BUSF_QUEUED | J288_BUSF_RETRY)) {
+            clear_flags(bus, J288_BUSF_QUEUED | J288_BUSF_RETRY);
             start_attempt(bus, now);
         } else {
             bus->state = (uint8_t)J288_BUS_IDLE;
@@ -710,7 +753,7 @@ J288_NOINLINE static bool reply_fast(j288_bus_t *bus, const uint8_t *data, size_
     bus->in_advance = true;
     bus->again = false;
     j288_reply_unpack(data, &bus->txn[bus->cur].reply);
-    end_attempt(bus, J288_OK, *now);
+    end_with_reply(bus, *now);
     bus->in_advance = false;
     return true;
 }
@@ -724,7 +767,7 @@ static J288_INLINE_HOT void accept(j288_bus_t *bus, const uint8_t *frame, uint8_
     bus->tx_frame = frame;
     begin_txn(bus, id, done, user);
     bus->stats.transactions++;
-    bus->queued = true;
+    set_flag(bus, J288_BUSF_QUEUED);
     /* From a completion callback (inside an advance) the bus is in the guard that finish()
      * has just begun: the guard's timer, or the next poll, starts the transmit. */
     if (!bus->in_advance) {
@@ -857,10 +900,37 @@ void j288_bus_on_error(j288_bus_t *bus, uint32_t line_flags)
     advance_from_event(bus);
 }
 
+/* The guard's end with a submit queued and nothing else waiting (no retry, no stop: the
+ * line's going away matters only to a retry): the next attempt starts, as step_quiet()
+ * starts it. Bytes still in the ring are stale either way (start_attempt() counts them as
+ * step_quiet()'s consume_all() would). Returns false, having done nothing, in any other case. */
+static bool guard_end_fast(j288_bus_t *bus, uint32_t now)
+{
+    if ((bus->flags != J288_BUSF_QUEUED) || (bus->state != (uint8_t)J288_BUS_GUARD) ||
+        !time_reached(now, bus->guard_end)) {
+        return false;
+    }
+    bus->flags = 0u;
+    bus->in_advance = true;
+    bus->again = false;
+    start_attempt(bus, now);
+    bus->in_advance = false;
+    if (bus->again) {
+        advance(bus, now); /* events from inside start_tx, as advance() would take them */
+    }
+    return true;
+}
+
 void j288_bus_on_timer(j288_bus_t *bus)
 {
-    if (bus != NULL) {
-        advance_from_event(bus);
+    uint32_t now;
+
+    if ((bus == NULL) || !bus->cfg.advance_in_isr) {
+        return;
+    }
+    now = bus->port->now_us(bus->port_ctx);
+    if (bus->in_advance || !guard_end_fast(bus, now)) {
+        advance(bus, now);
     }
 }
 
@@ -870,10 +940,11 @@ int j288_bus_estop(j288_bus_t *bus, uint32_t now_us)
         return J288_ERR_NULL;
     }
     j288_bus_lock(bus);
-    if (bus->estop_active) {
-        bus->estop_rearm = true; /* merged into the stop in progress, unless that one fails */
+    if (has_flag(bus, J288_BUSF_ESTOP_ACTIVE)) {
+        set_flag(bus, J288_BUSF_ESTOP_REARM); /* merged into the stop in progress, unless that
+                                                 one fails */
     } else {
-        bus->estop_pending = true;
+        set_flag(bus, J288_BUSF_ESTOP_PENDING);
     }
     if (bus->in_advance) {
         bus->again = true;

@@ -271,13 +271,24 @@ static inline void j288_bus_unlock(const j288_bus_t *bus)
     }
 }
 
+/* j288_bus_t.flags: what waits for the machine, one bit each, written only by the context
+ * that advances it (never by the event calls). */
+#define J288_BUSF_QUEUED 0x01u        /* an accepted submit waits for the guard to end */
+#define J288_BUSF_RETRY 0x02u         /* the failed attempt is re-sent when the guard ends */
+#define J288_BUSF_ESTOP_PENDING 0x04u /* a stop was requested and is not on the wire yet */
+#define J288_BUSF_ESTOP_ACTIVE 0x08u  /* the frame in flight (or to be re-sent) is the stop */
+#define J288_BUSF_ESTOP_REARM 0x10u   /* an estop was requested while the stop was active */
+/* Any of these refuses a submit. */
+#define J288_BUSF_REFUSE                                                                       \
+    (J288_BUSF_QUEUED | J288_BUSF_RETRY | J288_BUSF_ESTOP_PENDING | J288_BUSF_ESTOP_ACTIVE)
+
 /* Whether the bus accepts a new transaction now (j288_bus_submit()'s J288_ERR_BUSY test:
  * idle or in the guard, nothing queued, no retry or estop pending). Call it, and
  * j288_bus_accept_frame() after it, under one j288_bus_lock(). */
 static inline bool j288_bus_accepts(const j288_bus_t *bus)
 {
     uint8_t st = bus->state;
-    return !(bus->estop_pending || bus->estop_active || bus->queued || bus->retry_pending) &&
+    return ((bus->flags & J288_BUSF_REFUSE) == 0u) &&
            ((st == (uint8_t)J288_BUS_IDLE) || (st == (uint8_t)J288_BUS_GUARD));
 }
 

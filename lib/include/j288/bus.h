@@ -160,11 +160,7 @@ typedef struct j288_bus {
     bool collided;        /* this attempt's echo differed */
     bool in_advance;      /* the machine is advancing (re-entry guard) */
     bool again;           /* advance once more: something changed */
-    bool queued;          /* an accepted submit waits for the guard to end */
-    bool retry_pending;   /* the failed attempt is re-sent when the guard ends */
-    bool estop_pending;   /* a stop was requested and is not on the wire yet */
-    bool estop_active;    /* the frame in flight (or to be re-sent) is the stop frame */
-    bool estop_rearm;     /* an estop was requested while the stop was active */
+    uint8_t flags;        /* what waits: a queued submit, a retry, an estop (bus.c) */
     int attempt_fail;     /* most specific failure seen in this attempt, or J288_OK */
     uint32_t deadline;    /* reply deadline of the attempt in flight */
     uint32_t guard_end;
