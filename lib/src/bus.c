@@ -215,6 +215,7 @@ J288_NOINLINE static void ring_put(j288_bus_t *bus, const uint8_t *data, size_t 
         bus->stats.rx_overflows += (uint32_t)(len - n);
     }
     bus->ring_head = head + (uint32_t)n; /* publish after the bytes are in place */
+    bus->ev_any++;
 }
 
 /* ---- attempts and completion */
@@ -355,16 +356,10 @@ static void end_with_reply(j288_bus_t *bus, uint32_t now)
     }
 }
 
-/* Something recorded that the machine has not looked at yet. */
-static bool events_pending(const j288_bus_t *bus)
-{
-    return (bus->ev_tx_done != bus->seen_tx_done) || (bus->ring_head != bus->ring_tail) ||
-           (bus->ev_line != bus->seen_line) || (bus->ev_gone != bus->seen_gone);
-}
-
 static void start_attempt(j288_bus_t *bus, uint32_t now)
 {
     j288_txn_t *t = &bus->txn[bus->cur];
+    uint32_t any = bus->ev_any; /* read first: what is recorded after it counts as new */
     int rc;
 
     /* Whatever arrived before this transmit belongs to nobody. */
@@ -374,6 +369,7 @@ static void start_attempt(j288_bus_t *bus, uint32_t now)
     bus->seen_tx_done = bus->ev_tx_done;
     bus->seen_line = bus->ev_line;
     bus->seen_gone = bus->ev_gone;
+    bus->seen_any = any;
     bus->echo_pos = 0u;
     bus->tx_complete = false;
     bus->collided = false;
@@ -398,7 +394,7 @@ static void start_attempt(j288_bus_t *bus, uint32_t now)
         end_attempt(bus, J288_ERR_PORT, now);
     } else {
         /* Events reported from inside start_tx are taken in this same advance. */
-        bus->again = bus->again || events_pending(bus);
+        bus->again = bus->again || (bus->ev_any != any);
     }
 }
 
@@ -615,6 +611,8 @@ J288_NOINLINE static void on_deadline(j288_bus_t *bus, uint32_t now)
 
 static void step_active(j288_bus_t *bus, uint32_t now)
 {
+    uint32_t any = bus->ev_any; /* read first: this step takes every event recorded so far */
+
     if (bus->ev_gone != bus->seen_gone) {
         bus->seen_gone = bus->ev_gone;
         end_attempt(bus, J288_ERR_OFFLINE, now);
@@ -622,6 +620,7 @@ static void step_active(j288_bus_t *bus, uint32_t now)
         return;
     }
     take_events(bus, now);
+    bus->seen_any = any;
     if (!is_active(bus->state)) {
         return; /* a reply ended the attempt */
     }
@@ -694,18 +693,13 @@ static void advance_from_event(j288_bus_t *bus)
  * event counter, the ring, the parser's hunt) is skipped. Each does exactly what advance()
  * would do for that event and falls back to it in every other case. */
 
-/* No event counter moved but tx_done_events transmit-completes. */
-static bool only_these_events(const j288_bus_t *bus, uint32_t tx_done_events)
+/* Exactly n events were recorded since the machine last had taken every one (seen_any: a
+ * transmit's start, a pass of step_active(), the tx-done fast path), so that with n = 1 in an
+ * event call the event being handled is the only new one: no other event counter moved, no
+ * byte was put in the ring. (Outside an advance no byte waits in place either.) */
+static bool events_since_seen(const j288_bus_t *bus, uint32_t n)
 {
-    return ((bus->ev_tx_done - bus->seen_tx_done) == tx_done_events) &&
-           (bus->ev_line == bus->seen_line) && (bus->ev_gone == bus->seen_gone);
-}
-
-/* Only the event being handled is new: no other event counter moved, no byte waits. */
-static bool only_this_event(const j288_bus_t *bus, uint32_t tx_done_events)
-{
-    return only_these_events(bus, tx_done_events) && (bus->ring_head == bus->ring_tail) &&
-           (bus->direct_len == 0u);
+    return (uint32_t)(bus->ev_any - bus->seen_any) == n;
 }
 
 /* Transmit complete, no echo expected, the deadline not passed: wait for the reply. */
@@ -714,7 +708,7 @@ static bool tx_done_fast(j288_bus_t *bus)
     uint32_t now;
 
     if ((bus->state != (uint8_t)J288_BUS_TX) || bus->cfg.echo ||
-        (bus->tx_id == J288_BROADCAST_ID) || !only_this_event(bus, 1u)) {
+        (bus->tx_id == J288_BROADCAST_ID) || !events_since_seen(bus, 1u)) {
         return false;
     }
     now = bus->port->now_us(bus->port_ctx);
@@ -723,6 +717,7 @@ static bool tx_done_fast(j288_bus_t *bus)
         return true;
     }
     bus->seen_tx_done = bus->ev_tx_done;
+    bus->seen_any = bus->ev_any;
     bus->tx_complete = true;
     bus->state = (uint8_t)J288_BUS_WAIT_REPLY;
     return true;
@@ -741,7 +736,7 @@ J288_NOINLINE static bool reply_fast(j288_bus_t *bus, const uint8_t *data, size_
     uint32_t head = bus->ring_head;
 
     if ((len != J288_REPLY_LEN) || (bus->state != (uint8_t)J288_BUS_WAIT_REPLY) ||
-        !only_these_events(bus, 0u) || (bus->parser.len != 0u) ||
+        !events_since_seen(bus, 0u) || (bus->parser.len != 0u) ||
         (j288_get_u16le(data) != J288_REPLY_HEAD16) || ((data[2] & 0x0Fu) != bus->tx_id) ||
         !j288_reply_crc_ok(&bus->crc, data)) {
         return false;
@@ -820,6 +815,7 @@ void j288_bus_on_tx_done(j288_bus_t *bus)
     }
     bus->txdone_mark = bus->ring_head;
     bus->ev_tx_done++;
+    bus->ev_any++;
     /* Listen at once: the servo answers within microseconds. */
     if (bus->port->set_dir != NULL) {
         bus->port->set_dir(bus->port_ctx, J288_DIR_RX);
@@ -897,6 +893,7 @@ void j288_bus_on_error(j288_bus_t *bus, uint32_t line_flags)
     } else {
         bus->ev_line++;
     }
+    bus->ev_any++;
     advance_from_event(bus);
 }
 
