@@ -265,7 +265,12 @@ static void finish(j288_bus_t *bus, int result, uint32_t now)
     bus->flags = (uint8_t)(flags & (uint8_t)~(J288_BUSF_QUEUED | J288_BUSF_RETRY |
                                               J288_BUSF_ESTOP_ACTIVE | J288_BUSF_ESTOP_REARM));
     t->result = result;
-    t->latency_us = (t->attempts != 0u) ? (uint32_t)(now - t->start_us) : 0u;
+    if (t->attempts != 0u) {
+        t->latency_us = (uint32_t)(now - t->start_us);
+    } else {
+        t->start_us = 0u; /* never sent */
+        t->latency_us = 0u;
+    }
     if ((result != J288_OK) || (t->id == J288_BROADCAST_ID)) {
         (void)memset(&t->reply, 0, sizeof t->reply); /* no reply was taken */
     }
@@ -399,8 +404,9 @@ static void start_attempt(j288_bus_t *bus, uint32_t now)
 }
 
 /* A new transaction record, in the slot the previous callback is not looking at. Only what a
- * callback may read is set here (no clearing of the whole record): the reply is cleared by
- * finish() when none is taken. */
+ * callback may read is set here (no clearing of the whole record), and only what the end of
+ * the transaction does not set (result, start and latency: start_attempt() and finish()); the
+ * reply is cleared by finish() when none is taken. */
 static void begin_txn(j288_bus_t *bus, uint8_t id, j288_bus_done_fn done, void *user)
 {
     j288_txn_t *t;
@@ -409,15 +415,12 @@ static void begin_txn(j288_bus_t *bus, uint8_t id, j288_bus_done_fn done, void *
     bus->cur ^= 1u;
     t = &bus->txn[bus->cur];
     t->id = id;
-    t->result = J288_ERR_BUSY;
     t->attempts = 0u;
     /* Element by element: a few stores, where some targets' compilers (RV32) would call
      * memset for these 16 bytes. */
     for (i = 0u; i < (J288_CONFIG_MAX_RETRIES + 1u); i++) {
         t->attempt_result[i] = J288_OK;
     }
-    t->start_us = 0u;
-    t->latency_us = 0u;
     bus->tx_id = id;
     bus->done = done;
     bus->done_user = user;
@@ -729,11 +732,12 @@ static bool tx_done_fast(j288_bus_t *bus)
  * an advance with the ring empty (so no bytes wait in place either). In WAIT_REPLY every byte
  * still in the ring's past came after the transmit (before it, the state was TX or ECHO), and
  * with nothing held by the parser the byte path would find this frame where it starts.
- * Nothing changes unless it is taken; then *now is the time it was taken at. */
-J288_NOINLINE static bool reply_fast(j288_bus_t *bus, const uint8_t *data, size_t len,
-                                     uint32_t *now)
+ * Nothing changes unless it is taken; then whatever the completion asked for (an estop)
+ * follows in an advance, as advance() would take it. Returns whether it was taken. */
+J288_NOINLINE static bool reply_fast(j288_bus_t *bus, const uint8_t *data, size_t len)
 {
     uint32_t head = bus->ring_head;
+    uint32_t now;
 
     if ((len != J288_REPLY_LEN) || (bus->state != (uint8_t)J288_BUS_WAIT_REPLY) ||
         !events_since_seen(bus, 0u) || (bus->parser.len != 0u) ||
@@ -741,15 +745,18 @@ J288_NOINLINE static bool reply_fast(j288_bus_t *bus, const uint8_t *data, size_
         !j288_reply_crc_ok(&bus->crc, data)) {
         return false;
     }
-    *now = bus->port->now_us(bus->port_ctx);
+    now = bus->port->now_us(bus->port_ctx);
     bus->ring_head = head + J288_REPLY_LEN;
     bus->ring_tail = head + J288_REPLY_LEN;
     bus->parser.stats.frames++;
     bus->in_advance = true;
     bus->again = false;
     j288_reply_unpack(data, &bus->txn[bus->cur].reply);
-    end_with_reply(bus, *now);
+    end_with_reply(bus, now);
     bus->in_advance = false;
+    if (bus->again) {
+        advance(bus, now); /* what the completion asked for (an estop), as advance() would */
+    }
     return true;
 }
 
@@ -854,8 +861,6 @@ J288_NOINLINE static void take_in_place(j288_bus_t *bus, const uint8_t *data, si
 
 void j288_bus_on_rx(j288_bus_t *bus, const uint8_t *data, size_t len)
 {
-    uint32_t now;
-
     if ((bus == NULL) || (data == NULL) || (len == 0u)) {
         return;
     }
@@ -864,13 +869,9 @@ void j288_bus_on_rx(j288_bus_t *bus, const uint8_t *data, size_t len)
         advance_from_event(bus);
         return;
     }
-    if (reply_fast(bus, data, len, &now)) {
-        if (bus->again) {
-            advance(bus, now); /* what the completion asked for (an estop), as advance() would */
-        }
-        return;
+    if (!reply_fast(bus, data, len)) {
+        take_in_place(bus, data, len);
     }
-    take_in_place(bus, data, len);
 }
 
 /* Nothing to do: a reply with a pause inside it is heard whole until the deadline, and a
