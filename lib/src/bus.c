@@ -403,29 +403,6 @@ static void start_attempt(j288_bus_t *bus, uint32_t now)
     }
 }
 
-/* A new transaction record, in the slot the previous callback is not looking at. Only what a
- * callback may read is set here (no clearing of the whole record), and only what the end of
- * the transaction does not set (result, start and latency: start_attempt() and finish()); the
- * reply is cleared by finish() when none is taken. */
-static void begin_txn(j288_bus_t *bus, uint8_t id, j288_bus_done_fn done, void *user)
-{
-    j288_txn_t *t;
-    unsigned i;
-
-    bus->cur ^= 1u;
-    t = &bus->txn[bus->cur];
-    t->id = id;
-    t->attempts = 0u;
-    /* Element by element: a few stores, where some targets' compilers (RV32) would call
-     * memset for these 16 bytes. */
-    for (i = 0u; i < (J288_CONFIG_MAX_RETRIES + 1u); i++) {
-        t->attempt_result[i] = J288_OK;
-    }
-    bus->tx_id = id;
-    bus->done = done;
-    bus->done_user = user;
-}
-
 J288_NOINLINE static void send_estop(j288_bus_t *bus, uint32_t now)
 {
     j288_cmd_raw_t stop;
@@ -438,7 +415,7 @@ J288_NOINLINE static void send_estop(j288_bus_t *bus, uint32_t now)
     bus->tx_frame = bus->tx_buf;
     bus->flags = (uint8_t)((bus->flags & (uint8_t)~J288_BUSF_ESTOP_PENDING) |
                            J288_BUSF_ESTOP_ACTIVE);
-    begin_txn(bus, J288_BROADCAST_ID, NULL, NULL);
+    j288_bus_begin_txn(bus, J288_BROADCAST_ID, NULL, NULL);
     bus->stats.estops++; /* not in transactions: the stop is not a user transaction */
     start_attempt(bus, now);
 }
@@ -766,10 +743,7 @@ J288_NOINLINE static bool reply_fast(j288_bus_t *bus, const uint8_t *data, size_
 static J288_INLINE_HOT void accept(j288_bus_t *bus, const uint8_t *frame, uint8_t id,
                                    uint32_t now_us, j288_bus_done_fn done, void *user)
 {
-    bus->tx_frame = frame;
-    begin_txn(bus, id, done, user);
-    bus->stats.transactions++;
-    set_flag(bus, J288_BUSF_QUEUED);
+    j288_bus_queue_frame(bus, frame, id, done, user);
     /* From a completion callback (inside an advance) the bus is in the guard that finish()
      * has just begun: the guard's timer, or the next poll, starts the transmit. */
     if (!bus->in_advance) {

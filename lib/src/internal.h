@@ -292,6 +292,41 @@ static inline bool j288_bus_accepts(const j288_bus_t *bus)
            ((st == (uint8_t)J288_BUS_IDLE) || (st == (uint8_t)J288_BUS_GUARD));
 }
 
+/* A new transaction record, in the slot the previous callback is not looking at. Only what a
+ * callback may read is set here (no clearing of the whole record), and only what the end of
+ * the transaction does not set (result, start and latency: start_attempt() and finish()); the
+ * reply is cleared by finish() when none is taken. */
+static J288_INLINE_HOT void j288_bus_begin_txn(j288_bus_t *bus, uint8_t id,
+                                               j288_bus_done_fn done, void *user)
+{
+    j288_txn_t *t;
+    unsigned i;
+
+    bus->cur ^= 1u;
+    t = &bus->txn[bus->cur];
+    t->id = id;
+    t->attempts = 0u;
+    /* Element by element: a few stores, where some targets' compilers (RV32) would call
+     * memset for these 16 bytes. */
+    for (i = 0u; i < (J288_CONFIG_MAX_RETRIES + 1u); i++) {
+        t->attempt_result[i] = J288_OK;
+    }
+    bus->tx_id = id;
+    bus->done = done;
+    bus->done_user = user;
+}
+
+/* j288_bus_accept_frame() from inside an advance (a completion callback), where it only
+ * queues: the guard's timer, or the next poll, starts the transmit. */
+static J288_INLINE_HOT void j288_bus_queue_frame(j288_bus_t *bus, const uint8_t *frame,
+                                                 uint8_t id, j288_bus_done_fn done, void *user)
+{
+    bus->tx_frame = frame;
+    j288_bus_begin_txn(bus, id, done, user);
+    bus->stats.transactions++;
+    bus->flags = (uint8_t)(bus->flags | J288_BUSF_QUEUED);
+}
+
 /* The transaction of frame (J288_CMD_LEN bytes, addressed to id, CRC in place) begins, once
  * j288_bus_accepts() said yes under the same lock; the frame is sent from where it is, for
  * every attempt and the echo check, and must stay untouched until the completion call. */

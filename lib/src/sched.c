@@ -229,7 +229,11 @@ static int submit_slot(j288_sched_t *s, uint8_t id, uint32_t now, bool locked)
             j288_cmd_pack(&slot->cmd, s->frame[id], &bus->crc);
             s->frame_stale &= (uint16_t)~bit;
         }
-        j288_bus_accept_frame(bus, s->frame[id], id, now, sched_done, s);
+        if (bus->in_advance) {
+            j288_bus_queue_frame(bus, s->frame[id], id, sched_done, s); /* a completion's */
+        } else {
+            j288_bus_accept_frame(bus, s->frame[id], id, now, sched_done, s);
+        }
         rc = J288_OK;
     }
     if (locked) {
