@@ -340,7 +340,7 @@ static void end_attempt(j288_bus_t *bus, int result, uint32_t now)
  * no stop is pending or active (the common case, straight through): the transaction is done,
  * the guard begins, the callback runs. Nothing is queued or waiting to retry while an attempt
  * is on the wire, and its attempt_result[] entry is J288_OK since begin_txn(). */
-static void end_with_reply(j288_bus_t *bus, uint32_t now)
+static J288_INLINE_HOT void end_with_reply(j288_bus_t *bus, uint32_t now)
 {
     j288_txn_t *t = &bus->txn[bus->cur];
     j288_bus_done_fn done = bus->done;
