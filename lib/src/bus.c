@@ -361,7 +361,7 @@ static J288_INLINE_HOT void end_with_reply(j288_bus_t *bus, uint32_t now)
     }
 }
 
-static void start_attempt(j288_bus_t *bus, uint32_t now)
+static J288_INLINE_HOT void start_attempt(j288_bus_t *bus, uint32_t now)
 {
     j288_txn_t *t = &bus->txn[bus->cur];
     uint32_t any = bus->ev_any; /* read first: what is recorded after it counts as new */
@@ -403,6 +403,13 @@ static void start_attempt(j288_bus_t *bus, uint32_t now)
     }
 }
 
+/* The same out of line, for the paths that are not hot (a retry, the stop frame, a submit to
+ * an idle bus); the guard's end in the event calls has it inlined. */
+static void start_attempt_called(j288_bus_t *bus, uint32_t now)
+{
+    start_attempt(bus, now);
+}
+
 J288_NOINLINE static void send_estop(j288_bus_t *bus, uint32_t now)
 {
     j288_cmd_raw_t stop;
@@ -417,7 +424,7 @@ J288_NOINLINE static void send_estop(j288_bus_t *bus, uint32_t now)
                            J288_BUSF_ESTOP_ACTIVE);
     j288_bus_begin_txn(bus, J288_BROADCAST_ID, NULL, NULL);
     bus->stats.estops++; /* not in transactions: the stop is not a user transaction */
-    start_attempt(bus, now);
+    start_attempt_called(bus, now);
 }
 
 /* ---- byte consumption */
@@ -634,7 +641,7 @@ static void step_quiet(j288_bus_t *bus, uint32_t now)
     if ((bus->state == J288_BUS_IDLE) || time_reached(now, bus->guard_end)) {
         if (has_flag(bus, J288_BUSF_QUEUED | J288_BUSF_RETRY)) {
             clear_flags(bus, J288_BUSF_QUEUED | J288_BUSF_RETRY);
-            start_attempt(bus, now);
+            start_attempt_called(bus, now);
         } else {
             bus->state = (uint8_t)J288_BUS_IDLE;
         }
