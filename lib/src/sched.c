@@ -111,6 +111,7 @@ J288_NOINLINE static void report_reply(j288_sched_t *s, j288_slot_t *slot, uint8
 {
     const j288_reply_raw_t *r = &slot->reply;
 
+    slot->has_reply = true; /* (a slot without a reply yet is offline: it comes here) */
     if (!slot->online) {
         slot->online = true;
         emit(s, J288_EV_ONLINE, id, 0u, 0u);
@@ -144,7 +145,6 @@ static void take_reply(j288_sched_t *s, j288_slot_t *slot, const j288_txn_t *txn
         slot->stats.worst_latency_us = latency;
     }
     slot->reply = *r;
-    slot->has_reply = true;
     slot->reply_us = txn->start_us + latency;
     if (s->wd_clear_in_flight) {
         slot->clear_watchdog = false; /* the servo heard it: once is enough */
