@@ -150,7 +150,7 @@ typedef struct j288_bus {
     volatile uint32_t ev_gone;     /* (ev) */
     volatile uint32_t txdone_mark; /* (ev) ring_head when the transmit completed */
     volatile uint32_t line_flags;  /* (ev) OR of every line flag reported (diagnostic) */
-    volatile uint32_t ev_any;      /* (ev) every event above and every on_rx into the ring */
+    volatile uint32_t ev_any;      /* (ev) +1 at every tx done, line report, on_rx into ring */
     uint32_t seen_tx_done, seen_line, seen_gone;
     uint32_t seen_any;             /* ev_any when the machine had last taken every event */
     const uint8_t *direct;         /* bytes of an on_rx taken in place (advance_in_isr), */
