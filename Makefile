@@ -35,7 +35,6 @@ REQUIRE = $(NEED) $(1) $(2) || { [ $$? -eq 1 ] && exit 0; exit 1; }
 LIB_SRC := $(sort $(wildcard lib/src/*.c))
 LIB_OBJ := $(LIB_SRC:%.c=$(OBJ)/%.o)
 LIB_A := $(BUILD)/lib/libj288.a
-LIB_HDR := $(wildcard lib/include/j288/*.h lib/src/*.h)
 
 # What the fragments build and use (named here so that any fragment can depend on them).
 LINUX_A := $(BUILD)/lib/libj288_linux.a
@@ -53,7 +52,6 @@ UNITY_CFLAGS := -std=c99 -O1 -g -I$(UNITY) $(UNITY_DEFS) $(DEPFLAGS) $(EXTRA_CFL
 TEST_SUPPORT_SRC := $(sort $(wildcard test/support/*.c))
 TEST_SUPPORT_OBJ := $(TEST_SUPPORT_SRC:%.c=$(OBJ)/%.o)
 TEST_CPPFLAGS := $(CPPFLAGS_LIB) -I$(UNITY) -Itest/support -Itest/vectors $(UNITY_DEFS)
-TEST_HDR := $(LIB_HDR) $(wildcard test/support/*.h test/vectors/*.h)
 
 # test/unit/test_*.c -> build/test/test_*: each a plain main() with RUN_TEST lines.
 UNIT_TEST_SRC := $(sort $(wildcard test/unit/test_*.c))
@@ -61,11 +59,12 @@ UNIT_TESTS := $(UNIT_TEST_SRC:test/unit/%.c=$(BUILD)/test/%)
 
 # Fragments append: HOST_TESTS (binaries `make test` runs), TEST_SCRIPTS (shell tests run
 # after them from the repository root, with BUILD, BIN and CC in the environment), TEST_DEPS
-# (what the scripts need), ALL_TARGETS (what `make` builds).
+# (what the scripts need), ALL_TARGETS (what `make` builds besides HOST_TESTS; the CRC
+# variants' sub-builds are left to `make test`).
 HOST_TESTS := $(UNIT_TESTS)
 TEST_SCRIPTS :=
 TEST_DEPS :=
-ALL_TARGETS := $(LIB_A) $(UNIT_TESTS)
+ALL_TARGETS := $(LIB_A)
 
 .PHONY: all lib test unit-tests unity clean help install uninstall
 .DEFAULT_GOAL := all
@@ -76,16 +75,33 @@ include $(sort $(wildcard mk/cpu/*.mk))
 include mk/tools.mk mk/tests.mk mk/target.mk mk/bench.mk mk/hardening.mk mk/firmware.mk
 include mk/robot.mk mk/release.mk mk/python.mk mk/dds.mk mk/windows.mk
 
-all: $(ALL_TARGETS)
+all: $(ALL_TARGETS) $(filter-out $(BUILD)/crc-%,$(HOST_TESTS))
 
 # The header dependencies of every object built so far (DEPFLAGS).
 -include $(shell find $(BUILD) -name '*.d' 2>/dev/null)
 
 lib: $(LIB_A)
 
-$(OBJ)/lib/%.o: lib/%.c
-	@mkdir -p $(@D)
-	$(CC) $(CPPFLAGS_LIB) $(CFLAGS_COMMON) -c $< -o $@
+# Every host object X.c -> $(OBJ)/X.o, and every host program, by these two recipes. An object
+# takes its folder's preprocessor flags from CPPFLAGS_OBJ (pattern-specific, set beside the
+# folder's programs; the most specific pattern wins); an object or program that depends on
+# $(YAML_ENV) gets libyaml's flags.
+CPPFLAGS_OBJ = $(CPPFLAGS_LIB)
+YAML_IF_USED = $(if $(filter $(YAML_ENV),$^),$(call yaml_var,YAML_$(1)))
+define COMPILE
+@mkdir -p $(@D)
+$(CC) $(CPPFLAGS_OBJ) $(call YAML_IF_USED,CFLAGS) $(CFLAGS_COMMON) -c $< -o $@
+endef
+define LINK
+@mkdir -p $(@D)
+$(CC) $(CFLAGS_COMMON) $(filter %.o %.a,$^) -o $@ $(LDFLAGS_COMMON) $(call YAML_IF_USED,LIBS) -lm
+endef
+$(OBJ)/%.o: %.c
+	$(COMPILE)
+# (test objects need Unity's header: fetched first)
+$(OBJ)/test/%.o: test/%.c $(UNITY)/unity.c
+	$(COMPILE)
+$(OBJ)/test/%.o: CPPFLAGS_OBJ = $(TEST_CPPFLAGS)
 
 $(LIB_A): $(LIB_OBJ)
 	@mkdir -p $(@D)
@@ -101,13 +117,8 @@ $(UNITY_OBJ): $(UNITY)/unity.c
 	@mkdir -p $(@D)
 	$(CC) $(UNITY_CFLAGS) -c $< -o $@
 
-$(OBJ)/test/%.o: test/%.c $(UNITY)/unity.c
-	@mkdir -p $(@D)
-	$(CC) $(TEST_CPPFLAGS) $(CFLAGS_COMMON) -c $< -o $@
-
 $(BUILD)/test/%: $(OBJ)/test/unit/%.o $(TEST_SUPPORT_OBJ) $(UNITY_OBJ) $(LIB_A)
-	@mkdir -p $(@D)
-	$(CC) $(CFLAGS_COMMON) $^ -o $@ $(LDFLAGS_COMMON) -lm
+	$(LINK)
 
 # $(call RUN_TESTS,tests...): the runner, with what the test scripts expect to find.
 TEST_ENV = BUILD=$(BUILD) BIN=$(BIN) CC="$(CC)" J288_CFLAGS="$(filter-out $(DEPFLAGS),$(CFLAGS_COMMON))" \
@@ -122,19 +133,15 @@ test: $(HOST_TESTS) $(TEST_DEPS)
 
 # ---- install ---------------------------------------------------------------------------------
 # CMake's install (cmake/j288_install.cmake) from $(CMAKE_BUILD) for PREFIX under DESTDIR;
-# uninstall removes what it listed ($(INSTALLED)) and the j288 directories left empty. A program
-# CMake does not build (mk/dds.mk): a prerequisite of install, listed in $(INSTALLED_EXTRA).
+# uninstall removes what it listed ($(INSTALLED)) and the j288 directories left empty.
 PREFIX ?= /usr/local
-BINDIR ?= $(PREFIX)/bin
 CMAKE_BUILD := $(BUILD)/cmake
 INSTALLED := $(CMAKE_BUILD)/installed.txt
-INSTALLED_EXTRA := $(CMAKE_BUILD)/installed-extra.txt
 install:
 	@$(call REQUIRE,cmake,cmake); \
 	 cmake -S . -B $(CMAKE_BUILD) -DCMAKE_INSTALL_PREFIX=$(PREFIX) $(CMAKE_FLAGS) >/dev/null && \
 	 cmake --build $(CMAKE_BUILD) -j2 && DESTDIR=$(DESTDIR) cmake --install $(CMAKE_BUILD) && \
-	 { sed 's|^|$(DESTDIR)|' $(CMAKE_BUILD)/install_manifest.txt; echo; cat $(INSTALLED_EXTRA) 2>/dev/null; } | \
-	     grep . >$(INSTALLED); rm -f $(INSTALLED_EXTRA)
+	 { sed 's|^|$(DESTDIR)|' $(CMAKE_BUILD)/install_manifest.txt; echo; } | grep . >$(INSTALLED)
 
 uninstall:
 	@[ -f $(INSTALLED) ] || { echo "uninstall: $(INSTALLED) missing: nothing installed from here"; exit 1; }

@@ -1,7 +1,7 @@
 # The one install (`make install` runs it too): the static library and its headers, the CMake
 # package (exported targets j288::j288 and, on Linux, j288::robot), and when built libj288.so,
-# the port's headers, j288.pc, j288 and j288-sim with their man pages and bash completion, and
-# the Python package. `make uninstall` removes what install_manifest.txt lists.
+# the port's headers, j288.pc, j288, j288-sim and j288-dds with their man pages, bash completion
+# and the Python package. `make uninstall` removes what install_manifest.txt lists.
 include(GNUInstallDirs)
 include(CMakePackageConfigHelpers)
 set(_j288_cmake_dir "${CMAKE_INSTALL_LIBDIR}/cmake/j288")
@@ -10,7 +10,7 @@ install(TARGETS j288 EXPORT j288Targets ARCHIVE DESTINATION "${CMAKE_INSTALL_LIB
 install(DIRECTORY "${PROJECT_SOURCE_DIR}/lib/include/j288" DESTINATION "${CMAKE_INSTALL_INCLUDEDIR}"
         FILES_MATCHING PATTERN "*.h")
 if(TARGET j288_cli AND TARGET j288_sim)
-    install(TARGETS j288_cli j288_sim RUNTIME DESTINATION "${CMAKE_INSTALL_BINDIR}")
+    install(TARGETS ${_j288_tools} RUNTIME DESTINATION "${CMAKE_INSTALL_BINDIR}")
     foreach(f ${J288_MAN_PAGES})
         install(FILES "${f}" DESTINATION "${CMAKE_INSTALL_MANDIR}/man1")
     endforeach()

@@ -1,7 +1,7 @@
 # The Linux port (j288_linux, static), the robot config reader and multi-bus runner
 # (j288_robot, static; libyaml when found, else the reader says it is missing), the shared
 # library libj288.so (lib + port + runner: what the Python package loads) and the tools j288
-# (tools/j288) and j288-sim (tools/j288-sim), with the Makefile's sources and flags. POSIX
+# (tools/j288), j288-sim (tools/j288-sim) and j288-dds (tools/j288-dds), with the Makefile's sources and flags. POSIX
 # programs: Linux only.
 if(NOT CMAKE_SYSTEM_NAME STREQUAL "Linux")
     message(STATUS "j288: the Linux port, j288 and j288-sim are built on Linux only")
@@ -51,18 +51,38 @@ file(GLOB _j288_cli_sources CONFIGURE_DEPENDS "${PROJECT_SOURCE_DIR}/tools/j288/
 add_executable(j288_cli ${_j288_cli_sources})
 # The tools are POSIX programs (signals, realpath, popen); lib/ stays pure C99.
 target_compile_definitions(j288_cli PRIVATE _XOPEN_SOURCE=700)
+# (libyaml comes with the static j288_robot: its private link dependency, LINK_ONLY)
 target_link_libraries(j288_cli PRIVATE j288_robot j288_linux)
-if(J288_YAML_LIB AND J288_YAML_INCLUDE)
-    target_link_libraries(j288_cli PRIVATE ${J288_YAML_LIB})
-endif()
 
 add_executable(j288_sim "${PROJECT_SOURCE_DIR}/tools/j288-sim/servo_model.c"
                         "${PROJECT_SOURCE_DIR}/tools/j288-sim/sim_main.c")
 target_link_libraries(j288_sim PRIVATE j288::j288)
 
+# The DDS bridge (tools/j288-dds, docs/dds.md), when Cyclone DDS is there (Debian: cyclonedds-dev
+# cyclonedds-tools). idlc's code (NO_TYPE_INFO: -t, as in mk/dds.mk) is built apart, without the
+# project's warning set: it is idlc's.
+find_package(CycloneDDS QUIET)
+set(_j288_tools j288_cli j288_sim)
+if(CycloneDDS_FOUND)
+    file(GLOB _j288_idl CONFIGURE_DEPENDS "${PROJECT_SOURCE_DIR}/tools/j288-dds/idl/*.idl")
+    idlc_generate(TARGET j288_dds_idl FILES ${_j288_idl} NO_TYPE_INFO
+                  INCLUDES "${PROJECT_SOURCE_DIR}/tools/j288-dds/idl")
+    add_library(j288_dds_types STATIC)
+    target_link_libraries(j288_dds_types PRIVATE j288_dds_idl PUBLIC CycloneDDS::ddsc)
+    target_include_directories(j288_dds_types PUBLIC "${CMAKE_CURRENT_BINARY_DIR}")
+    file(GLOB _j288_dds_sources CONFIGURE_DEPENDS "${PROJECT_SOURCE_DIR}/tools/j288-dds/*.c")
+    add_executable(j288_dds ${_j288_dds_sources})
+    target_compile_definitions(j288_dds PRIVATE _XOPEN_SOURCE=700)
+    target_link_libraries(j288_dds PRIVATE j288_dds_types j288_robot j288_linux)
+    set_target_properties(j288_dds PROPERTIES OUTPUT_NAME j288-dds)
+    list(APPEND _j288_tools j288_dds)
+else()
+    message(STATUS "j288: Cyclone DDS not found (Debian: cyclonedds-dev cyclonedds-tools): no j288-dds")
+endif()
+
 set_target_properties(j288_cli PROPERTIES OUTPUT_NAME j288)
 set_target_properties(j288_sim PROPERTIES OUTPUT_NAME j288-sim)
-foreach(t j288_linux j288_robot j288_shared j288_cli j288_sim)
+foreach(t j288_linux j288_robot j288_shared ${_j288_tools})
     set_target_properties(${t} PROPERTIES C_STANDARD 99 C_STANDARD_REQUIRED ON C_EXTENSIONS OFF)
     if(CMAKE_C_COMPILER_ID MATCHES "GNU|Clang")
         target_compile_options(${t} PRIVATE ${J288_WARNINGS})
@@ -83,6 +103,10 @@ if(J288_HELP2MAN)
     j288_man(j288_cli j288 "Unitree J288/S288 servo bus tool")
     j288_man(j288_sim j288-sim "simulated J288 servo bus")
     set(J288_MAN_PAGES "${PROJECT_BINARY_DIR}/j288.1" "${PROJECT_BINARY_DIR}/j288-sim.1")
+    if(TARGET j288_dds)
+        j288_man(j288_dds j288-dds "J288 robot on DDS for ROS 2 and unitree_sdk2")
+        list(APPEND J288_MAN_PAGES "${PROJECT_BINARY_DIR}/j288-dds.1")
+    endif()
 else()
     message(STATUS "j288: help2man not found (Debian: help2man): no man pages")
 endif()

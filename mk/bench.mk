@@ -27,9 +27,9 @@ bench-bus: $(ENGINE_BENCH)
 
 CODEC_BENCH := $(BUILD)/bench/codec_bench
 CODEC_BENCH_N ?= 20000
-$(CODEC_BENCH): test/bench/codec_bench.c $(LIB_A) $(LIB_HDR)
-	@mkdir -p $(@D)
-	$(CC) $(CPPFLAGS_LIB) $(CFLAGS_COMMON) $< $(LIB_A) -o $@ $(LDFLAGS_COMMON) -lm
+$(OBJ)/test/bench/%.o: CPPFLAGS_OBJ = $(CPPFLAGS_LIB)
+$(CODEC_BENCH): $(OBJ)/test/bench/codec_bench.o $(LIB_A)
+	$(LINK)
 
 bench-codec: $(CODEC_BENCH)
 	@$(call REQUIRE,valgrind,valgrind); \
@@ -37,8 +37,7 @@ bench-codec: $(CODEC_BENCH)
 
 LINUX_BENCH := $(BUILD)/bench/bench_linux_port
 $(LINUX_BENCH): $(OBJ)/test/linux/bench_linux_port.o $(LINUX_A) $(LIB_A)
-	@mkdir -p $(@D)
-	$(CC) $(CFLAGS_COMMON) $^ -o $@ $(LDFLAGS_COMMON) -lm
+	$(LINK)
 
 bench-linux: $(LINUX_BENCH) $(SIM_BIN)
 	$(LINUX_BENCH) $(SIM_BIN) 5000

@@ -6,10 +6,11 @@
 #                      in a private network namespace (TEST_SCRIPTS)
 #   make test-dds      those tests alone (CI's test-dds step)
 #   make bench-dds     cycles/s with and without DDS, command-to-wire latency, DDS's CPU share
-# Without Cyclone DDS: a one-line notice and nothing else (CI=true: an error).
+# Without Cyclone DDS: a one-line notice and nothing else (CI=true: an error). CMake builds and
+# installs the bridge too (cmake/j288_tools.cmake): make install, make deb (package j288-dds).
 # The IDL in tools/j288-dds/idl is compiled by idlc into $(DDS_GEN) (-t: no XTypes type
 # information, so that peers match on the type name as ROS 2's rmw_cyclonedds does).
-.PHONY: dds dds-missing test-dds bench-dds install-dds
+.PHONY: dds dds-missing test-dds bench-dds
 DDS_FOUND := $(shell pkg-config --exists CycloneDDS 2>/dev/null && command -v idlc >/dev/null 2>&1 && echo yes)
 DDS_BIN := $(BIN)/j288-dds
 DDS_GEN := $(BUILD)/dds/gen
@@ -17,7 +18,6 @@ DDS_IDL_NAMES := builtin_interfaces std_msgs sensor_msgs diagnostic_msgs unitree
 DDS_IDL := $(DDS_IDL_NAMES:%=tools/j288-dds/idl/%.idl)
 DDS_GEN_OBJ := $(DDS_IDL_NAMES:%=$(OBJ)/dds/gen/%.o)
 DDS_GEN_HDR := $(DDS_IDL_NAMES:%=$(DDS_GEN)/%.h)
-DDS_HDR := $(wildcard tools/j288-dds/*.h) $(DDS_GEN_HDR)
 DDS_CPPFLAGS := $(TOOL_CPPFLAGS) -Itools/j288-dds -I$(DDS_GEN) $(shell pkg-config --cflags CycloneDDS 2>/dev/null)
 DDS_LIBS := $(shell pkg-config --libs CycloneDDS 2>/dev/null)
 DDS_TOOL_OBJ := $(addprefix $(OBJ)/tools/j288-dds/,bridge.o diag.o unitree_crc.o)
@@ -37,29 +37,23 @@ $(OBJ)/dds/gen/%.o: $(DDS_GEN)/%.c $(DDS_GEN_HDR)
 	@mkdir -p $(@D)
 	$(CC) $(CSTD) $(OPT) $(EXTRA_CFLAGS) $(DDS_CPPFLAGS) -c $< -o $@
 
-$(OBJ)/tools/j288-dds/%.o: tools/j288-dds/%.c $(DDS_HDR) $(ROBOT_HDR) $(LIB_HDR)
-	@mkdir -p $(@D)
-	$(CC) $(DDS_CPPFLAGS) $(CFLAGS_COMMON) -c $< -o $@
+# The bridge's and the tests' objects (the test peer, test/dds/dds_peer.c, shares nothing with
+# the bridge but the IDL) need idlc's headers first; their programs link Cyclone's library.
+$(OBJ)/tools/j288-dds/%.o $(OBJ)/test/dds/%.o: CPPFLAGS_OBJ = $(DDS_CPPFLAGS)
+$(OBJ)/tools/j288-dds/main.o $(DDS_TOOL_OBJ) $(OBJ)/test/dds/dds_peer.o $(OBJ)/test/dds/dds_golden.o: \
+    $(DDS_GEN_HDR)
+$(DDS_BIN) $(DDS_TEST_PEER) $(DDS_GOLDEN): LDFLAGS_COMMON += $(DDS_LIBS)
 
 $(DDS_BIN): $(OBJ)/tools/j288-dds/main.o $(DDS_TOOL_OBJ) $(DDS_GEN_OBJ) $(ROBOT_OBJ) $(CONFIG_OBJ) \
     $(LINUX_A) $(LIB_A) $(YAML_ENV)
-	@mkdir -p $(@D)
-	$(CC) $(CFLAGS_COMMON) $(filter-out $(YAML_ENV),$^) -o $@ $(LDFLAGS_COMMON) \
-	    $(call yaml_var,YAML_LIBS) $(DDS_LIBS) -lm
-
-# The test peer (test/dds/dds_peer.c) shares nothing with the bridge but the IDL.
-$(OBJ)/test/dds/%.o: test/dds/%.c $(DDS_GEN_HDR) $(DDS_HDR)
-	@mkdir -p $(@D)
-	$(CC) $(DDS_CPPFLAGS) $(CFLAGS_COMMON) -c $< -o $@
+	$(LINK)
 $(DDS_TEST_PEER): $(OBJ)/test/dds/dds_peer.o $(DDS_GEN_OBJ)
-	@mkdir -p $(@D)
-	$(CC) $(CFLAGS_COMMON) $^ -o $@ $(LDFLAGS_COMMON) $(DDS_LIBS) -lm
+	$(LINK)
 # The golden-bytes program: Cyclone's serialization, and the crc of unitree_crc.c. Cyclone's
 # serdata header pulls in its atomics, which use GNU asm: gnu99 for that one file.
 $(OBJ)/test/dds/dds_golden.o: CFLAGS_COMMON += -std=gnu99
 $(DDS_GOLDEN): $(OBJ)/test/dds/dds_golden.o $(OBJ)/tools/j288-dds/unitree_crc.o $(DDS_GEN_OBJ) $(LIB_A)
-	@mkdir -p $(@D)
-	$(CC) $(CFLAGS_COMMON) $^ -o $@ $(LDFLAGS_COMMON) $(DDS_LIBS) -lm
+	$(LINK)
 
 dds: $(DDS_BIN)
 ALL_TARGETS += $(DDS_BIN) $(DDS_TEST_PEER) $(DDS_GOLDEN)
@@ -69,12 +63,6 @@ TEST_SCRIPTS += $(DDS_TESTS)
 test-dds: $(DDS_BIN) $(DDS_TEST_PEER) $(DDS_GOLDEN) $(SIM_BIN)
 	$(call RUN_TESTS,$(DDS_TESTS))
 
-# (beside CMake's install, which does not build the bridge: listed for make uninstall)
-install-dds: $(DDS_BIN)
-	install -d $(DESTDIR)$(BINDIR)
-	install -m 755 $(DDS_BIN) $(DESTDIR)$(BINDIR)/
-	mkdir -p $(CMAKE_BUILD) && echo $(DESTDIR)$(BINDIR)/j288-dds >>$(INSTALLED_EXTRA)
-
 bench-dds: $(DDS_BIN) $(DDS_TEST_PEER) $(SIM_BIN) $(J288_BIN) $(BUILD)/bench/write_stamp.so
 	BUILD=$(BUILD) bash scripts/bench-dds.sh
 else
@@ -82,11 +70,9 @@ dds dds-missing test-dds bench-dds:
 	@if [ "$${CI:-}" = true ]; then \
 	    echo "error: Cyclone DDS not found (CI=true: a failure); install: cyclonedds-dev cyclonedds-tools" >&2; exit 1; fi
 	@echo "notice: skipping j288-dds and its tests, Cyclone DDS not found; install with: apt-get install -y --no-install-recommends cyclonedds-dev cyclonedds-tools" >&2
-install-dds:
 ALL_TARGETS += dds-missing
 TEST_DEPS += dds-missing
 endif
-install: install-dds
 
 # The benchmark's write() stamper (test/bench/write_stamp.c), preloaded into the bridge.
 $(BUILD)/bench/write_stamp.so: test/bench/write_stamp.c

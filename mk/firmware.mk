@@ -27,32 +27,34 @@ FW_APP_SRC := examples/stm32_hal/main.c examples/stm32_hal/board_common.c exampl
     port/stm32_hal/j288_stm32.c $(LIB_SRC)
 FW_ELFS := $(foreach b,$(FW_BOARDS),$(BUILD)/firmware/$(b)/j288_$(b).elf)
 
+# $(call ST_CC,board,includes): the Cortex-M4F compiler against ST's HAL and CMSIS of the
+# board's family, with the board's HAL configuration (examples/stm32_hal/<board>) and includes.
+ST_CC = $(call CPU_CC,m4f) -D$(FW_$(1)_DEVICE) -DUSE_HAL_DRIVER -Iexamples/stm32_hal/$(1) $(2) -Iport/stm32_hal \
+    $(CPPFLAGS_LIB) -isystem $(ST_DIR)/stm32$(FW_$(1)_FAMILY)xx_hal_driver/Inc \
+    -isystem $(ST_DIR)/cmsis_device_$(FW_$(1)_FAMILY)/Include -isystem $(ST_DIR)/cmsis_core/Include \
+    -g $(DEPFLAGS) -ffunction-sections -fdata-sections
+# $(call ST_HAL_SRC,board): ST's sources of the board's HAL modules, and its system file.
+ST_HAL_SRC = $(FW_$(1)_HAL:%=$(ST_DIR)/stm32$(FW_$(1)_FAMILY)xx_hal_driver/Src/stm32$(FW_$(1)_FAMILY)xx_%.c) \
+    $(ST_DIR)/cmsis_device_$(FW_$(1)_FAMILY)/Source/Templates/system_stm32$(FW_$(1)_FAMILY)xx.c
+# $(call ST_OBJ_RULES,dir,compiler): our X.c into dir/app/X.o with every warning, ST's sources
+# into dir/st/ with none (ST's headers are system headers; its code is not ours to fix).
+define ST_OBJ_RULES
+$(1)/app/%.o: %.c
+	@mkdir -p $$(@D)
+	$(2) $(CSTD) $(WARN) -c $$< -o $$@
+$(1)/st/%.o: $(ST_DIR)/%.c
+	@mkdir -p $$(@D)
+	$(2) -std=gnu11 -w -c $$< -o $$@
+endef
+
 # $(call FW_RULES,board)
 define FW_RULES
-FW_$(1)_HALDIR := $(ST_DIR)/stm32$(FW_$(1)_FAMILY)xx_hal_driver
-FW_$(1)_DEVDIR := $(ST_DIR)/cmsis_device_$(FW_$(1)_FAMILY)
-FW_$(1)_ST_SRC := $$(FW_$(1)_HAL:%=$$(FW_$(1)_HALDIR)/Src/stm32$(FW_$(1)_FAMILY)xx_%.c) \
-    $$(FW_$(1)_DEVDIR)/Source/Templates/system_stm32$(FW_$(1)_FAMILY)xx.c
-FW_$(1)_STARTUP := $$(FW_$(1)_DEVDIR)/Source/Templates/gcc/startup_$(shell echo $(FW_$(1)_DEVICE) | tr A-Z a-z).s
-FW_$(1)_CC := $(call TC,m4f,CC) $(CPU_m4f_FLAGS) $(CPU_m4f_DEFS) -D$(FW_$(1)_DEVICE) -DUSE_HAL_DRIVER \
-    -Iexamples/stm32_hal/$(1) -Iexamples/stm32_hal -Iport/stm32_hal $(CPPFLAGS_LIB) \
-    -isystem $$(FW_$(1)_HALDIR)/Inc -isystem $$(FW_$(1)_DEVDIR)/Include -isystem $(ST_DIR)/cmsis_core/Include \
-    -Os -g $(DEPFLAGS) -ffunction-sections -fdata-sections
-FW_$(1)_OBJ := $(FW_APP_SRC:%.c=$(BUILD)/firmware/$(1)/obj/%.o) $(BUILD)/firmware/$(1)/obj/board.o \
-    $$(patsubst $(ST_DIR)/%.c,$(BUILD)/firmware/$(1)/st/%.o,$$(FW_$(1)_ST_SRC)) $(BUILD)/firmware/$(1)/st/startup.o
-
-$(BUILD)/firmware/$(1)/obj/%.o: %.c
+FW_$(1)_OBJ := $(patsubst %.c,$(BUILD)/firmware/$(1)/app/%.o,$(FW_APP_SRC) examples/stm32_hal/$(1)/board.c) \
+    $(patsubst $(ST_DIR)/%.c,$(BUILD)/firmware/$(1)/st/%.o,$(call ST_HAL_SRC,$(1))) $(BUILD)/firmware/$(1)/st/startup.o
+$(call ST_OBJ_RULES,$(BUILD)/firmware/$(1),$(call ST_CC,$(1),-Iexamples/stm32_hal) -Os)
+$(BUILD)/firmware/$(1)/st/startup.o: $(ST_DIR)/cmsis_device_$(FW_$(1)_FAMILY)/Source/Templates/gcc/startup_$(shell echo $(FW_$(1)_DEVICE) | tr A-Z a-z).s
 	@mkdir -p $$(@D)
-	$$(FW_$(1)_CC) $(CSTD) $(WARN) -c $$< -o $$@
-$(BUILD)/firmware/$(1)/obj/board.o: examples/stm32_hal/$(1)/board.c
-	@mkdir -p $$(@D)
-	$$(FW_$(1)_CC) $(CSTD) $(WARN) -c $$< -o $$@
-$(BUILD)/firmware/$(1)/st/%.o: $(ST_DIR)/%.c
-	@mkdir -p $$(@D)
-	$$(FW_$(1)_CC) -std=gnu11 -w -c $$< -o $$@
-$(BUILD)/firmware/$(1)/st/startup.o: $$(FW_$(1)_STARTUP)
-	@mkdir -p $$(@D)
-	$$(FW_$(1)_CC) -x assembler-with-cpp -c $$< -o $$@
+	$(call ST_CC,$(1),-Iexamples/stm32_hal) -Os -x assembler-with-cpp -c $$< -o $$@
 $(BUILD)/firmware/$(1)/j288_$(1).elf: $$(FW_$(1)_OBJ) examples/stm32_hal/$(1)/$(FW_$(1)_LD)
 	$(call TC,m4f,CC) $(CPU_m4f_FLAGS) --specs=nano.specs --specs=nosys.specs -Wl,--gc-sections \
 	    -Wl,-Map=$$(@:.elf=.map) -T examples/stm32_hal/$(1)/$(FW_$(1)_LD) $$(FW_$(1)_OBJ) -o $$@ -lm
@@ -93,24 +95,13 @@ firmware-build: $(FW_BUILD)
 HB_FAMILIES := f4 g4
 HB_f4_BOARD := nucleo_f446re
 HB_g4_BOARD := nucleo_g474re
-HB_HAL = $(FW_$(HB_$(1)_BOARD)_HAL:%=$(ST_DIR)/stm32$(1)xx_hal_driver/Src/stm32$(1)xx_%.c) \
-    $(ST_DIR)/cmsis_device_$(1)/Source/Templates/system_stm32$(1)xx.c
 HB_APP := test/stm32/hal_bench.c port/stm32_hal/j288_stm32.c $(LIB_SRC) $(call TC,m4f,STARTUP)
-HB_CC = $(call CPU_CC,m4f) -D$(FW_$(HB_$(1)_BOARD)_DEVICE) -DUSE_HAL_DRIVER \
-    -Iexamples/stm32_hal/$(HB_$(1)_BOARD) -Iport/stm32_hal -Itest/support $(CPPFLAGS_LIB) \
-    -isystem $(ST_DIR)/stm32$(1)xx_hal_driver/Inc -isystem $(ST_DIR)/cmsis_device_$(1)/Include \
-    -isystem $(ST_DIR)/cmsis_core/Include -ffunction-sections -fdata-sections -g $(DEPFLAGS)
 
 # $(call HB_RULES,opt,family)
 define HB_RULES
-$(BUILD)/bench-stm32-hal/$(2)-$(1)/app/%.o: %.c
-	@mkdir -p $$(@D)
-	$(call HB_CC,$(2)) -$(1) $(CSTD) $(WARN) -c $$< -o $$@
-$(BUILD)/bench-stm32-hal/$(2)-$(1)/st/%.o: $(ST_DIR)/%.c
-	@mkdir -p $$(@D)
-	$(call HB_CC,$(2)) -$(1) -std=gnu11 -w -c $$< -o $$@
+$(call ST_OBJ_RULES,$(BUILD)/bench-stm32-hal/$(2)-$(1),$(call ST_CC,$(HB_$(2)_BOARD),-Itest/support) -$(1))
 $(BUILD)/bench-stm32-hal/hal_bench_$(2)_$(1).elf: $(HB_APP:%.c=$(BUILD)/bench-stm32-hal/$(2)-$(1)/app/%.o) \
-    $(patsubst $(ST_DIR)/%.c,$(BUILD)/bench-stm32-hal/$(2)-$(1)/st/%.o,$(call HB_HAL,$(2)))
+    $(patsubst $(ST_DIR)/%.c,$(BUILD)/bench-stm32-hal/$(2)-$(1)/st/%.o,$(call ST_HAL_SRC,$(HB_$(2)_BOARD)))
 	$(call TC,m4f,CC) $(call TGT_LINK_FLAGS,m4f,SEMIHOST,$(CPU_m4f_LD)) $$^ -o $$@ -lm
 endef
 $(foreach f,$(HB_FAMILIES),$(foreach o,O2 Os,$(eval $(call HB_RULES,$(o),$(f)))))

@@ -25,11 +25,12 @@ FUZZ_SECONDS ?= 30
 FUZZ_CC ?= clang-14
 FUZZ_CFLAGS := -std=c99 -g -O1 -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=undefined \
     -Ilib/include -Itest/fuzz -Itest/support
-FUZZ_BINS := $(FUZZ_NAMES:%=$(BUILD)/fuzz/fuzz_%)
-
-$(BUILD)/fuzz/fuzz_%: test/fuzz/fuzz_%.c $(LIB_SRC) $(TEST_HDR) $(wildcard test/fuzz/*.h tools/j288/*.[ch] host/j288_number.[ch] host/j288_robot_config.[ch])
+# (one compile of every source: the headers listed by hand)
+$(BUILD)/fuzz/fuzz_%: test/fuzz/fuzz_%.c $(LIB_SRC) $(wildcard lib/include/j288/*.h lib/src/*.h test/support/*.h \
+    test/vectors/*.h test/fuzz/*.h tools/j288/*.[ch] host/j288_number.[ch] host/j288_robot_config.[ch])
 	@mkdir -p $(@D)
-	$(FUZZ_CC) $(FUZZ_CFLAGS) $(FUZZ_CPPFLAGS_$*) $< $(FUZZ_EXTRA_$*) $(LIB_SRC) -o $@ $(FUZZ_LIBS_$*) -lm
+	$(FUZZ_CC) $(FUZZ_CFLAGS) $(FUZZ_CPPFLAGS_$*) $(call YAML_IF_USED,CFLAGS) $< $(FUZZ_EXTRA_$*) $(LIB_SRC) -o $@ \
+	    $(call YAML_IF_USED,LIBS) -lm
 # The config target's flags come from libyaml's probe (mk/tools.mk).
 $(BUILD)/fuzz/fuzz_config: $(YAML_ENV)
 
@@ -120,13 +121,9 @@ SOAK_TXNS ?= 100000
 SOAK_SHORT_TXNS ?= 10000
 SOAK_BIN := $(BUILD)/soak/soak
 
-$(OBJ)/test/soak/%.o: test/soak/%.c
-	@mkdir -p $(@D)
-	$(CC) $(LINUX_CPPFLAGS) $(CFLAGS_COMMON) -c $< -o $@
-
+$(OBJ)/test/soak/%.o: CPPFLAGS_OBJ = $(LINUX_CPPFLAGS)
 $(SOAK_BIN): $(OBJ)/test/soak/soak.o $(LINUX_A) $(LIB_A)
-	@mkdir -p $(@D)
-	$(CC) $(CFLAGS_COMMON) $^ -o $@ $(LDFLAGS_COMMON) -lm
+	$(LINK)
 
 .PHONY: soak soak-short
 soak: $(SOAK_BIN) $(SIM_BIN)

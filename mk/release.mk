@@ -15,14 +15,13 @@ SO_SRC := $(LIB_SRC) port/linux/j288_linux.c host/j288_robot.c host/j288_host_wa
     host/j288_robot_config.c host/j288_number.c
 SO_OBJ := $(SO_SRC:%.c=$(OBJ)/pic/%.o)
 
+$(OBJ)/pic/%.o: CPPFLAGS_OBJ = -fPIC $(HOST_CPPFLAGS)
 $(OBJ)/pic/%.o: %.c $(YAML_ENV)
-	@mkdir -p $(@D)
-	$(CC) -fPIC $(HOST_CPPFLAGS) $(call yaml_var,YAML_CFLAGS) $(CFLAGS_COMMON) -c $< -o $@
+	$(COMPILE)
 
+$(SO_REAL): LDFLAGS_COMMON += -shared -Wl,-soname,$(SO_NAME)
 $(SO_REAL): $(SO_OBJ) $(YAML_ENV)
-	@mkdir -p $(@D)
-	$(CC) -shared -Wl,-soname,$(SO_NAME) $(CFLAGS_COMMON) $(SO_OBJ) -o $@ $(LDFLAGS_COMMON) \
-	    $(call yaml_var,YAML_LIBS) -lm
+	$(LINK)
 
 $(SO_LIB): $(SO_REAL)
 	ln -sf $(notdir $(SO_REAL)) $(BUILD)/lib/$(SO_NAME)

@@ -6,22 +6,12 @@
 # (the runner, and its one OS-specific call, the wait over every bus: host/j288_host_wait.c)
 ROBOT_OBJ := $(OBJ)/host/j288_robot.o $(OBJ)/host/j288_host_wait.o
 
-$(ROBOT_OBJ): $(OBJ)/host/%.o: host/%.c
-	@mkdir -p $(@D)
-	$(CC) $(HOST_CPPFLAGS) $(CFLAGS_COMMON) -c $< -o $@
-
 ROBOT_TEST := $(BUILD)/test/test_robot
-$(OBJ)/test/linux/test_robot.o: test/linux/test_robot.c $(UNITY)/unity.c
-	@mkdir -p $(@D)
-	$(CC) $(TEST_CPPFLAGS) -Iport/linux -Ihost -DJ288_SIM_DEFAULT='"$(SIM_BIN)"' $(CFLAGS_COMMON) -c $< -o $@
-
 $(ROBOT_TEST): $(OBJ)/test/linux/test_robot.o $(SIM_PROCESS_OBJ) $(ROBOT_OBJ) $(CONFIG_OBJ) $(UNITY_OBJ) $(LINUX_A) $(LIB_A) \
     $(YAML_ENV)
-	@mkdir -p $(@D)
-	$(CC) $(CFLAGS_COMMON) $(filter-out $(YAML_ENV),$^) -o $@ $(LDFLAGS_COMMON) $(call yaml_var,YAML_LIBS) -lm
+	$(LINK)
 
 HOST_TESTS += $(ROBOT_TEST)
-ALL_TARGETS += $(ROBOT_TEST)
 TEST_DEPS += $(SIM_BIN)
 
 # The j288 tool's bus commands use the runner (cli_bus.h includes it) and the config reader.

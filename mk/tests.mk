@@ -12,9 +12,7 @@
 
 # ---- the j288 tool's helpers -----------------------------------------------------------------
 CLI_TEST := $(BUILD)/test/test_cli_helpers
-$(OBJ)/test/cli/%.o: test/cli/%.c $(UNITY)/unity.c
-	@mkdir -p $(@D)
-	$(CC) $(TEST_CPPFLAGS) -Itools/j288 $(TOOL_CPPFLAGS) $(CFLAGS_COMMON) -c $< -o $@
+$(OBJ)/test/cli/%.o: CPPFLAGS_OBJ = $(TEST_CPPFLAGS) -Itools/j288 $(TOOL_CPPFLAGS)
 
 # The captured error stream both tool tests check (test/cli/cli_capture.c).
 CLI_CAPTURE_OBJ := $(OBJ)/test/cli/cli_capture.o
@@ -22,23 +20,18 @@ CLI_CAPTURE_OBJ := $(OBJ)/test/cli/cli_capture.o
 $(CLI_TEST): $(OBJ)/test/cli/test_cli_helpers.o $(CLI_CAPTURE_OBJ) \
     $(addprefix $(OBJ)/tools/j288/,args.o hexparse.o json.o frameview.o report.o) $(NUMBER_OBJ) \
     $(UNITY_OBJ) $(LIB_A)
-	@mkdir -p $(@D)
-	$(CC) $(CFLAGS_COMMON) $^ -o $@ $(LDFLAGS_COMMON) -lm
+	$(LINK)
 
 # The tool's robot config and joint selection (cli_joint.c), with the bus plumbing it calls.
 CLI_JOINT_TEST := $(BUILD)/test/test_cli_joint
-$(OBJ)/test/cli/test_cli_joint.o: test/cli/test_cli_joint.c $(UNITY)/unity.c $(YAML_ENV)
-	@mkdir -p $(@D)
-	$(CC) $(TEST_CPPFLAGS) -Itools/j288 $(TOOL_CPPFLAGS) $(call yaml_var,YAML_CFLAGS) $(CFLAGS_COMMON) -c $< -o $@
+$(OBJ)/test/cli/test_cli_joint.o: $(YAML_ENV)
 
 $(CLI_JOINT_TEST): $(OBJ)/test/cli/test_cli_joint.o $(CLI_CAPTURE_OBJ) \
     $(addprefix $(OBJ)/tools/j288/,cli_joint.o cli_bus.o args.o json.o report.o) \
     $(OBJ)/host/j288_robot.o $(OBJ)/host/j288_host_wait.o $(CONFIG_OBJ) \
-    $(UNITY_OBJ) $(LINUX_A) $(LIB_A)
-	@mkdir -p $(@D)
-	$(CC) $(CFLAGS_COMMON) $^ -o $@ $(LDFLAGS_COMMON) $(call yaml_var,YAML_LIBS) -lm
+    $(UNITY_OBJ) $(LINUX_A) $(LIB_A) $(YAML_ENV)
+	$(LINK)
 HOST_TESTS += $(CLI_JOINT_TEST)
-ALL_TARGETS += $(CLI_JOINT_TEST)
 
 # ---- the codec tests with each CRC backend (J288_CONFIG_CRC_BACKEND) -------------------------
 # slice4, nibble, bitwise, and HW through J288_CONFIG_CRC_HW_FUNCTION (a stand-in in
@@ -66,57 +59,45 @@ FUZZ_NAMES := $(sort $(patsubst test/fuzz/fuzz_%.c,%,$(wildcard test/fuzz/fuzz_*
 FUZZ_REPLAY_TESTS := $(FUZZ_NAMES:%=$(BUILD)/test/fuzz_replay_%)
 FUZZ_EXTRA_cli := tools/j288/hexparse.c tools/j288/args.c host/j288_number.c
 FUZZ_CPPFLAGS_cli := -Itools/j288 $(TOOL_CPPFLAGS)
-# The config target links the reader and libyaml (FUZZ_LIBS_<name>: a target's libraries).
+# The config target links the reader and libyaml.
 FUZZ_EXTRA_config := host/j288_robot_config.c host/j288_number.c
-FUZZ_CPPFLAGS_config := -Ihost $(call yaml_var,YAML_CFLAGS)
-FUZZ_LIBS_config := $(call yaml_var,YAML_LIBS)
-$(OBJ)/test/fuzz/fuzz_config.o: host/j288_robot_config.h $(YAML_ENV)
-$(BUILD)/test/fuzz_replay_config: LDFLAGS_COMMON += $(FUZZ_LIBS_config)
+FUZZ_CPPFLAGS_config := -Ihost
+$(OBJ)/test/fuzz/fuzz_config.o $(BUILD)/test/fuzz_replay_config: $(YAML_ENV)
 
+# (their own rules: the flags depend on the target's name, $*)
+$(OBJ)/test/fuzz/replay_%.o: CPPFLAGS_OBJ = -Itest/fuzz -DFUZZ_CORPUS_DIR='"test/fuzz/corpus/$*"'
 $(OBJ)/test/fuzz/replay_%.o: test/fuzz/replay_main.c
-	@mkdir -p $(@D)
-	$(CC) -Itest/fuzz -DFUZZ_CORPUS_DIR='"test/fuzz/corpus/$*"' $(CFLAGS_COMMON) -c $< -o $@
-
+	$(COMPILE)
+$(OBJ)/test/fuzz/fuzz_%.o: CPPFLAGS_OBJ = $(CPPFLAGS_LIB) -Itest/fuzz -Itest/support $(FUZZ_CPPFLAGS_$*)
 $(OBJ)/test/fuzz/fuzz_%.o: test/fuzz/fuzz_%.c
-	@mkdir -p $(@D)
-	$(CC) $(CPPFLAGS_LIB) -Itest/fuzz -Itest/support $(FUZZ_CPPFLAGS_$*) $(CFLAGS_COMMON) -c $< -o $@
+	$(COMPILE)
 
 $(BUILD)/test/fuzz_replay_%: $(OBJ)/test/fuzz/fuzz_%.o $(OBJ)/test/fuzz/replay_%.o $(LIB_A)
-	@mkdir -p $(@D)
-	$(CC) $(CFLAGS_COMMON) $^ -o $@ $(LDFLAGS_COMMON) -lm
+	$(LINK)
 $(foreach n,$(FUZZ_NAMES),$(eval $(BUILD)/test/fuzz_replay_$(n): $(FUZZ_EXTRA_$(n):%.c=$(OBJ)/%.o)))
 
 # ---- the Linux port, the simulator's model, the STM32 port -----------------------------------
 LINUX_PORT_TEST := $(BUILD)/test/test_linux_port
-$(OBJ)/test/linux/%.o: test/linux/%.c $(UNITY)/unity.c
-	@mkdir -p $(@D)
-	$(CC) $(TEST_CPPFLAGS) -Iport/linux -Ihost -DJ288_SIM_DEFAULT='"$(SIM_BIN)"' $(CFLAGS_COMMON) -c $< -o $@
+$(OBJ)/test/linux/%.o: CPPFLAGS_OBJ = $(TEST_CPPFLAGS) -Iport/linux -Ihost -DJ288_SIM_DEFAULT='"$(SIM_BIN)"' \
+    -DJ288_EXAMPLE_CONFIG='"examples/robot.yaml"'
 
 # j288-sim as a child process, for the tests that drive it (test/linux/sim_process.c).
 SIM_PROCESS_OBJ := $(OBJ)/test/linux/sim_process.o
 
 $(LINUX_PORT_TEST): $(OBJ)/test/linux/test_linux_port.o $(SIM_PROCESS_OBJ) $(UNITY_OBJ) $(LINUX_A) $(LIB_A)
-	@mkdir -p $(@D)
-	$(CC) $(CFLAGS_COMMON) $^ -o $@ $(LDFLAGS_COMMON) -lm
+	$(LINK)
 
 CONFIG_TEST := $(BUILD)/test/test_robot_config
-$(OBJ)/test/linux/test_robot_config.o: test/linux/test_robot_config.c $(UNITY)/unity.c $(YAML_ENV)
-	@mkdir -p $(@D)
-	$(CC) $(TEST_CPPFLAGS) -Iport/linux -Ihost $(call yaml_var,YAML_CFLAGS) \
-	    -DJ288_EXAMPLE_CONFIG='"examples/robot.yaml"' $(CFLAGS_COMMON) -c $< -o $@
+$(OBJ)/test/linux/test_robot_config.o: $(YAML_ENV)
 
-$(CONFIG_TEST): $(OBJ)/test/linux/test_robot_config.o $(CONFIG_OBJ) $(UNITY_OBJ) $(LIB_A)
-	@mkdir -p $(@D)
-	$(CC) $(CFLAGS_COMMON) $^ -o $@ $(LDFLAGS_COMMON) $(call yaml_var,YAML_LIBS) -lm
+$(CONFIG_TEST): $(OBJ)/test/linux/test_robot_config.o $(CONFIG_OBJ) $(UNITY_OBJ) $(LIB_A) $(YAML_ENV)
+	$(LINK)
 
 SIM_MODEL_TEST := $(BUILD)/test/test_sim_model
-$(OBJ)/test/sim/%.o: test/sim/%.c $(UNITY)/unity.c
-	@mkdir -p $(@D)
-	$(CC) $(TEST_CPPFLAGS) -Itools/j288-sim $(CFLAGS_COMMON) -c $< -o $@
+$(OBJ)/test/sim/%.o: CPPFLAGS_OBJ = $(TEST_CPPFLAGS) -Itools/j288-sim
 
 $(SIM_MODEL_TEST): $(OBJ)/test/sim/test_sim_model.o $(SIM_MODEL_OBJ) $(UNITY_OBJ) $(LIB_A)
-	@mkdir -p $(@D)
-	$(CC) $(CFLAGS_COMMON) $^ -o $@ $(LDFLAGS_COMMON) -lm
+	$(LINK)
 
 # Built with the D-cache maintenance on and a 64-byte receive buffer (a transaction's echo and
 # reply then cross the half, complete and wrap points), so that every path is exercised, and
@@ -128,14 +109,12 @@ STM32_TEST_SRC := port/stm32_hal/j288_stm32.c test/stm32/fake_hal.c test/stm32/t
 
 # $(call STM32_HOST_TEST,name,objdir,defs): test_stm32_port built with the stub's defs.
 define STM32_HOST_TEST
+$$(OBJ)/$(2)/%.o: CPPFLAGS_OBJ = $$(TEST_CPPFLAGS) -Iport/stm32_hal -Itest/stm32/stub -Itest/stm32 \
+    $$(STM32_TEST_DEFS) $(3)
 $$(OBJ)/$(2)/%.o: %.c $$(UNITY)/unity.c
-	@mkdir -p $$(@D)
-	$$(CC) $$(TEST_CPPFLAGS) -Iport/stm32_hal -Itest/stm32/stub -Itest/stm32 $$(STM32_TEST_DEFS) $(3) \
-	    $$(CFLAGS_COMMON) -c $$< -o $$@
-
+	$$(COMPILE)
 $$(BUILD)/test/$(1): $$(STM32_TEST_SRC:%.c=$$(OBJ)/$(2)/%.o) $$(UNITY_OBJ) $$(LIB_A)
-	@mkdir -p $$(@D)
-	$$(CC) $$(CFLAGS_COMMON) $$^ -o $$@ $$(LDFLAGS_COMMON) -lm
+	$$(LINK)
 endef
 STM32_TEST := $(BUILD)/test/test_stm32_port
 STM32_G4_TEST := $(BUILD)/test/test_stm32_port_g4
@@ -162,8 +141,6 @@ TEST_SCRIPTS += test/e2e/lib_sim_check.sh
 # The bash completion (tools/completion/j288.bash) against the tools' --help.
 TEST_SCRIPTS += test/e2e/completion.sh
 TEST_DEPS += $(J288_BIN) $(SIM_BIN) $(EXAMPLE_LINUX) $(LIB_A)
-ALL_TARGETS += $(CLI_TEST) $(FUZZ_REPLAY_TESTS) $(LINUX_PORT_TEST) $(CONFIG_TEST) $(SIM_MODEL_TEST) \
-    $(STM32_TEST) $(STM32_G4_TEST) $(STM32_H7_TEST)
 
 .PHONY: check-abi vectors-check
 check-abi: $(LIB_A)

@@ -10,9 +10,8 @@
 
 LINUX_CPPFLAGS := $(CPPFLAGS_LIB) -Iport/linux
 HOST_CPPFLAGS := $(LINUX_CPPFLAGS) -Ihost
-$(OBJ)/port/linux/%.o: port/linux/%.c
-	@mkdir -p $(@D)
-	$(CC) $(LINUX_CPPFLAGS) $(CFLAGS_COMMON) -c $< -o $@
+$(OBJ)/port/linux/%.o: CPPFLAGS_OBJ = $(LINUX_CPPFLAGS)
+$(OBJ)/host/%.o: CPPFLAGS_OBJ = $(HOST_CPPFLAGS)
 
 $(LINUX_A): $(OBJ)/port/linux/j288_linux.o
 	@mkdir -p $(@D)
@@ -22,23 +21,17 @@ $(LINUX_A): $(OBJ)/port/linux/j288_linux.o
 # The tools are POSIX programs (signals, realpath, popen for gnuplot); lib/ stays pure C99.
 TOOL_CPPFLAGS := $(HOST_CPPFLAGS) -D_XOPEN_SOURCE=700
 J288_SRC := $(sort $(wildcard tools/j288/*.c))
-$(OBJ)/tools/j288/%.o: tools/j288/%.c
-	@mkdir -p $(@D)
-	$(CC) $(TOOL_CPPFLAGS) $(CFLAGS_COMMON) -c $< -o $@
+$(OBJ)/tools/j288/%.o: CPPFLAGS_OBJ = $(TOOL_CPPFLAGS)
 
-$(J288_BIN): $(J288_SRC:%.c=$(OBJ)/%.o) $(CONFIG_OBJ) $(LINUX_A) $(LIB_A)
-	@mkdir -p $(@D)
-	$(CC) $(CFLAGS_COMMON) $^ -o $@ $(LDFLAGS_COMMON) $(call yaml_var,YAML_LIBS) -lm
+$(J288_BIN): $(J288_SRC:%.c=$(OBJ)/%.o) $(CONFIG_OBJ) $(LINUX_A) $(LIB_A) $(YAML_ENV)
+	$(LINK)
 
 # The simulator: servo_model.c (servos and bus, no I/O) and sim_main.c (the pty front end).
 SIM_MODEL_OBJ := $(OBJ)/tools/j288-sim/servo_model.o
-$(OBJ)/tools/j288-sim/%.o: tools/j288-sim/%.c
-	@mkdir -p $(@D)
-	$(CC) $(CPPFLAGS_LIB) -Itools/j288-sim $(CFLAGS_COMMON) -c $< -o $@
+$(OBJ)/tools/j288-sim/%.o: CPPFLAGS_OBJ = $(CPPFLAGS_LIB) -Itools/j288-sim
 
 $(SIM_BIN): $(SIM_MODEL_OBJ) $(OBJ)/tools/j288-sim/sim_main.o $(LIB_A)
-	@mkdir -p $(@D)
-	$(CC) $(CFLAGS_COMMON) $^ -o $@ $(LDFLAGS_COMMON) -lm
+	$(LINK)
 
 # The robot config reader (host/j288_robot_config.c, not in the archive: it needs
 # libyaml). pkg-config's yaml-0.1 (Debian's libyaml-dev), checked to link with $(CC), gives the
@@ -59,22 +52,13 @@ $(YAML_ENV):
 	else printf 'YAML_CFLAGS=\nYAML_LIBS=\n' >$@; \
 	    echo "libyaml: not found: building without robot config support (install libyaml-dev)"; fi
 
-$(NUMBER_OBJ): host/j288_number.c
-	@mkdir -p $(@D)
-	$(CC) $(HOST_CPPFLAGS) $(CFLAGS_COMMON) -c $< -o $@
-
-$(OBJ)/host/j288_robot_config.o: host/j288_robot_config.c $(YAML_ENV)
-	@mkdir -p $(@D)
-	$(CC) $(HOST_CPPFLAGS) $(call yaml_var,YAML_CFLAGS) $(CFLAGS_COMMON) -c $< -o $@
+$(OBJ)/host/j288_robot_config.o: $(YAML_ENV)
 
 EXAMPLE_LINUX := $(BIN)/linux-status
-$(OBJ)/examples/linux/%.o: examples/linux/%.c
-	@mkdir -p $(@D)
-	$(CC) $(TOOL_CPPFLAGS) $(CFLAGS_COMMON) -c $< -o $@
+$(OBJ)/examples/linux/%.o: CPPFLAGS_OBJ = $(TOOL_CPPFLAGS)
 
 $(EXAMPLE_LINUX): $(OBJ)/examples/linux/main.o $(LINUX_A) $(LIB_A)
-	@mkdir -p $(@D)
-	$(CC) $(CFLAGS_COMMON) $^ -o $@ $(LDFLAGS_COMMON) -lm
+	$(LINK)
 
 linux: $(LINUX_A)
 cli: $(J288_BIN)

@@ -15,7 +15,8 @@ WIN_CC ?= x86_64-w64-mingw32-gcc
 WIN_AR ?= x86_64-w64-mingw32-ar
 WIN := $(BUILD)/windows
 WIN_OBJ := $(WIN)/obj
-WIN_CFLAGS := $(CSTD) $(WARN) $(OPT)
+# $(DEPFLAGS): each object's header dependencies beside it (X.d, included by the Makefile).
+WIN_CFLAGS := $(CSTD) $(WARN) $(OPT) $(DEPFLAGS)
 WIN_CPPFLAGS := $(CPPFLAGS_LIB) -Iport/windows
 # winmm: timeBeginPeriod (1 ms timer waits) in the port.
 WIN_LIBS := -lwinmm
@@ -24,18 +25,22 @@ WIN_LIB_A := $(WIN)/libj288.a
 WIN_PORT_A := $(WIN)/libj288_windows.a
 WIN_DLL := $(WIN)/j288.dll
 WIN_IMPLIB := $(WIN)/libj288.dll.a
-WIN_PORT_HDR := port/windows/j288_windows.h
 WIN_UNIT_TESTS := $(UNIT_TEST_SRC:test/unit/%.c=$(WIN)/test/%.exe)
 WIN_PORT_TEST := $(WIN)/test/test_windows_port.exe
 WIN_BENCH := $(WIN)/bench/bench_windows_port.exe
 
-$(WIN_OBJ)/lib/%.o: lib/%.c $(LIB_HDR)
-	@mkdir -p $(@D)
-	$(WIN_CC) $(CPPFLAGS_LIB) $(WIN_CFLAGS) -c $< -o $@
-
-$(WIN_OBJ)/port/windows/%.o: port/windows/%.c $(WIN_PORT_HDR) $(LIB_HDR)
-	@mkdir -p $(@D)
-	$(WIN_CC) $(WIN_CPPFLAGS) $(WIN_CFLAGS) -c $< -o $@
+# The host's COMPILE and LINK recipes (Makefile) with the cross compiler and these flags: every
+# target under $(WIN) takes them (pattern-specific), each folder its CPPFLAGS_OBJ.
+$(WIN)/%: CC = $(WIN_CC)
+$(WIN)/%: CFLAGS_COMMON = $(WIN_CFLAGS)
+$(WIN)/%: LDFLAGS_COMMON =
+$(WIN)/%: YAML_ENV = $(WIN_YAML_ENV)
+$(WIN_OBJ)/%.o: %.c
+	$(COMPILE)
+$(WIN_OBJ)/test/%.o: test/%.c $(UNITY)/unity.c
+	$(COMPILE)
+$(WIN_OBJ)/port/windows/%.o: CPPFLAGS_OBJ = $(WIN_CPPFLAGS)
+$(WIN_OBJ)/test/%.o: CPPFLAGS_OBJ = $(TEST_CPPFLAGS) -Iport/windows
 
 $(WIN_LIB_A): $(LIB_SRC:%.c=$(WIN_OBJ)/%.o)
 	@mkdir -p $(@D)
@@ -56,8 +61,6 @@ $(WIN_PORT_A): $(WIN_OBJ)/port/windows/j288_windows.o
 WIN_TOOL_CPPFLAGS := $(WIN_CPPFLAGS) -Ihost -Itools/j288 -D__USE_MINGW_ANSI_STDIO=1
 WIN_TOOL_CFLAGS := $(WIN_CFLAGS) -Wno-float-conversion
 WIN_YAML_ENV := $(WIN)/libyaml/libyaml.env
-win_yaml_var = $$(sed -n 's/^$(1)=//p' $(WIN_YAML_ENV))
-WIN_HOST_HDR := $(wildcard host/*.h) $(WIN_PORT_HDR) $(LIB_HDR)
 WIN_HOST_OBJ := $(WIN_OBJ)/host/j288_robot.o $(WIN_OBJ)/host/j288_robot_config.o \
     $(WIN_OBJ)/host/j288_number.o $(WIN_OBJ)/host/j288_host_wait_win32.o
 # j288 top is a POSIX terminal program: tools/j288/windows/cmd_top.c says so instead.
@@ -68,17 +71,13 @@ WIN_J288 := $(WIN)/j288.exe
 $(WIN_YAML_ENV):
 	bash scripts/libyaml-mingw.sh $(WIN)/libyaml $(WIN_CC)
 
-$(WIN_OBJ)/host/%.o: host/%.c $(WIN_HOST_HDR) $(WIN_YAML_ENV)
-	@mkdir -p $(@D)
-	$(WIN_CC) $(WIN_TOOL_CPPFLAGS) $(call win_yaml_var,YAML_CFLAGS) $(WIN_TOOL_CFLAGS) -c $< -o $@
-
-$(WIN_OBJ)/tools/j288/%.o: tools/j288/%.c $(J288_HDR) $(WIN_HOST_HDR)
-	@mkdir -p $(@D)
-	$(WIN_CC) $(WIN_TOOL_CPPFLAGS) $(WIN_TOOL_CFLAGS) -c $< -o $@
+$(WIN_OBJ)/host/%.o $(WIN_OBJ)/tools/j288/%.o $(WIN_J288): CPPFLAGS_OBJ = $(WIN_TOOL_CPPFLAGS)
+$(WIN_OBJ)/host/%.o $(WIN_OBJ)/tools/j288/%.o $(WIN_J288): CFLAGS_COMMON = $(WIN_TOOL_CFLAGS)
+$(WIN_HOST_OBJ): $(WIN_YAML_ENV)
+$(WIN_J288) $(WIN_DLL) $(WIN_IMPLIB) $(WIN_BENCH): LDFLAGS_COMMON = $(WIN_LIBS)
 
 $(WIN_J288): $(WIN_J288_OBJ) $(WIN_HOST_OBJ) $(WIN_PORT_A) $(WIN_LIB_A) $(WIN_YAML_ENV)
-	@mkdir -p $(@D)
-	$(WIN_CC) $(WIN_TOOL_CFLAGS) $(filter %.o %.a,$^) -o $@ $(call win_yaml_var,YAML_LIBS) $(WIN_LIBS)
+	$(LINK)
 
 # The DLL exports every global symbol of lib/ and the port (no __declspec in the headers:
 # mingw's linker exports all when none is marked); programs link the import library.
@@ -87,31 +86,24 @@ WIN_DLL_OBJ := $(LIB_SRC:%.c=$(WIN_OBJ)/%.o) $(WIN_OBJ)/port/windows/j288_window
 $(WIN_DLL) $(WIN_IMPLIB) &: $(WIN_DLL_OBJ) $(WIN_YAML_ENV)
 	@mkdir -p $(@D)
 	$(WIN_CC) -shared $(WIN_CFLAGS) $(WIN_DLL_OBJ) -o $(WIN_DLL) \
-	    -Wl,--out-implib,$(WIN_IMPLIB) $(call win_yaml_var,YAML_LIBS) $(WIN_LIBS)
+	    -Wl,--out-implib,$(WIN_IMPLIB) $(call YAML_IF_USED,LIBS) $(WIN_LIBS)
 
 # ---- tests and benchmark ---------------------------------------------------------------------
 WIN_UNITY_OBJ := $(WIN_OBJ)/unity/unity.o
 $(WIN_UNITY_OBJ): $(UNITY)/unity.c
 	@mkdir -p $(@D)
-	$(WIN_CC) -std=c99 -O1 -g -I$(UNITY) $(UNITY_DEFS) -c $< -o $@
-
-$(WIN_OBJ)/test/%.o: test/%.c $(TEST_HDR) $(WIN_PORT_HDR) $(UNITY)/unity.c
-	@mkdir -p $(@D)
-	$(WIN_CC) $(TEST_CPPFLAGS) -Iport/windows $(WIN_CFLAGS) -c $< -o $@
+	$(WIN_CC) $(UNITY_CFLAGS) -c $< -o $@
 
 WIN_TEST_SUPPORT_OBJ := $(TEST_SUPPORT_SRC:%.c=$(WIN_OBJ)/%.o)
 $(WIN)/test/%.exe: $(WIN_OBJ)/test/unit/%.o $(WIN_TEST_SUPPORT_OBJ) $(WIN_UNITY_OBJ) $(WIN_LIB_A)
-	@mkdir -p $(@D)
-	$(WIN_CC) $(WIN_CFLAGS) $^ -o $@
+	$(LINK)
 
 # The port's test goes through the DLL (its import library): that checks the DLL too.
 $(WIN_PORT_TEST): $(WIN_OBJ)/test/windows/test_windows_port.o $(WIN_UNITY_OBJ) $(WIN_IMPLIB)
-	@mkdir -p $(@D)
-	$(WIN_CC) $(WIN_CFLAGS) $^ -o $@
+	$(LINK)
 
 $(WIN_BENCH): $(WIN_OBJ)/test/windows/bench_windows_port.o $(WIN_PORT_A) $(WIN_LIB_A)
-	@mkdir -p $(@D)
-	$(WIN_CC) $(WIN_CFLAGS) $^ -o $@ $(WIN_LIBS)
+	$(LINK)
 
 WIN_ALL := $(WIN_LIB_A) $(WIN_PORT_A) $(WIN_DLL) $(WIN_IMPLIB) $(WIN_UNIT_TESTS) $(WIN_PORT_TEST) \
     $(WIN_BENCH)

@@ -6,9 +6,10 @@
 # run, with their man pages and bash completion), `make uninstall` leaving nothing of it,
 # add_subdirectory, and the library cross-built with cmake/arm-none-eabi.cmake for Cortex-M4F
 # and Cortex-M0 (SI off), and a pkg-config consumer (test/e2e/pkgconfig_consumer.c, against
-# the shared library of both installs). Every install's j288, j288-sim and j288.pc, and the
-# Python package (imported with PYTHONPATH alone), say the header's version. Needs cmake; the
-# cross build needs arm-none-eabi-gcc, the pkg-config consumer pkg-config.
+# the shared library of both installs). Every install's j288, j288-sim, j288-dds (with Cyclone
+# DDS) and j288.pc, and the Python package (imported with PYTHONPATH alone), say the header's
+# version. Needs cmake; the cross build needs arm-none-eabi-gcc, the pkg-config consumer
+# pkg-config.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/need.sh cmake cmake || exit $(($? == 1 ? 0 : 1))
@@ -23,19 +24,20 @@ same_version() {
         *) echo "check-consumers: $1 says '$2', the header $version" >&2; exit 1 ;; esac
 }
 
-# consumer NAME CMAKE_ARGS...: configure, build and run test/cmake_consumer.
+# consumer NAME SOURCE PROGRAM CMAKE_ARGS...: configure and build the CMake project SOURCE, run
+# its PROGRAM.
 consumer() {
-    local name=$1; shift
-    quiet cmake -S test/cmake_consumer -B "$root/$name" "$@"
+    local name=$1 src=$2 exe=$3; shift 3
+    quiet cmake -S "$src" -B "$root/$name" "$@"
     quiet cmake --build "$root/$name" -j "$jobs"
-    echo "$name: $("$root/$name/j288_consumer")"
+    echo "$name: $(env -u LD_LIBRARY_PATH "$root/$name/$exe")"
 }
-# robot_consumer NAME CMAKE_ARGS...: test/e2e/pkgconfig_consumer.c (the library, the Linux port
-# and the runner) built against the target j288::robot, and run.
-robot_consumer() {
-    local name=$1 src=$root/robot-consumer; shift
-    mkdir -p "$src"
-    cat >"$src/CMakeLists.txt" <<EOF
+# The consumers: test/cmake_consumer (j288::j288), and test/e2e/pkgconfig_consumer.c (the
+# library, the Linux port and the runner) built against the target j288::robot.
+cmake_consumer() { consumer "$1" test/cmake_consumer j288_consumer "${@:2}"; }
+robot_consumer() { consumer "$1" "$root/robot-consumer" robot_consumer "${@:2}"; }
+mkdir -p "$root/robot-consumer"
+cat >"$root/robot-consumer/CMakeLists.txt" <<EOF
 cmake_minimum_required(VERSION 3.13)
 project(j288_robot_consumer LANGUAGES C)
 if(J288_SOURCE_DIR)
@@ -47,10 +49,6 @@ endif()
 add_executable(robot_consumer "$PWD/test/e2e/pkgconfig_consumer.c")
 target_link_libraries(robot_consumer PRIVATE j288::robot)
 EOF
-    quiet cmake -S "$src" -B "$root/$name" "$@"
-    quiet cmake --build "$root/$name" -j "$jobs"
-    echo "$name: $(env -u LD_LIBRARY_PATH "$root/$name/robot_consumer")"
-}
 # installed PREFIX LIBDIR: what an install must hold, then a find_package consumer against it.
 installed() {
     local p=$1 l=$2 f
@@ -66,7 +64,12 @@ installed() {
         { echo "check-consumers: the installed completion: $out" >&2; exit 1; }
     same_version "$p/bin/j288 --version" "$("$p/bin/j288" --version 2>&1)"
     same_version "$p/bin/j288-sim --version" "$("$p/bin/j288-sim" --version 2>&1)"
-    consumer "find_package-$(basename "$p")" -DCMAKE_PREFIX_PATH="$p"
+    if pkg-config --exists CycloneDDS 2>/dev/null; then # the DDS bridge: built where Cyclone DDS is
+        grep -q '^\.TH J288-DDS "1"' "$p/share/man/man1/j288-dds.1" ||
+            { echo "check-consumers: $p/share/man/man1/j288-dds.1 is not j288-dds's man page" >&2; exit 1; }
+        same_version "$p/bin/j288-dds --version" "$("$p/bin/j288-dds" --version 2>&1)"
+    fi
+    cmake_consumer "find_package-$(basename "$p")" -DCMAKE_PREFIX_PATH="$p"
     robot_consumer "find_package-robot-$(basename "$p")" -DCMAKE_PREFIX_PATH="$p"
     pkgconfig_consumer "$p" "$l"
 }
@@ -114,7 +117,7 @@ quiet "${mk[@]}" uninstall
 left=$(cd "$root/make-destdir" && find . ! -type d -o -name j288)
 [ -z "$left" ] || { echo "check-consumers: make uninstall left: $left" >&2; exit 1; }
 echo "make uninstall: nothing left of $(wc -l <"$root/make/cmake/install_manifest.txt") files"
-consumer add_subdirectory -DJ288_SOURCE_DIR="$PWD"
+cmake_consumer add_subdirectory -DJ288_SOURCE_DIR="$PWD"
 robot_consumer add_subdirectory-robot -DJ288_SOURCE_DIR="$PWD"
 
 bash scripts/need.sh arm-none-eabi-gcc gcc-arm-none-eabi || exit $(($? == 1 ? 0 : 1))

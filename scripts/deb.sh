@@ -1,10 +1,11 @@
 #!/usr/bin/env bash
 # usage: [BUILD=build] scripts/deb.sh build|check    (make deb, make deb-check; CI step deb)
-# build: libj288-0, libj288-dev, j288-tools, python3-j288 into $BUILD/deb/ with debhelper, from
-#   a copy of the tree with a debian/changelog of the one version; lintian without errors.
+# build: libj288-0, libj288-dev, j288-tools, j288-dds, python3-j288 into $BUILD/deb/ with
+#   debhelper, from a copy of the tree with a debian/changelog of the one version; lintian
+#   without errors; only j288-dds depends on Cyclone DDS (libddsc).
 # check: then apt install them for real (root or sudo: CI, or a machine you may change), check
-#   j288 --version, pkg-config, find_package(j288) (test/cmake_consumer), import j288 and the
-#   completion, purge them and check that none of their files is left.
+#   j288 --version, j288-dds --version, pkg-config, find_package(j288) (test/cmake_consumer),
+#   import j288 and the completion, purge them and check that none of their files is left.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 mode=${1:-build}
@@ -23,7 +24,7 @@ tar -cf - --exclude=./build --exclude=./.git --exclude="./$BUILD" --exclude='*.e
     --exclude=./python/j288/libj288.so --exclude=__pycache__ . | tar -xf - -C "$src"
 printf 'j288 (%s) unstable; urgency=medium\n\n  * Release %s (CHANGELOG.md).\n\n -- %s  %s\n' "$version" \
     "$version" "$(sed -n 's/^Maintainer: //p' debian/control)" "$(date -R)" >"$src/debian/changelog"
-# (noddebs: the four packages, without the -dbgsym ones)
+# (noddebs: the five packages, without the -dbgsym ones)
 (cd "$src" && DEB_BUILD_OPTIONS="noddebs ${DEB_BUILD_OPTIONS:-}" quiet dpkg-buildpackage -b -us -uc -j2)
 mv "$out"/src/*.deb "$out"/src/*.changes "$out"/src/*.buildinfo "$out"/
 ls "$out"/*.deb
@@ -31,16 +32,22 @@ lintian --suppress-tags initial-upload-closes-no-bugs "$out"/*.changes 2>&1 |
     { grep -v '^running with root privileges' || true; } | tee "$out/lintian.txt"
 ! grep -q '^E: ' "$out/lintian.txt" || { echo "deb: lintian reports errors" >&2; exit 1; }
 echo "lintian: no errors"
+for p in j288-tools j288-dds; do dpkg-deb -f "$out/${p}_${version}_"*.deb Depends | sed "s/^/$p: /"; done |
+    tee "$out/depends.txt"
+[ "$(grep -c libddsc "$out/depends.txt")" = 1 ] && grep -q '^j288-dds: .*libddsc' "$out/depends.txt" ||
+    { echo "deb: libddsc must be a dependency of j288-dds alone" >&2; exit 1; }
 [ "$mode" = check ] || exit 0
 
 sudo=
 [ "$(id -u)" -eq 0 ] || sudo=sudo
-pkgs=(libj288-0 libj288-dev j288-tools python3-j288)
+pkgs=(libj288-0 libj288-dev j288-tools j288-dds python3-j288)
 for p in "${pkgs[@]}"; do dpkg-deb -c "$out/${p}_${version}_"*.deb; done |
     awk '{ sub(/^\./, "", $6); sub(/\/$/, "", $6) } $1 !~ /^d/ || $6 ~ /\/j288$/ { print $6 }' | sort >"$out/files.txt"
 trap '$sudo apt-get purge -y -qq "${pkgs[@]}" >/dev/null 2>&1 || true' EXIT
 quiet $sudo apt-get install -y -o DPkg::Lock::Timeout=300 --no-install-recommends "$out"/*.deb
-[ "$(cd / && j288 --version)" = "j288 $version" ] || { echo "deb: j288 --version: $(j288 --version)" >&2; exit 1; }
+for tool in j288 j288-dds; do
+    [ "$(cd / && $tool --version)" = "$tool $version" ] || { echo "deb: $tool --version: $($tool --version)" >&2; exit 1; }
+done
 [ "$(pkg-config --modversion j288)" = "$version" ] || { echo "deb: pkg-config says $(pkg-config --modversion j288)" >&2; exit 1; }
 quiet cmake -S test/cmake_consumer -B "$out/consumer"
 quiet cmake --build "$out/consumer"

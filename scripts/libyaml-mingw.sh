@@ -3,17 +3,17 @@
 # libyaml for the Windows cross build (Debian packages no mingw-w64 libyaml): Debian's own
 # libyaml source package (scripts/apt-source.sh; no root, /etc/apt untouched) cross-compiled
 # with CC into DIR/libyaml.a, static (YAML_DECLARE_STATIC: nothing to ship beside j288.exe).
-# Writes DIR/libyaml.env as scripts/libyaml.sh does (YAML_FOUND, YAML_CFLAGS, YAML_LIBS). When
-# the source cannot be fetched: YAML_FOUND=0 and one line saying so; the config reader then
-# builds as its stubs, which refuse robot config files with a message that says why.
+# Writes DIR/libyaml.env as mk/tools.mk does for the host (YAML_CFLAGS, YAML_LIBS). When the
+# source cannot be fetched: both empty and one line saying so; the config reader then builds
+# as its stubs, which refuse robot config files with a message that says why.
 # Delete DIR to build again.
 set -euo pipefail
 [ $# -eq 2 ] || { echo "usage: scripts/libyaml-mingw.sh DIR CC" >&2; exit 2; }
 mkdir -p "$1"
 dir=$(cd "$1" && pwd)
 cc=$2
-result() { # FOUND CFLAGS LIBS
-    printf 'YAML_FOUND=%s\nYAML_CFLAGS=%s\nYAML_LIBS=%s\n' "$1" "$2" "$3" >"$dir/libyaml.env.tmp"
+result() { # CFLAGS LIBS
+    printf 'YAML_CFLAGS=%s\nYAML_LIBS=%s\n' "$1" "$2" >"$dir/libyaml.env.tmp"
     mv "$dir/libyaml.env.tmp" "$dir/libyaml.env"
 }
 work=$(mktemp -d)
@@ -21,7 +21,7 @@ trap 'rm -rf "$work"' EXIT
 
 if [ ! -f "$dir/libyaml.a" ]; then
     if ! bash "$(dirname "$0")/apt-source.sh" libyaml "$work/src" >"$work/fetch.log" 2>&1; then
-        result 0 "" ""
+        result "" ""
         echo "libyaml (Windows): Debian's libyaml source not fetched: robot config files are refused by j288.exe"
         exit 0
     fi
@@ -45,4 +45,4 @@ if [ ! -f "$dir/libyaml.a" ]; then
     basename "$work"/src/libyaml_*.dsc .dsc >"$dir/.package"
     echo "libyaml (Windows): Debian's $(cat "$dir/.package") cross-built into $dir/libyaml.a"
 fi
-result 1 "-DJ288_HAVE_LIBYAML -DYAML_DECLARE_STATIC -I$dir/include" "$dir/libyaml.a"
+result "-DJ288_HAVE_LIBYAML -DYAML_DECLARE_STATIC -I$dir/include" "$dir/libyaml.a"

@@ -40,6 +40,22 @@ static bool is_active(uint8_t state)
     return (state >= (uint8_t)J288_BUS_TX) && (state <= (uint8_t)J288_BUS_WAIT_REPLY);
 }
 
+/* The flags (J288_BUSF_*, internal.h): one byte, so that "anything pending?" is one test. */
+static bool has_flag(const j288_bus_t *bus, uint8_t f)
+{
+    return (bus->flags & f) != 0u;
+}
+
+static void set_flag(j288_bus_t *bus, uint8_t f)
+{
+    bus->flags = (uint8_t)(bus->flags | f);
+}
+
+static void clear_flags(j288_bus_t *bus, uint8_t f)
+{
+    bus->flags = (uint8_t)(bus->flags & (uint8_t)~f);
+}
+
 static void arm_at(j288_bus_t *bus, uint32_t t)
 {
     bus->timer_at = t;
@@ -199,6 +215,7 @@ J288_NOINLINE static void ring_put(j288_bus_t *bus, const uint8_t *data, size_t 
         bus->stats.rx_overflows += (uint32_t)(len - n);
     }
     bus->ring_head = head + (uint32_t)n; /* publish after the bytes are in place */
+    bus->ev_any++;
 }
 
 /* ---- attempts and completion */
@@ -208,7 +225,7 @@ static void enter_guard(j288_bus_t *bus, uint32_t end)
     bus->state = (uint8_t)J288_BUS_GUARD;
     bus->guard_end = end;
     arm_at(bus, end);
-    if (bus->estop_pending) {
+    if (has_flag(bus, J288_BUSF_ESTOP_PENDING)) {
         bus->again = true; /* the stop goes out at once, not after the guard */
     }
 }
@@ -231,18 +248,29 @@ static void finish(j288_bus_t *bus, int result, uint32_t now)
     j288_txn_t *t = &bus->txn[bus->cur];
     j288_bus_done_fn done = bus->done;
     void *user = bus->done_user;
-    bool was_estop = bus->estop_active;
+    uint8_t flags = bus->flags;
+    bool was_estop = (flags & J288_BUSF_ESTOP_ACTIVE) != 0u;
 
-    if (!was_estop && bus->estop_pending) {
+    if (!was_estop && ((flags & J288_BUSF_ESTOP_PENDING) != 0u)) {
         result = J288_ERR_ABORTED;
     }
     if (was_estop && (result != J288_OK)) {
         bus->stats.estop_failures++;
-        bus->estop_pending = bus->estop_rearm; /* a request merged into it: a stop of its own */
+        /* a request merged into it: a stop of its own */
+        flags = (uint8_t)(flags & (uint8_t)~J288_BUSF_ESTOP_PENDING);
+        if ((flags & J288_BUSF_ESTOP_REARM) != 0u) {
+            flags |= J288_BUSF_ESTOP_PENDING;
+        }
     }
-    bus->estop_rearm = false;
+    bus->flags = (uint8_t)(flags & (uint8_t)~(J288_BUSF_QUEUED | J288_BUSF_RETRY |
+                                              J288_BUSF_ESTOP_ACTIVE | J288_BUSF_ESTOP_REARM));
     t->result = result;
-    t->latency_us = (t->attempts != 0u) ? (uint32_t)(now - t->start_us) : 0u;
+    if (t->attempts != 0u) {
+        t->latency_us = (uint32_t)(now - t->start_us);
+    } else {
+        t->start_us = 0u; /* never sent */
+        t->latency_us = 0u;
+    }
     if ((result != J288_OK) || (t->id == J288_BROADCAST_ID)) {
         (void)memset(&t->reply, 0, sizeof t->reply); /* no reply was taken */
     }
@@ -255,9 +283,6 @@ static void finish(j288_bus_t *bus, int result, uint32_t now)
             bus->stats.failed++;
         }
     }
-    bus->queued = false;
-    bus->retry_pending = false;
-    bus->estop_active = false;
     bus->done = NULL;
     enter_guard(bus, (result == J288_OK) ? (now + bus->cfg.guard_us)
                                          : guard_after_failure(bus, now));
@@ -289,10 +314,10 @@ static bool attempt_is_final(const j288_bus_t *bus, int result, uint8_t attempts
     if ((result == J288_OK) || (result == J288_ERR_OFFLINE)) {
         return true;
     }
-    if (bus->estop_active) {
+    if (has_flag(bus, J288_BUSF_ESTOP_ACTIVE)) {
         return attempts >= J288_ESTOP_ATTEMPTS;
     }
-    return bus->estop_pending || (attempts > bus->cfg.retries);
+    return has_flag(bus, J288_BUSF_ESTOP_PENDING) || (attempts > bus->cfg.retries);
 }
 
 /* An attempt ended: keep its reason, then retry after a guard or finish. */
@@ -307,20 +332,39 @@ static void end_attempt(j288_bus_t *bus, int result, uint32_t now)
         finish(bus, result, now);
         return;
     }
-    bus->retry_pending = true;
+    set_flag(bus, J288_BUSF_RETRY);
     enter_guard(bus, guard_after_failure(bus, now));
 }
 
-/* Something recorded that the machine has not looked at yet. */
-static bool events_pending(const j288_bus_t *bus)
-{
-    return (bus->ev_tx_done != bus->seen_tx_done) || (bus->ring_head != bus->ring_tail) ||
-           (bus->ev_line != bus->seen_line) || (bus->ev_gone != bus->seen_gone);
-}
-
-static void start_attempt(j288_bus_t *bus, uint32_t now)
+/* An attempt ended with its reply taken: end_attempt(J288_OK) and finish() as they go when
+ * no stop is pending or active (the common case, straight through): the transaction is done,
+ * the guard begins, the callback runs. Nothing is queued or waiting to retry while an attempt
+ * is on the wire, and its attempt_result[] entry is J288_OK since begin_txn(). */
+static J288_INLINE_HOT void end_with_reply(j288_bus_t *bus, uint32_t now)
 {
     j288_txn_t *t = &bus->txn[bus->cur];
+    j288_bus_done_fn done = bus->done;
+
+    if (bus->flags != 0u) {
+        end_attempt(bus, J288_OK, now);
+        return;
+    }
+    t->result = J288_OK;
+    t->latency_us = (uint32_t)(now - t->start_us);
+    bus->stats.ok++;
+    bus->done = NULL;
+    bus->state = (uint8_t)J288_BUS_GUARD;
+    bus->guard_end = now + bus->cfg.guard_us;
+    arm_at(bus, bus->guard_end);
+    if (done != NULL) {
+        done(bus->done_user, t);
+    }
+}
+
+static J288_INLINE_HOT void start_attempt(j288_bus_t *bus, uint32_t now)
+{
+    j288_txn_t *t = &bus->txn[bus->cur];
+    uint32_t any = bus->ev_any; /* read first: what is recorded after it counts as new */
     int rc;
 
     /* Whatever arrived before this transmit belongs to nobody. */
@@ -330,6 +374,7 @@ static void start_attempt(j288_bus_t *bus, uint32_t now)
     bus->seen_tx_done = bus->ev_tx_done;
     bus->seen_line = bus->ev_line;
     bus->seen_gone = bus->ev_gone;
+    bus->seen_any = any;
     bus->echo_pos = 0u;
     bus->tx_complete = false;
     bus->collided = false;
@@ -354,33 +399,15 @@ static void start_attempt(j288_bus_t *bus, uint32_t now)
         end_attempt(bus, J288_ERR_PORT, now);
     } else {
         /* Events reported from inside start_tx are taken in this same advance. */
-        bus->again = bus->again || events_pending(bus);
+        bus->again = bus->again || (bus->ev_any != any);
     }
 }
 
-/* A new transaction record, in the slot the previous callback is not looking at. Only what a
- * callback may read is set here (no clearing of the whole record): the reply is cleared by
- * finish() when none is taken. */
-static void begin_txn(j288_bus_t *bus, uint8_t id, j288_bus_done_fn done, void *user)
+/* The same out of line, for the paths that are not hot (a retry, the stop frame, a submit to
+ * an idle bus); the guard's end in the event calls has it inlined. */
+static void start_attempt_called(j288_bus_t *bus, uint32_t now)
 {
-    j288_txn_t *t;
-    unsigned i;
-
-    bus->cur ^= 1u;
-    t = &bus->txn[bus->cur];
-    t->id = id;
-    t->result = J288_ERR_BUSY;
-    t->attempts = 0u;
-    /* Element by element: a few stores, where some targets' compilers (RV32) would call
-     * memset for these 16 bytes. */
-    for (i = 0u; i < (J288_CONFIG_MAX_RETRIES + 1u); i++) {
-        t->attempt_result[i] = J288_OK;
-    }
-    t->start_us = 0u;
-    t->latency_us = 0u;
-    bus->tx_id = id;
-    bus->done = done;
-    bus->done_user = user;
+    start_attempt(bus, now);
 }
 
 J288_NOINLINE static void send_estop(j288_bus_t *bus, uint32_t now)
@@ -393,11 +420,11 @@ J288_NOINLINE static void send_estop(j288_bus_t *bus, uint32_t now)
     j288_cmd_lock(&stop, J288_BROADCAST_ID, false);
     (void)j288_cmd_encode(&stop, bus->tx_buf, &bus->crc); /* constant, valid fields */
     bus->tx_frame = bus->tx_buf;
-    bus->estop_pending = false;
-    bus->estop_active = true;
-    begin_txn(bus, J288_BROADCAST_ID, NULL, NULL);
+    bus->flags = (uint8_t)((bus->flags & (uint8_t)~J288_BUSF_ESTOP_PENDING) |
+                           J288_BUSF_ESTOP_ACTIVE);
+    j288_bus_begin_txn(bus, J288_BROADCAST_ID, NULL, NULL);
     bus->stats.estops++; /* not in transactions: the stop is not a user transaction */
-    start_attempt(bus, now);
+    start_attempt_called(bus, now);
 }
 
 /* ---- byte consumption */
@@ -412,7 +439,7 @@ static void take_frame(j288_bus_t *bus, const uint8_t *frame, uint32_t now)
         return;
     }
     j288_reply_unpack(frame, &bus->txn[bus->cur].reply);
-    end_attempt(bus, J288_OK, now);
+    end_with_reply(bus, now);
 }
 
 /* Reply window: through the parser, which checks a whole frame where it lies. Returns bytes
@@ -571,6 +598,8 @@ J288_NOINLINE static void on_deadline(j288_bus_t *bus, uint32_t now)
 
 static void step_active(j288_bus_t *bus, uint32_t now)
 {
+    uint32_t any = bus->ev_any; /* read first: this step takes every event recorded so far */
+
     if (bus->ev_gone != bus->seen_gone) {
         bus->seen_gone = bus->ev_gone;
         end_attempt(bus, J288_ERR_OFFLINE, now);
@@ -578,6 +607,7 @@ static void step_active(j288_bus_t *bus, uint32_t now)
         return;
     }
     take_events(bus, now);
+    bus->seen_any = any;
     if (!is_active(bus->state)) {
         return; /* a reply ended the attempt */
     }
@@ -595,13 +625,13 @@ static void step_active(j288_bus_t *bus, uint32_t now)
 static void step_quiet(j288_bus_t *bus, uint32_t now)
 {
     consume_all(bus, now); /* late replies and noise: stale */
-    if (bus->retry_pending && (bus->ev_gone != bus->seen_gone)) {
+    if (has_flag(bus, J288_BUSF_RETRY) && (bus->ev_gone != bus->seen_gone)) {
         bus->seen_gone = bus->ev_gone;
         finish(bus, J288_ERR_OFFLINE, now); /* the line went away between two attempts */
         return;
     }
-    if (bus->estop_pending) {
-        if (bus->queued || bus->retry_pending) {
+    if (has_flag(bus, J288_BUSF_ESTOP_PENDING)) {
+        if (has_flag(bus, J288_BUSF_QUEUED | J288_BUSF_RETRY)) {
             finish(bus, J288_ERR_ABORTED, now); /* calls back; the stop goes next time round */
             return;
         }
@@ -609,10 +639,9 @@ static void step_quiet(j288_bus_t *bus, uint32_t now)
         return;
     }
     if ((bus->state == J288_BUS_IDLE) || time_reached(now, bus->guard_end)) {
-        if (bus->queued || bus->retry_pending) {
-            bus->queued = false;
-            bus->retry_pending = false;
-            start_attempt(bus, now);
+        if (has_flag(bus, J288_BUSF_QUEUED | J288_BUSF_RETRY)) {
+            clear_flags(bus, J288_BUSF_QUEUED | J288_BUSF_RETRY);
+            start_attempt_called(bus, now);
         } else {
             bus->state = (uint8_t)J288_BUS_IDLE;
         }
@@ -651,18 +680,13 @@ static void advance_from_event(j288_bus_t *bus)
  * event counter, the ring, the parser's hunt) is skipped. Each does exactly what advance()
  * would do for that event and falls back to it in every other case. */
 
-/* No event counter moved but tx_done_events transmit-completes. */
-static bool only_these_events(const j288_bus_t *bus, uint32_t tx_done_events)
+/* Exactly n events were recorded since the machine last had taken every one (seen_any: a
+ * transmit's start, a pass of step_active(), the tx-done fast path), so that with n = 1 in an
+ * event call the event being handled is the only new one: no other event counter moved, no
+ * byte was put in the ring. (Outside an advance no byte waits in place either.) */
+static bool events_since_seen(const j288_bus_t *bus, uint32_t n)
 {
-    return ((bus->ev_tx_done - bus->seen_tx_done) == tx_done_events) &&
-           (bus->ev_line == bus->seen_line) && (bus->ev_gone == bus->seen_gone);
-}
-
-/* Only the event being handled is new: no other event counter moved, no byte waits. */
-static bool only_this_event(const j288_bus_t *bus, uint32_t tx_done_events)
-{
-    return only_these_events(bus, tx_done_events) && (bus->ring_head == bus->ring_tail) &&
-           (bus->direct_len == 0u);
+    return (uint32_t)(bus->ev_any - bus->seen_any) == n;
 }
 
 /* Transmit complete, no echo expected, the deadline not passed: wait for the reply. */
@@ -671,7 +695,7 @@ static bool tx_done_fast(j288_bus_t *bus)
     uint32_t now;
 
     if ((bus->state != (uint8_t)J288_BUS_TX) || bus->cfg.echo ||
-        (bus->tx_id == J288_BROADCAST_ID) || !only_this_event(bus, 1u)) {
+        (bus->tx_id == J288_BROADCAST_ID) || !events_since_seen(bus, 1u)) {
         return false;
     }
     now = bus->port->now_us(bus->port_ctx);
@@ -680,6 +704,7 @@ static bool tx_done_fast(j288_bus_t *bus)
         return true;
     }
     bus->seen_tx_done = bus->ev_tx_done;
+    bus->seen_any = bus->ev_any;
     bus->tx_complete = true;
     bus->state = (uint8_t)J288_BUS_WAIT_REPLY;
     return true;
@@ -691,27 +716,31 @@ static bool tx_done_fast(j288_bus_t *bus)
  * an advance with the ring empty (so no bytes wait in place either). In WAIT_REPLY every byte
  * still in the ring's past came after the transmit (before it, the state was TX or ECHO), and
  * with nothing held by the parser the byte path would find this frame where it starts.
- * Nothing changes unless it is taken; then *now is the time it was taken at. */
-J288_NOINLINE static bool reply_fast(j288_bus_t *bus, const uint8_t *data, size_t len,
-                                     uint32_t *now)
+ * Nothing changes unless it is taken; then whatever the completion asked for (an estop)
+ * follows in an advance, as advance() would take it. Returns whether it was taken. */
+J288_NOINLINE static bool reply_fast(j288_bus_t *bus, const uint8_t *data, size_t len)
 {
     uint32_t head = bus->ring_head;
+    uint32_t now;
 
     if ((len != J288_REPLY_LEN) || (bus->state != (uint8_t)J288_BUS_WAIT_REPLY) ||
-        !only_these_events(bus, 0u) || (bus->parser.len != 0u) ||
+        !events_since_seen(bus, 0u) || (bus->parser.len != 0u) ||
         (j288_get_u16le(data) != J288_REPLY_HEAD16) || ((data[2] & 0x0Fu) != bus->tx_id) ||
         !j288_reply_crc_ok(&bus->crc, data)) {
         return false;
     }
-    *now = bus->port->now_us(bus->port_ctx);
+    now = bus->port->now_us(bus->port_ctx);
     bus->ring_head = head + J288_REPLY_LEN;
     bus->ring_tail = head + J288_REPLY_LEN;
     bus->parser.stats.frames++;
     bus->in_advance = true;
     bus->again = false;
     j288_reply_unpack(data, &bus->txn[bus->cur].reply);
-    end_attempt(bus, J288_OK, *now);
+    end_with_reply(bus, now);
     bus->in_advance = false;
+    if (bus->again) {
+        advance(bus, now); /* what the completion asked for (an estop), as advance() would */
+    }
     return true;
 }
 
@@ -721,10 +750,7 @@ J288_NOINLINE static bool reply_fast(j288_bus_t *bus, const uint8_t *data, size_
 static J288_INLINE_HOT void accept(j288_bus_t *bus, const uint8_t *frame, uint8_t id,
                                    uint32_t now_us, j288_bus_done_fn done, void *user)
 {
-    bus->tx_frame = frame;
-    begin_txn(bus, id, done, user);
-    bus->stats.transactions++;
-    bus->queued = true;
+    j288_bus_queue_frame(bus, frame, id, done, user);
     /* From a completion callback (inside an advance) the bus is in the guard that finish()
      * has just begun: the guard's timer, or the next poll, starts the transmit. */
     if (!bus->in_advance) {
@@ -777,6 +803,7 @@ void j288_bus_on_tx_done(j288_bus_t *bus)
     }
     bus->txdone_mark = bus->ring_head;
     bus->ev_tx_done++;
+    bus->ev_any++;
     /* Listen at once: the servo answers within microseconds. */
     if (bus->port->set_dir != NULL) {
         bus->port->set_dir(bus->port_ctx, J288_DIR_RX);
@@ -815,8 +842,6 @@ J288_NOINLINE static void take_in_place(j288_bus_t *bus, const uint8_t *data, si
 
 void j288_bus_on_rx(j288_bus_t *bus, const uint8_t *data, size_t len)
 {
-    uint32_t now;
-
     if ((bus == NULL) || (data == NULL) || (len == 0u)) {
         return;
     }
@@ -825,13 +850,9 @@ void j288_bus_on_rx(j288_bus_t *bus, const uint8_t *data, size_t len)
         advance_from_event(bus);
         return;
     }
-    if (reply_fast(bus, data, len, &now)) {
-        if (bus->again) {
-            advance(bus, now); /* what the completion asked for (an estop), as advance() would */
-        }
-        return;
+    if (!reply_fast(bus, data, len)) {
+        take_in_place(bus, data, len);
     }
-    take_in_place(bus, data, len);
 }
 
 /* Nothing to do: a reply with a pause inside it is heard whole until the deadline, and a
@@ -854,13 +875,41 @@ void j288_bus_on_error(j288_bus_t *bus, uint32_t line_flags)
     } else {
         bus->ev_line++;
     }
+    bus->ev_any++;
     advance_from_event(bus);
+}
+
+/* The guard's end with a submit queued and nothing else waiting (no retry, no stop: the
+ * line's going away matters only to a retry): the next attempt starts, as step_quiet()
+ * starts it. Bytes still in the ring are stale either way (start_attempt() counts them as
+ * step_quiet()'s consume_all() would). Returns false, having done nothing, in any other case. */
+static bool guard_end_fast(j288_bus_t *bus, uint32_t now)
+{
+    if ((bus->flags != J288_BUSF_QUEUED) || (bus->state != (uint8_t)J288_BUS_GUARD) ||
+        !time_reached(now, bus->guard_end)) {
+        return false;
+    }
+    bus->flags = 0u;
+    bus->in_advance = true;
+    bus->again = false;
+    start_attempt(bus, now);
+    bus->in_advance = false;
+    if (bus->again) {
+        advance(bus, now); /* events from inside start_tx, as advance() would take them */
+    }
+    return true;
 }
 
 void j288_bus_on_timer(j288_bus_t *bus)
 {
-    if (bus != NULL) {
-        advance_from_event(bus);
+    uint32_t now;
+
+    if ((bus == NULL) || !bus->cfg.advance_in_isr) {
+        return;
+    }
+    now = bus->port->now_us(bus->port_ctx);
+    if (bus->in_advance || !guard_end_fast(bus, now)) {
+        advance(bus, now);
     }
 }
 
@@ -870,10 +919,11 @@ int j288_bus_estop(j288_bus_t *bus, uint32_t now_us)
         return J288_ERR_NULL;
     }
     j288_bus_lock(bus);
-    if (bus->estop_active) {
-        bus->estop_rearm = true; /* merged into the stop in progress, unless that one fails */
+    if (has_flag(bus, J288_BUSF_ESTOP_ACTIVE)) {
+        set_flag(bus, J288_BUSF_ESTOP_REARM); /* merged into the stop in progress, unless that
+                                                 one fails */
     } else {
-        bus->estop_pending = true;
+        set_flag(bus, J288_BUSF_ESTOP_PENDING);
     }
     if (bus->in_advance) {
         bus->again = true;

@@ -44,6 +44,7 @@ int j288_sched_enable(j288_sched_t *s, uint8_t id, bool enabled)
 
 int j288_sched_set_cmd(j288_sched_t *s, const j288_cmd_raw_t *cmd)
 {
+    bool locked;
     int err;
 
     if ((s == NULL) || (cmd == NULL)) {
@@ -58,10 +59,15 @@ int j288_sched_set_cmd(j288_sched_t *s, const j288_cmd_raw_t *cmd)
     if (err != J288_OK) {
         return err;
     }
-    j288_bus_lock(s->bus);
+    locked = j288_bus_needs_lock(s->bus); /* once: nothing in between changes it */
+    if (locked) {
+        s->bus->port->lock(s->bus->port_ctx);
+    }
     s->slot[cmd->id].cmd = *cmd;
     s->frame_stale |= (uint16_t)((uint32_t)1u << cmd->id);
-    j288_bus_unlock(s->bus);
+    if (locked) {
+        s->bus->port->unlock(s->bus->port_ctx);
+    }
     return J288_OK;
 }
 
@@ -98,39 +104,54 @@ static void emit(const j288_sched_t *s, j288_event_kind_t kind, uint8_t id, uint
     s->cfg.on_event(s->cfg.user, &ev);
 }
 
+/* A good reply's events against the previous one (old_*), in the order sched.h lists them;
+ * out of line: most replies change nothing. */
+J288_NOINLINE static void report_reply(j288_sched_t *s, j288_slot_t *slot, uint8_t id,
+                                       uint32_t old_faults, uint8_t old_warn, bool old_trip)
+{
+    const j288_reply_raw_t *r = &slot->reply;
+
+    slot->has_reply = true; /* (a slot without a reply yet is offline: it comes here) */
+    if (!slot->online) {
+        slot->online = true;
+        emit(s, J288_EV_ONLINE, id, 0u, 0u);
+    }
+    if (r->faults != old_faults) {
+        emit(s, J288_EV_FAULTS_CHANGED, id, old_faults, r->faults);
+    }
+    if (r->warnings != old_warn) {
+        emit(s, J288_EV_WARNINGS_CHANGED, id, old_warn, r->warnings);
+    }
+    if (r->watchdog_tripped && !old_trip) {
+        emit(s, J288_EV_WATCHDOG_TRIPPED, id, 0u, 1u);
+    } else if (!r->watchdog_tripped && old_trip) {
+        emit(s, J288_EV_WATCHDOG_CLEARED, id, 1u, 0u);
+    }
+}
+
 static void take_reply(j288_sched_t *s, j288_slot_t *slot, const j288_txn_t *txn)
 {
     const j288_reply_raw_t *r = &txn->reply;
-    uint32_t old_faults = slot->has_reply ? slot->reply.faults : 0u;
-    uint32_t old_warn = slot->has_reply ? slot->reply.warnings : 0u;
-    bool old_trip = slot->has_reply && slot->reply.watchdog_tripped;
+    /* Before the first reply slot->reply is all zero (init), the "previous" sched.h names. */
+    uint32_t old_faults = slot->reply.faults;
+    uint8_t old_warn = slot->reply.warnings;
+    bool old_trip = slot->reply.watchdog_tripped;
+    uint32_t latency = txn->latency_us;
 
     slot->stats.successes++;
     slot->stats.consecutive_failures = 0u;
-    slot->stats.last_latency_us = txn->latency_us;
-    if (txn->latency_us > slot->stats.worst_latency_us) {
-        slot->stats.worst_latency_us = txn->latency_us;
+    slot->stats.last_latency_us = latency;
+    if (latency > slot->stats.worst_latency_us) {
+        slot->stats.worst_latency_us = latency;
     }
     slot->reply = *r;
-    slot->has_reply = true;
-    slot->reply_us = txn->start_us + txn->latency_us;
+    slot->reply_us = txn->start_us + latency;
     if (s->wd_clear_in_flight) {
         slot->clear_watchdog = false; /* the servo heard it: once is enough */
     }
-    if (!slot->online) {
-        slot->online = true;
-        emit(s, J288_EV_ONLINE, txn->id, 0u, 0u);
-    }
-    if (r->faults != old_faults) {
-        emit(s, J288_EV_FAULTS_CHANGED, txn->id, old_faults, r->faults);
-    }
-    if (r->warnings != old_warn) {
-        emit(s, J288_EV_WARNINGS_CHANGED, txn->id, old_warn, r->warnings);
-    }
-    if (r->watchdog_tripped && !old_trip) {
-        emit(s, J288_EV_WATCHDOG_TRIPPED, txn->id, 0u, 1u);
-    } else if (!r->watchdog_tripped && old_trip) {
-        emit(s, J288_EV_WATCHDOG_CLEARED, txn->id, 1u, 0u);
+    if (!slot->online || (r->faults != old_faults) || (r->warnings != old_warn) ||
+        (r->watchdog_tripped != old_trip)) {
+        report_reply(s, slot, txn->id, old_faults, old_warn, old_trip);
     }
 }
 
@@ -185,12 +206,11 @@ static void end_sweep(j288_sched_t *s, uint32_t now)
  * writes it, and only once the bus has accepted a new transaction (until then frame[id] may
  * still be on the wire, in a transaction an estop is ending), under the lock that set_cmd
  * takes (its stale mark is not lost). */
-static int submit_slot(j288_sched_t *s, uint8_t id, uint32_t now)
+static int submit_slot(j288_sched_t *s, uint8_t id, uint32_t now, bool locked)
 {
     const j288_slot_t *slot = &s->slot[id];
     j288_bus_t *bus = s->bus;
     uint16_t bit = (uint16_t)((uint32_t)1u << id);
-    bool locked;
     int rc;
 
     if (slot->clear_watchdog) {
@@ -198,7 +218,6 @@ static int submit_slot(j288_sched_t *s, uint8_t id, uint32_t now)
         cleared.watchdog = false;
         return j288_bus_submit(bus, &cleared, now, sched_done, s);
     }
-    locked = j288_bus_needs_lock(bus); /* once: the same before and after the submit */
     if (locked) {
         bus->port->lock(bus->port_ctx);
     }
@@ -210,7 +229,11 @@ static int submit_slot(j288_sched_t *s, uint8_t id, uint32_t now)
             j288_cmd_pack(&slot->cmd, s->frame[id], &bus->crc);
             s->frame_stale &= (uint16_t)~bit;
         }
-        j288_bus_accept_frame(bus, s->frame[id], id, now, sched_done, s);
+        if (bus->in_advance) {
+            j288_bus_queue_frame(bus, s->frame[id], id, sched_done, s); /* a completion's */
+        } else {
+            j288_bus_accept_frame(bus, s->frame[id], id, now, sched_done, s);
+        }
         rc = J288_OK;
     }
     if (locked) {
@@ -220,8 +243,10 @@ static int submit_slot(j288_sched_t *s, uint8_t id, uint32_t now)
 }
 
 /* Submit the next enabled slot of this sweep; end the sweep (and start the next one when
- * continuous) when none is left. Returns J288_ERR_BUSY if the bus refused the submit. */
-static int next_slot(j288_sched_t *s, uint32_t now)
+ * continuous) when none is left. Returns J288_ERR_BUSY if the bus refused the submit. locked:
+ * j288_bus_needs_lock() as the caller found it, the same before and after the submit (false
+ * in a completion callback, which runs with the lock held or not needed: internal.h). */
+static int next_slot(j288_sched_t *s, uint32_t now, bool locked)
 {
     for (;;) {
         while (s->cursor < J288_MAX_SERVOS) {
@@ -233,7 +258,7 @@ static int next_slot(j288_sched_t *s, uint32_t now)
             }
             s->wd_clear_in_flight = slot->clear_watchdog;
             s->sent++;
-            rc = submit_slot(s, id, now);
+            rc = submit_slot(s, id, now, locked);
             if (rc == J288_OK) {
                 return J288_OK; /* sched_done continues the sweep */
             }
@@ -279,7 +304,7 @@ static void sched_done(void *user, const j288_txn_t *txn)
     /* j288_sched_estop() clears sweeping as it sets stopped, and only a start sets sweeping
      * again (clearing stopped): a sweeping scheduler is never stopped. */
     if (s->sweeping) {
-        (void)next_slot(s, txn->start_us + txn->latency_us);
+        (void)next_slot(s, txn->start_us + txn->latency_us, false);
     }
 }
 
@@ -298,7 +323,7 @@ int j288_sched_start_sweep(j288_sched_t *s, uint32_t now_us)
     s->cursor = 0u;
     s->sent = 0u;
     s->sweeping = true;
-    rc = next_slot(s, now_us);
+    rc = next_slot(s, now_us, j288_bus_needs_lock(s->bus));
     return rc;
 }
 

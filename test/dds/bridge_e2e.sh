@@ -98,11 +98,7 @@ t_too_many_names() {
     local names=leg9_8 speeds=0 i
     for i in $(seq 1 64); do names="$names,leg9_8"; speeds="$speeds,0"; done
     "$PEER" command --count 10 --hz 100 "$names" - "$speeds" - || return 1
-    for i in $(seq 1 50); do
-        "$PEER" diag >"$SIM_DIR/diag" && grep -q "^j288-dds: bridge|unknown joint name=20$" "$SIM_DIR/diag" && break
-        sleep 0.1
-    done
-    grep -q "^j288-dds: bridge|unknown joint name=20$" "$SIM_DIR/diag" || { echo "not counted as unknown names"; return 1; }
+    wait_diag "^j288-dds: bridge|unknown joint name=20$" || { echo "not counted as unknown names"; return 1; }
     ! grep -q 'joint named twice' "$SIM_DIR/bridge.err" || { echo "reported as a joint named twice"; return 1; }
 }
 t_lengths_differ() { bad leg0_3 'array lengths differ' 1,2 - -; }
@@ -117,11 +113,8 @@ t_infinity() {
 }
 t_outside_limits() { bad leg0_3 "target outside the joint's limits" 4.0 - -; }
 t_refusals_in_diagnostics() {
-    "$PEER" diag >"$SIM_DIR/diag" || return 1
-    grep -q "^j288-dds: bridge|unknown joint name=20$" "$SIM_DIR/diag" &&
-        grep -q "^j288-dds: bridge|NaN or infinite value=30$" "$SIM_DIR/diag" &&
-        grep -q '^j288-dds: bus leg1|sweeps=' "$SIM_DIR/diag" &&
-        grep -q '^j288-dds: joint leg0_1|winding_temp_c=' "$SIM_DIR/diag"
+    wait_diag "^j288-dds: bridge|unknown joint name=20$" "^j288-dds: bridge|NaN or infinite value=30$" \
+        '^j288-dds: bus leg1|sweeps=' '^j288-dds: joint leg0_1|winding_temp_c='
 }
 t_watchdog_trip_reported() {
     # the bridge frozen for 1.5 s while leg1_2 follows commands (watchdog bit 1): the servo's

@@ -130,6 +130,21 @@ wait_err() {
     echo "not on the bridge's stderr: $1"; cat "$SIM_DIR/bridge.err"; return 1
 }
 
+# wait_diag PATTERN...: the bridge's diagnostics (read with the peer into $SIM_DIR/diag) hold a
+# line matching each basic regex, within 10 s scaled: the bridge counts a command when it takes
+# it, which under memcheck on a busy machine is well after the peer has sent it.
+wait_diag() {
+    local i p ok
+    for i in $(seq 1 "$(e2e_scaled 50)"); do
+        ok=1
+        "$PEER" diag >"$SIM_DIR/diag" || ok=0
+        for p in "$@"; do [ $ok -eq 1 ] && { grep -q "$p" "$SIM_DIR/diag" || ok=0; }; done
+        [ $ok -eq 1 ] && return 0
+        sleep 0.2
+    done
+    echo "not in the diagnostics: $*"; cat "$SIM_DIR/diag"; return 1
+}
+
 # reported_once CAUSE: exactly one stderr line for that refusal cause.
 reported_once() {
     local n

@@ -17,7 +17,10 @@ cd "$(dirname "$0")/../.."
 e2e_need_python
 SIM_DIR=$E2E_TMP
 . test/e2e/lib_sim.sh
-SIM_WRAP=(timeout -k 2 120)
+# A bound for a simulator left behind, never reached while the script runs: the script's own
+# limit (300 s, scaled). A fixed 120 s ended the main simulator mid-script under memcheck on a
+# loaded machine ("no such device" from port_in_use on).
+SIM_WRAP=(timeout -k 2 "$(e2e_scaled 300)")
 BIG_MARGIN=250000
 M=(--margin-us "$BIG_MARGIN")
 # Where absent ids are asked too (scan: 12 ids, 4 tries each; log's probe sweeps), each
@@ -219,7 +222,7 @@ safe_stop() {
     local name=$1 sig=$2 want=$3 ids=$4; shift 4
     local id pid rc ok=1 why="" from
     from=$(log_lines "$MAIN_LOG")
-    timeout --foreground -k 2 60 "$@" >"$E2E_TMP/bg.out" 2>"$E2E_TMP/bg.err" &
+    timeout --foreground -k 2 "$(e2e_scaled 60)" "$@" >"$E2E_TMP/bg.out" 2>"$E2E_TMP/bg.err" &
     pid=$!
     BG_PIDS+=("$pid")
     for id in ${ids//,/ }; do
@@ -245,7 +248,7 @@ safe_stop sigterm_log TERM 143 1,3 "$J288" --port "$MAIN" log --id 1,3 --rate 10
 
 # ---- port in use -----------------------------------------------------------------------------
 from=$(log_lines "$MAIN_LOG")
-timeout -k 2 60 "$J288" --port "$MAIN" hold --id 1 "${M[@]}" >/dev/null 2>&1 &
+timeout -k 2 "$(e2e_scaled 60)" "$J288" --port "$MAIN" hold --id 1 "${M[@]}" >/dev/null 2>&1 &
 HOLDER=$!
 BG_PIDS+=("$HOLDER")
 wait_for_log "$MAIN_LOG" 'id=1 status=1' 20 "$from"
@@ -277,7 +280,7 @@ stop_sim "$SIM_PID"
 
 # ---- vanished device: the simulator exits under a running command ------------------------------
 start_sim vanish --ids 1 || exit 1
-timeout -k 2 60 "$J288" --port "$DEV" hold --id 1 "${M[@]}" >"$E2E_TMP/bg.out" 2>"$E2E_TMP/bg.err" &
+timeout -k 2 "$(e2e_scaled 60)" "$J288" --port "$DEV" hold --id 1 "${M[@]}" >"$E2E_TMP/bg.out" 2>"$E2E_TMP/bg.err" &
 pid=$!
 BG_PIDS+=("$pid")
 wait_for_log "$E2E_TMP/vanish.log" 'id=1 status=1'
@@ -289,7 +292,7 @@ else
     e2e_fail vanished_during_hold "exit $rc, stderr: $(cat "$E2E_TMP/bg.err")"
 fi
 start_sim vanish2 --ids 1,2 || exit 1
-timeout -k 2 60 "$J288" --port "$DEV" log --id 1,2 --rate 500 --duration 40 --csv "$E2E_TMP/v.csv" "${M[@]}" >"$E2E_TMP/bg.out" 2>"$E2E_TMP/bg.err" &
+timeout -k 2 "$(e2e_scaled 60)" "$J288" --port "$DEV" log --id 1,2 --rate 500 --duration 40 --csv "$E2E_TMP/v.csv" "${M[@]}" >"$E2E_TMP/bg.out" 2>"$E2E_TMP/bg.err" &
 pid=$!
 BG_PIDS+=("$pid")
 wait_for_log "$E2E_TMP/vanish2.log" 'id=2 status=0'

@@ -20,7 +20,7 @@ logged() {
     return 1
 }
 
-start_sims 3 --exit-after 120 --log "$E2E_TMP/log.{k}"
+start_sims 3 --exit-after "$(e2e_scaled 120)" --log "$E2E_TMP/log.{k}"
 robot_config 3 "$E2E_TMP/robot.yaml" 250000 2 0.05
 
 t_status() {

@@ -23,7 +23,7 @@ cleanup() {
 trap cleanup EXIT
 need_built "$J288" "$SIM"
 
-sim_start_linked top --ids 1,2 --quiet --exit-after 120 --fault 2:0x200 || exit 1
+sim_start_linked top --ids 1,2 --quiet --exit-after "$(e2e_scaled 120)" --fault 2:0x200 || exit 1
 CFG=$E2E_TMP/robot.yaml
 printf 'buses:\n  - {name: left, port: %s, margin_us: 250000}\njoints:\n  - {name: hip, id: 1}\n  - {name: knee, id: 2}\n  - {name: ankle, id: 7}\n' \
     "$DEV" >"$CFG"

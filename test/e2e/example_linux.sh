@@ -8,7 +8,7 @@ SIM=${J288_SIM:-$BIN/j288-sim}
 EX=$BIN/linux-status
 trap 'kill -TERM $sim_pid 2>/dev/null; wait $sim_pid 2>/dev/null; e2e_cleanup_tmp' EXIT
 
-"$SIM" --ids 1,2 --link "$E2E_TMP/bus" --exit-after 120 >"$E2E_TMP/sim.out" 2>"$E2E_TMP/sim.err" &
+"$SIM" --ids 1,2 --link "$E2E_TMP/bus" --exit-after "$(e2e_scaled 120)" >"$E2E_TMP/sim.out" 2>"$E2E_TMP/sim.err" &
 sim_pid=$!
 for _ in $(seq 1 600); do [ -L "$E2E_TMP/bus" ] && break; sleep 0.05; done # up to 30 s
 

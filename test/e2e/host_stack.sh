@@ -43,7 +43,7 @@ lines() { cat "$1" 2>/dev/null | wc -l; }
 fresh_sim() { # NAME [more simulator options]
     local name=$1; shift
     [ -n "${SIM_PID:-}" ] && stop_sim "$SIM_PID"
-    sim_start_linked "$name" --ids 1 --load-torque 2 --exit-after 120 "$@" || return 1
+    sim_start_linked "$name" --ids 1 --load-torque 2 --exit-after "$(e2e_scaled 120)" "$@" || return 1
     LOG=$SIM_DIR/$name.log
     CFG=$SIM_DIR/$name.yaml
     printf 'buses:\n  - {name: b, port: %s, margin_us: 250000}\njoints:\n  - {name: hip, bus: b, id: 1, clamp: true}\n' \

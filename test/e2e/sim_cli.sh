@@ -55,7 +55,7 @@ t_path_link_exit_after() {
 t_signals() {
     local sig
     for sig in TERM INT; do
-        start_sim --exit-after 120 || return 1
+        start_sim --exit-after "$(e2e_scaled 120)" || return 1
         [ -n "$SIM_PTY" ] || return 1
         kill -s "$sig" "$SIM_PID"
         wait_exit "$SIM_PID" 20 || return 1
@@ -107,7 +107,7 @@ status_fails() {
 # statistics so far); after SIGUSR2 it times out again.
 t_fault_switch() {
     [ -x "$J288" ] || { echo "$J288 not built"; return 1; }
-    start_sim --ids 1 --drop 1 --exit-after 120 || return 1
+    start_sim --ids 1 --drop 1 --exit-after "$(e2e_scaled 120)" || return 1
     status_fails || { echo "status succeeded with --drop 1"; return 1; }
     kill -s USR1 "$SIM_PID"
     wait_err '^j288-sim: faults off: stats: .* replies 0 dropped 1 ' || { echo "no ack"; return 1; }
@@ -123,7 +123,7 @@ t_fault_switch() {
 # disturb the clean exchanges after the switch.
 t_fault_switch_late_in_flight() {
     [ -x "$J288" ] || { echo "$J288 not built"; return 1; }
-    start_sim --ids 1 --late 1 --late-us 400000 --exit-after 120 || return 1
+    start_sim --ids 1 --late 1 --late-us 400000 --exit-after "$(e2e_scaled 120)" || return 1
     status_fails || { echo "status succeeded with the reply 400 ms late"; return 1; }
     kill -s USR1 "$SIM_PID"
     wait_err '^j288-sim: faults off: stats: .* late 1 ' || { echo "no ack"; return 1; }
@@ -159,7 +159,7 @@ t_truth_start() {
     [ -x "$J288" ] || { echo "$J288 not built"; return 1; }
     local f=$E2E_TMP/truth
     rm -f "$f"
-    start_sim --ids 1,2 --phase 1:2.5 --start-angle 1:-1.25 --truth "$f" --quiet --exit-after 120 || return 1
+    start_sim --ids 1,2 --phase 1:2.5 --start-angle 1:-1.25 --truth "$f" --quiet --exit-after "$(e2e_scaled 120)" || return 1
     [ "$(head -n1 "$f")" = "# j288-sim truth seq=1 t=0.000000 reason=start" ] || { echo "header: $(head -n1 "$f")"; return 1; }
     [ "$(grep -c '^id=' "$f")" -eq 2 ] || return 1
     [ "$(truth_val "$f" 1 c)" = 2.500000000 ] && [ "$(truth_val "$f" 1 theta)" = -1.250000000 ] || return 1
@@ -192,7 +192,7 @@ t_power_cycle_signal() {
     [ -x "$J288" ] || { echo "$J288 not built"; return 1; }
     local f=$E2E_TMP/truth k0
     rm -f "$f"
-    start_sim --ids 1,2 --truth "$f" --power-off-ms 200 --exit-after 120 || return 1
+    start_sim --ids 1,2 --truth "$f" --power-off-ms 200 --exit-after "$(e2e_scaled 120)" || return 1
     k0=$(truth_val "$f" 1 k)
     # (watchdog off: a loaded machine that starves the tool for 1 s must not trip it here)
     timeout 30 "$J288" --port "$SIM_PTY" move --id 1 --pos 20 --side rotor --speed 50 --duration 1.5 \
@@ -220,7 +220,7 @@ t_power_cycle_option() {
     [ -x "$J288" ] || { echo "$J288 not built"; return 1; }
     local f=$E2E_TMP/truth
     rm -f "$f"
-    start_sim --ids 1,2 --truth "$f" --power-cycle-after 0:1 --power-off-ms 60000 --quiet --exit-after 120 || return 1
+    start_sim --ids 1,2 --truth "$f" --power-cycle-after 0:1 --power-off-ms 60000 --quiet --exit-after "$(e2e_scaled 120)" || return 1
     wait_file "$f" 'reason=power-off$' || { echo "no power-off truth"; return 1; }
     [ "$(truth_val "$f" 1 powered)" = 0 ] && [ "$(truth_val "$f" 2 powered)" = 1 ] || { cat "$f"; return 1; }
     status_fails || { echo "servo 1 answered while off"; return 1; }

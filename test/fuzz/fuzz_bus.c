@@ -488,7 +488,7 @@ static void do_op(fuzz_in_t *in)
         w.estops++;
         /* A stop already on the wire absorbs the request (bus.c, by design), even if that
          * stop then fails: only then is no new stop frame due. */
-        if (!bus.estop_active) {
+        if ((bus.flags & J288_BUSF_ESTOP_ACTIVE) == 0u) {
             w.estop_expected = true;
         }
         FUZZ_CHECK(j288_bus_estop(&bus, w.now) == J288_OK);

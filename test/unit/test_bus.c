@@ -1484,6 +1484,106 @@ static void test_isr_first_whole_reply_from_another_id(void)
     TEST_ASSERT_EQUAL_INT(J288_BUS_WAIT_REPLY, j288_bus_state(&bus));
 }
 
+/* A completion that hears 5 more bytes (put in the ring: the bus is advancing) and submits
+ * the next command, which waits for the guard. */
+static void on_done_noise_then_submit(void *user, const j288_txn_t *txn)
+{
+    j288_cmd_raw_t cmd = worked_cmd();
+    on_done(user, txn);
+    if (cb.calls == 1) {
+        j288_bus_on_rx(&bus, WORKED_REPLY3, 5u);
+        TEST_ASSERT_EQUAL_INT(J288_OK, j288_bus_submit(&bus, &cmd, fake_port_now_us(&fp),
+                                                       on_done_noise_then_submit, user));
+    }
+}
+
+/* The guard's timer starts the queued submit (the timer's fast path): bytes left in the ring
+ * from the guard are counted stale, not taken as the new attempt's reply, and the next reply
+ * is taken as usual. */
+static void test_isr_guard_timer_starts_queued_after_stale_bytes(void)
+{
+    j288_cmd_raw_t cmd = worked_cmd();
+    setup_isr_manual(false);
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_bus_submit(&bus, &cmd, fake_port_now_us(&fp),
+                                                   on_done_noise_then_submit, &cb));
+    j288_bus_on_tx_done(&bus);
+    j288_bus_on_rx(&bus, WORKED_REPLY3, J288_REPLY_LEN);
+    TEST_ASSERT_EQUAL_INT(1, cb.calls);
+    TEST_ASSERT_EQUAL_INT(J288_BUS_GUARD, j288_bus_state(&bus));
+    TEST_ASSERT_EQUAL_UINT32(1u, fp.nframes);
+    TEST_ASSERT_EQUAL_UINT32(0u, j288_bus_stats(&bus)->stale_bytes);
+    fp.now_ns += (uint64_t)J288_DEFAULT_GUARD_US * US;
+    j288_bus_on_timer(&bus);
+    TEST_ASSERT_EQUAL_INT(J288_BUS_TX, j288_bus_state(&bus));
+    TEST_ASSERT_EQUAL_UINT32(2u, fp.nframes);
+    TEST_ASSERT_EQUAL_UINT32(5u, j288_bus_stats(&bus)->stale_bytes);
+    TEST_ASSERT_EQUAL_UINT32(0u, j288_bus_stats(&bus)->crc_errors);
+    j288_bus_on_tx_done(&bus);
+    TEST_ASSERT_EQUAL_INT(J288_BUS_WAIT_REPLY, j288_bus_state(&bus));
+    j288_bus_on_rx(&bus, WORKED_REPLY3, J288_REPLY_LEN);
+    TEST_ASSERT_EQUAL_INT(2, cb.calls);
+    TEST_ASSERT_EQUAL_INT(J288_OK, cb.txn.result);
+    TEST_ASSERT_EQUAL_UINT32(2u, j288_bus_parser_stats(&bus)->frames);
+    TEST_ASSERT_EQUAL_UINT32(2u, j288_bus_stats(&bus)->ok);
+}
+
+/* A retry waits for the guard after the failure; the guard's timer starts it (the general
+ * pass: the timer's fast path only takes a queued submit), and its reply ends the transaction. */
+static void test_isr_guard_timer_starts_retry(void)
+{
+    j288_bus_config_t cfg;
+    j288_cmd_raw_t cmd = worked_cmd();
+    memset(&cfg, 0, sizeof cfg);
+    cfg.advance_in_isr = true;
+    cfg.retries = 1u;
+    setup_cfg(&cfg);
+    fp.poll_fn = NULL;
+    fp.txdone = FAKE_TXDONE_MANUAL;
+    submit_ok(&cmd);
+    j288_bus_on_tx_done(&bus);
+    fp.now_ns = (uint64_t)BUDGET_US * US; /* the deadline, no reply */
+    j288_bus_on_timer(&bus);
+    TEST_ASSERT_EQUAL_INT(J288_BUS_GUARD, j288_bus_state(&bus));
+    TEST_ASSERT_EQUAL_INT(0, cb.calls);
+    fp.now_ns += (uint64_t)(BUDGET_US - 1u) * US; /* one microsecond before the guard's end */
+    j288_bus_on_timer(&bus);
+    TEST_ASSERT_EQUAL_UINT32(1u, fp.nframes);
+    fp.now_ns += US;
+    j288_bus_on_timer(&bus);
+    TEST_ASSERT_EQUAL_INT(J288_BUS_TX, j288_bus_state(&bus));
+    TEST_ASSERT_EQUAL_UINT32(2u, fp.nframes);
+    j288_bus_on_tx_done(&bus);
+    j288_bus_on_rx(&bus, WORKED_REPLY3, J288_REPLY_LEN);
+    TEST_ASSERT_EQUAL_INT(1, cb.calls);
+    TEST_ASSERT_EQUAL_INT(J288_OK, cb.txn.result);
+    TEST_ASSERT_EQUAL_UINT8(2u, cb.txn.attempts);
+    TEST_ASSERT_EQUAL_INT(J288_ERR_TIMEOUT, cb.txn.attempt_result[0]);
+    TEST_ASSERT_EQUAL_INT(J288_OK, cb.txn.attempt_result[1]);
+    TEST_ASSERT_EQUAL_UINT32(1u, j288_bus_stats(&bus)->timeouts);
+}
+
+/* A stop requested while a reply is awaited: the reply, taken whole by the fast path, ends
+ * the transaction J288_ERR_ABORTED (its attempt's own result kept), and the stop goes out. */
+static void test_isr_reply_under_pending_estop_aborts(void)
+{
+    j288_cmd_raw_t cmd = worked_cmd();
+    j288_cmd_raw_t stop = stop_cmd();
+    setup_isr_manual(false);
+    submit_ok(&cmd);
+    j288_bus_on_tx_done(&bus);
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_bus_estop(&bus, fake_port_now_us(&fp)));
+    TEST_ASSERT_EQUAL_INT(J288_BUS_WAIT_REPLY, j288_bus_state(&bus));
+    j288_bus_on_rx(&bus, WORKED_REPLY3, J288_REPLY_LEN);
+    TEST_ASSERT_EQUAL_INT(1, cb.calls);
+    TEST_ASSERT_EQUAL_INT(J288_ERR_ABORTED, cb.txn.result);
+    TEST_ASSERT_EQUAL_INT(J288_OK, cb.txn.attempt_result[0]);
+    TEST_ASSERT_EQUAL_UINT32(1u, j288_bus_stats(&bus)->aborted);
+    TEST_ASSERT_EQUAL_UINT32(0u, j288_bus_stats(&bus)->ok);
+    TEST_ASSERT_EQUAL_INT(J288_BUS_TX, j288_bus_state(&bus));
+    TEST_ASSERT_EQUAL_UINT32(2u, fp.nframes);
+    assert_frame_cmd(1u, &stop);
+}
+
 /* Without advance_in_isr the event calls only record: the state moves at the next poll. */
 static void test_poll_mode_tx_done_waits_for_poll(void)
 {
@@ -2064,6 +2164,9 @@ int main(void)
     RUN_TEST(test_isr_reply_with_bad_head_refused);
     RUN_TEST(test_isr_whole_replies_wrong_id_bad_crc_then_ours);
     RUN_TEST(test_isr_first_whole_reply_from_another_id);
+    RUN_TEST(test_isr_guard_timer_starts_queued_after_stale_bytes);
+    RUN_TEST(test_isr_guard_timer_starts_retry);
+    RUN_TEST(test_isr_reply_under_pending_estop_aborts);
     RUN_TEST(test_poll_mode_tx_done_waits_for_poll);
     RUN_TEST(test_failure_ranking);
     RUN_TEST(test_noise_while_idle_is_not_echo);

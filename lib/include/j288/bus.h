@@ -150,7 +150,9 @@ typedef struct j288_bus {
     volatile uint32_t ev_gone;     /* (ev) */
     volatile uint32_t txdone_mark; /* (ev) ring_head when the transmit completed */
     volatile uint32_t line_flags;  /* (ev) OR of every line flag reported (diagnostic) */
+    volatile uint32_t ev_any;      /* (ev) +1 at every tx done, line report, on_rx into ring */
     uint32_t seen_tx_done, seen_line, seen_gone;
+    uint32_t seen_any;             /* ev_any when the machine had last taken every event */
     const uint8_t *direct;         /* bytes of an on_rx taken in place (advance_in_isr), */
     uint32_t direct_pos;           /* at these ring positions, during that call only */
     uint32_t direct_len;
@@ -160,11 +162,7 @@ typedef struct j288_bus {
     bool collided;        /* this attempt's echo differed */
     bool in_advance;      /* the machine is advancing (re-entry guard) */
     bool again;           /* advance once more: something changed */
-    bool queued;          /* an accepted submit waits for the guard to end */
-    bool retry_pending;   /* the failed attempt is re-sent when the guard ends */
-    bool estop_pending;   /* a stop was requested and is not on the wire yet */
-    bool estop_active;    /* the frame in flight (or to be re-sent) is the stop frame */
-    bool estop_rearm;     /* an estop was requested while the stop was active */
+    uint8_t flags;        /* what waits: a queued submit, a retry, an estop (bus.c) */
     int attempt_fail;     /* most specific failure seen in this attempt, or J288_OK */
     uint32_t deadline;    /* reply deadline of the attempt in flight */
     uint32_t guard_end;
