@@ -12,14 +12,11 @@ static uint8_t *buf(j288_parser_t *p)
 }
 
 #if J288_STORE32_AS_WORD
-/* Word i of the store (the frame's bytes 4i-2 .. 4i+1), little-endian: one aligned store. */
+/* Word i of the store (the frame's bytes 4i-2 .. 4i+1): one aligned store, little-endian as
+ * the core (J288_STORE32_AS_WORD holds only on little-endian cores). */
 static void hold_word(j288_parser_t *p, size_t i, uint32_t v)
 {
-#if J288_LITTLE_ENDIAN
     p->held.words[i] = v;
-#else
-    j288_put_u32le(&p->held.bytes[4u * i], v);
-#endif
 }
 #endif
 
@@ -301,8 +298,8 @@ J288_NOINLINE static int feed_after_bad_reply(j288_parser_t *p, const uint8_t *d
     return rc;
 }
 
-/* j288_parser_feed() but for a whole reply at the start of data, out of line so that the
- * common case below saves and restores only the registers it needs. */
+/* j288_parser_feed() for everything but a whole reply at the start of data, out of line so
+ * that that common case saves and restores only the registers it needs. */
 J288_NOINLINE static int feed_scan(j288_parser_t *p, const uint8_t *data, size_t len,
                                    size_t *consumed)
 {
