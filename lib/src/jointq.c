@@ -132,19 +132,33 @@ static j288_q24_t wrap_pi(int32_t x)
     return r;
 }
 
-/* The same for |x| < 2^62, by division: only on a start, never per reply. */
+/* The same for |x| < 2^40 (on a start only: N theta), in 64 bits without a division (which
+ * would link a kilobyte of the C library's 64-bit division on Cortex-M0): the turn estimate
+ * is within 0.2 turn of the exact one, then corrected. */
 static j288_q24_t wrap_pi64(int64_t x)
 {
     uint64_t m = (x < 0) ? ((uint64_t)0 - (uint64_t)x) : (uint64_t)x;
-    uint64_t n = (m + (uint64_t)(TWO_PI_Q / 2)) / (uint64_t)TWO_PI_Q;
-    int32_t r = (int32_t)((int64_t)m - (int64_t)(n * (uint64_t)TWO_PI_Q)); /* [-pi, pi] */
-    return (x < 0) ? -r : r;
+    uint32_t n = (uint32_t)((mul64((uint32_t)(m >> 16), INV_TWO_PI_26) + (1u << 25)) >> 26);
+    int64_t r = (int64_t)m - (int64_t)mul64(n, (uint32_t)TWO_PI_Q);
+    if (r > PI_Q) {
+        r -= TWO_PI_Q;
+    } else if (r < -PI_Q) {
+        r += TWO_PI_Q;
+    } else {
+        /* within */
+    }
+    return (x < 0) ? -(j288_q24_t)r : (j288_q24_t)r;
 }
 
-/* a / b rounded half away from zero (b > 0). Rare paths only. */
-static int64_t div_round(int64_t a, int64_t b)
+/* round(s / n), halves away from zero, for a mean known to lie within +-2^31 (|s| < 2^40,
+ * 0 < n < 256): by 20-bit halves with 32-bit divisions. */
+static j288_q24_t mean_of(int64_t s, uint32_t n)
 {
-    return (a >= 0) ? ((a + (b / 2)) / b) : -(((-a) + (b / 2)) / b);
+    uint64_t m = ((s < 0) ? ((uint64_t)0 - (uint64_t)s) : (uint64_t)s) + (n / 2u);
+    uint32_t hi = (uint32_t)(m >> 20);
+    uint32_t q_hi = hi / n;
+    uint32_t q_lo = (((hi % n) << 20) | ((uint32_t)m & 0xFFFFFu)) / n;
+    return signed_of(s < 0, (q_hi << 20) + q_lo);
 }
 
 /* a - b in rotor LSB, modulo 2^32 (the wire's int32 may wrap). */
@@ -461,11 +475,20 @@ static void follow(j288_jointq_t *j, int32_t pos)
     j->st.residual = j->st.encoder_fault ? 0 : residual_of(j, j->st.pos);
 }
 
+/* N |theta| rounded, exactly: 288 theta + 7 theta / 20 (|theta| < 2^31). */
+static uint64_t gear_up(uint32_t m)
+{
+    uint32_t q = m / (uint32_t)GEAR_DEN;
+    uint32_t r = m % (uint32_t)GEAR_DEN;
+    return mul64(m, (uint32_t)(GEAR_NUM / GEAR_DEN)) + (uint64_t)(7u * q) +
+           (uint64_t)(((7u * r) + ((uint32_t)GEAR_DEN / 2u)) / (uint32_t)GEAR_DEN);
+}
+
 /* Calibrated start: correct the anchor angle q by eps = N theta + c - p (mod 2 pi). */
 static bool apply_phase(j288_jointq_t *j, j288_q24_t *q, unsigned *ev)
 {
     int64_t theta = (int64_t)j->cfg.zero + (reversed(j) ? -(int64_t)*q : (int64_t)*q);
-    int64_t rotor;
+    uint64_t rotor;
     j288_q24_t eps;
     int32_t corr;
 
@@ -477,8 +500,9 @@ static bool apply_phase(j288_jointq_t *j, j288_q24_t *q, unsigned *ev)
     } else {
         /* within */
     }
-    rotor = div_round(theta * GEAR_NUM, GEAR_DEN);
-    eps = wrap_pi64((rotor + j->cfg.phase) - rotor_frac(j->init_pos));
+    rotor = gear_up(mag32((int32_t)theta)); /* |theta| <= 20 pi: |N theta| < 2^39 */
+    eps = wrap_pi64(((theta < 0) ? -(int64_t)rotor : (int64_t)rotor) + j->cfg.phase -
+                    rotor_frac(j->init_pos));
     j->st.cal_residual = eps;
     if (mag32(eps) > (uint32_t)j->cfg.cal_tol) {
         if (!j->st.cal_mismatch) {
@@ -487,7 +511,9 @@ static bool apply_phase(j288_jointq_t *j, j288_q24_t *q, unsigned *ev)
         j->st.cal_mismatch = true;
         return false;
     }
-    corr = (int32_t)div_round((int64_t)eps * GEAR_DEN, GEAR_NUM); /* eps / N, output rad */
+    /* eps / N in output rad: |eps| <= pi, so 20 |eps| < 2^31 */
+    corr = signed_of(eps < 0, ((mag32(eps) * (uint32_t)GEAR_DEN) + (uint32_t)(GEAR_NUM / 2)) /
+                                  (uint32_t)GEAR_NUM);
     *q -= reversed(j) ? -corr : corr;
     j->st.calibrated = true;
     return true;
@@ -495,7 +521,7 @@ static bool apply_phase(j288_jointq_t *j, j288_q24_t *q, unsigned *ev)
 
 static void finish_start(j288_jointq_t *j, int32_t pos, unsigned *ev)
 {
-    int64_t theta = (int64_t)j->init_e0 + div_round(j->init_sum, (int64_t)j->init_n);
+    int64_t theta = (int64_t)j->init_e0 + mean_of(j->init_sum, j->init_n);
     j288_q24_t q = label_q(j, theta);
 
     j->init_n = 0u;
