@@ -637,6 +637,22 @@ def fixed_command_vectors():
     add("pos_min", 0, 0, -(1 << 31), 0, 0)
     add("all_out", -(1 << 31), (1 << 31) - 1, -(1 << 31), (1 << 31) - 1, (1 << 31) - 1)
     add("all_out_neg_gains", (1 << 31) - 1, -(1 << 31), 0, -(1 << 31), -5)
+    # The inputs closest to a half without being one, both sides, for the rational factors
+    # (torque and gains): x = m num / den has 2 m num = den + t (mod 2 den) for a small t.
+    for q, pos_in in (("torque", 0), ("kp", 3), ("kd", 4)):
+        f = lsb_per_unit(q, "output") / FIXED_SCALE[q]
+        num, den = f.numerator, f.denominator
+        g = math.gcd(2 * num, 2 * den)
+        lo, hi = RANGE[q]
+        for t in (-2 * g, -g, g, 2 * g):
+            if (den + t) % g:
+                continue
+            m = ((den + t) // g) * pow(2 * num // g, -1, 2 * den // g) % (2 * den // g)
+            while m * f < hi - 1:
+                vals = [0, 0, 0, 0, 0]
+                vals[pos_in] = m
+                add("%s_near_half_%+d_%d" % (q, t, m), *vals)
+                m += 2 * den // g * max(1, (hi // 3) // max(1, int((2 * den // g) * f)))
     rng = XorShift32(0xF1CED0)
     for i in range(60):
         vals = []
