@@ -20,7 +20,7 @@
 #define GEAR_INT 288u                /* N = 288 + 7 / 20 */
 #define GEAR_REST 7u
 #define HALF_26 0x2000000u           /* 2^25: rounds a value in 2^-26 units */
-#define INV_TWO_PI_26 41722u         /* 2^26 / (2 pi * 2^8): turns from |x| >> 16 */
+#define INV_TWO_PI_26 41721u         /* 2^42 / TWO_PI_Q rounded down: turns from |x| >> 16 */
 #define ROTOR_LSB_MASK 0x7FFFu       /* position LSB within one rotor turn */
 #define COUNT_MASK (J288_OUT_POS_COUNTS - 1u)
 /* Rotor LSB in 20 output turns (5767 rotor turns): the output angle's period in LSB. */
@@ -118,30 +118,24 @@ static uint32_t jq_ratio_fix(uint32_t r, uint32_t m, uint32_t num, uint32_t den)
     return r;
 }
 
-/* x - 2 pi n for the nearest integer n: [-pi, pi]. |x| < 2^31 - 2^26 (123 rad): the turn
- * estimate from |x| >> 16 is within 0.001 of the exact one, so one correction step ends it. */
+/* x - 2 pi n for the nearest integer n: [-pi, pi]. |x| < 2^31 - 2^26 (123 rad). The turn
+ * estimate from |x| >> 16 and a reciprocal rounded down never exceeds the exact turns and is
+ * within 0.001 turn of them: r is at least -pi, and one step down corrects it. */
 static j288_q24_t jq_wrap_pi(int32_t x)
 {
     uint32_t m = jq_mag32(x);
     uint32_t n = (((m >> 16) * INV_TWO_PI_26) + HALF_26) >> 26;
     uint32_t turns = n * (uint32_t)TWO_PI_Q; /* <= m + pi: an int32 */
     int32_t r = (int32_t)m - (int32_t)turns;
-    if (x < 0) {
-        r = -r;
-    }
     if (r > PI_Q) {
         r -= TWO_PI_Q;
-    } else if (r < -PI_Q) {
-        r += TWO_PI_Q;
-    } else {
-        /* within */
     }
-    return r;
+    return (x < 0) ? -r : r;
 }
 
 /* The same for |x| < 2^40 (on a start only: N theta), in 64 bits without a division (which
- * would link a kilobyte of the C library's 64-bit division on Cortex-M0): the turn estimate
- * is within 0.2 turn of the exact one, then corrected. */
+ * would link a kilobyte of the C library's 64-bit division on Cortex-M0); the estimate is
+ * within 0.05 turn below the exact one. */
 static j288_q24_t jq_wrap_pi64(int64_t x)
 {
     uint64_t m = (x < 0) ? ((uint64_t)0 - (uint64_t)x) : (uint64_t)x;
@@ -149,10 +143,6 @@ static j288_q24_t jq_wrap_pi64(int64_t x)
     int64_t r = (int64_t)m - (int64_t)jq_mul64(n, (uint32_t)TWO_PI_Q);
     if (r > PI_Q) {
         r -= TWO_PI_Q;
-    } else if (r < -PI_Q) {
-        r += TWO_PI_Q;
-    } else {
-        /* within */
     }
     return (x < 0) ? -(j288_q24_t)r : (j288_q24_t)r;
 }

@@ -273,6 +273,7 @@ static void test_config_checks(void)
     BAD(zero, J288_JOINTQ_MAX_ANGLE + 1, J288_ERR_BAD_CONFIG);
     BAD(pos_max, -1, J288_ERR_BAD_CONFIG); /* pos_min 0 >= pos_max */
     BAD(pos_min, -J288_JOINTQ_MAX_ANGLE - 1, J288_ERR_BAD_CONFIG);
+    BAD(pos_max, J288_JOINTQ_MAX_ANGLE + 1, J288_ERR_BAD_CONFIG);
     BAD(max_speed, -1, J288_ERR_BAD_CONFIG);
     BAD(max_torque, -1, J288_ERR_BAD_CONFIG);
     BAD(kp, -1, J288_ERR_BAD_CONFIG);
@@ -335,6 +336,35 @@ static void test_errors_and_unknown(void)
     j288_jointq_reset(&jq);
     TEST_ASSERT_FALSE(j288_jointq_state(&jq)->known);
     TEST_ASSERT_EQUAL_HEX(EVB(ANGLE_UNKNOWN), feed(&jq, &m));
+    TEST_ASSERT_EQUAL_INT(J288_ERR_NULL, j288_jointq_lock_command(&jq, NULL));
+    /* The hold-here target of an unknown joint is 0, with the default gains. */
+    c.kp = q16(7.0);
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_jointq_init(&jq, &c));
+    j288_jointq_target_init(&jq, NULL);
+    t.pos = 99;
+    j288_jointq_target_init(&jq, &t);
+    TEST_ASSERT_EQUAL_INT32(0, t.pos);
+    TEST_ASSERT_EQUAL_INT32(q16(7.0), t.kp);
+    /* A reversed joint's zero here is its zero minus the angle; beyond +-128 rad: an error. */
+    c.direction = -1;
+    c.zero = q24(2.0);
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_jointq_init(&jq, &c));
+    (void)start_joint(&jq, &m);
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_jointq_zero_here(&jq, &z));
+    TEST_ASSERT_EQUAL_INT32(c.zero - j288_jointq_state(&jq)->pos, z);
+    c.direction = 1;
+    c.zero = J288_JOINTQ_MAX_ANGLE;
+    c.pos_min = q24(-64.0);
+    c.pos_max = q24(64.0);
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_jointq_init(&jq, &c));
+    (void)start_joint(&jq, &m);
+    r = reply_of(&m, 3u);
+    r.faults = J288_FAULT_OUTPUT_ENCODER;
+    r.pos = (int32_t)((uint32_t)r.pos + 2000000000u); /* saturates at +120 rad */
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_jointq_take_reply(&jq, &r, &ev));
+    z = 7;
+    TEST_ASSERT_EQUAL_INT(J288_ERR_RANGE, j288_jointq_zero_here(&jq, &z));
+    TEST_ASSERT_EQUAL_INT32(7, z);
 }
 
 /* ---- against the model */
@@ -474,6 +504,68 @@ static void test_power_cycle_and_encoder_fault(void)
     }
 }
 
+/* The turn choice at exactly a half turn from the range's middle (a wrap's boundary), far
+ * zeros with a calibrated start (theta beyond +-20 pi, reduced by 40 pi), and a start that
+ * sees a huge rotor jump between samples or an encoder fault. */
+static void test_edges_of_the_start(void)
+{
+    j288_jointq_config_t c = cfg_for(5u);
+    j288_reply_raw_t r;
+    unsigned ev = 0u;
+    model_t m = servo_at(0.3, 0.7);
+    int32_t enc = j288_out_pos_to_q(model_count(&m));
+    int sign;
+
+    for (sign = -1; sign <= 1; sign += 2) {
+        /* zero a hair more than pi from the encoder angle: q = -+(pi + 100 steps) labels as
+         * +-(pi - 100 steps) within the default range's middle */
+        c = cfg_for(5u);
+        c.zero = enc - sign * (J288_JOINTQ_PI + 100);
+        TEST_ASSERT_EQUAL_INT(J288_OK, j288_jointq_init(&jq, &c));
+        (void)start_joint(&jq, &m);
+        TEST_ASSERT_INT32_WITHIN(1, -sign * (J288_JOINTQ_TWO_PI - J288_JOINTQ_PI - 100),
+                                 j288_jointq_state(&jq)->pos);
+    }
+    for (sign = -1; sign <= 1; sign += 2) {
+        double theta = 65.0 * (double)sign;
+        m = servo_at(theta, -0.4);
+        c = cfg_for(5u);
+        c.zero = q24(60.0 * (double)sign);
+        c.pos_min = q24(sign > 0 ? 3.0 : -7.0);
+        c.pos_max = q24(sign > 0 ? 7.0 : -3.0);
+        c.has_phase = true;
+        c.phase = q24(m.c);
+        TEST_ASSERT_EQUAL_INT(J288_OK, j288_jointq_init(&jq, &c));
+        TEST_ASSERT_EQUAL_HEX(EVB(ANGLE_UNKNOWN) | EVB(ANGLE_KNOWN), start_joint(&jq, &m));
+        TEST_ASSERT_TRUE(j288_jointq_state(&jq)->calibrated);
+        TEST_ASSERT_DOUBLE_WITHIN(CAL_TOL, 5.0 * (double)sign, rad(j288_jointq_state(&jq)->pos));
+    }
+    /* 150 million LSB between two samples (26 output rad modulo 20 turns): the second
+     * disagrees and the collection starts again from it. */
+    m = servo_at(0.3, 0.7);
+    c = cfg_for(5u);
+    c.init_samples = 2u;
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_jointq_init(&jq, &c));
+    r = reply_of(&m, 5u);
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_jointq_take_reply(&jq, &r, &ev));
+    r.pos = (int32_t)((uint32_t)r.pos + 150000000u);
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_jointq_take_reply(&jq, &r, &ev));
+    TEST_ASSERT_FALSE(j288_jointq_state(&jq)->known);
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_jointq_take_reply(&jq, &r, &ev));
+    TEST_ASSERT_TRUE(j288_jointq_state(&jq)->known);
+    /* Fault bit 12 before the start: no start from the encoder, however many replies. */
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_jointq_init(&jq, &c));
+    r = reply_of(&m, 5u);
+    r.faults = J288_FAULT_OUTPUT_ENCODER;
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_jointq_take_reply(&jq, &r, &ev));
+    TEST_ASSERT_EQUAL_HEX(EVB(ENCODER_FAULT) | EVB(ANGLE_UNKNOWN), ev);
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_jointq_take_reply(&jq, &r, &ev));
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_jointq_take_reply(&jq, &r, &ev));
+    TEST_ASSERT_FALSE(j288_jointq_state(&jq)->known);
+    TEST_ASSERT_EQUAL_HEX(EVB(ENCODER_OK), feed(&jq, &m));
+    TEST_ASSERT_EQUAL_HEX(EVB(ANGLE_KNOWN), feed(&jq, &m));
+}
+
 /* ---- targets */
 
 static void known_joint(const j288_jointq_config_t *c, model_t *m)
@@ -594,6 +686,18 @@ static void test_large_rotor_positions(void)
     t.pos = q24(5.0);
     TEST_ASSERT_EQUAL_INT(J288_OK, j288_jointq_command(&jq, &t, &cmd, NULL));
     TEST_ASSERT_TRUE(cmd.pos > 0);
+    /* The same at the other end of int32. */
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_jointq_init(&jq, &c));
+    for (i = 0; i < 10; i++) {
+        r = reply_of(&m, 3u);
+        r.pos = INT32_MIN + 1000;
+        TEST_ASSERT_EQUAL_INT(J288_OK, j288_jointq_take_reply(&jq, &r, NULL));
+    }
+    t.pos = q24(5.8);
+    TEST_ASSERT_EQUAL_INT(J288_ERR_RANGE_POS, j288_jointq_command(&jq, &t, &cmd, NULL));
+    t.pos = q24(6.0);
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_jointq_command(&jq, &t, &cmd, NULL));
+    TEST_ASSERT_TRUE(cmd.pos < 0);
 }
 
 #if J288_CONFIG_SI
@@ -871,6 +975,55 @@ static void test_binding(void)
     TEST_ASSERT_EQUAL_INT(J288_OK, j288_jointq_bus_lock(&jb, &jq));
     sweep(&m);
     TEST_ASSERT_EQUAL_UINT8(J288_MODE_LOCK, last_frame().status);
+    /* A wrong phase: the mismatch event carries eps. */
+    c.has_phase = true;
+    c.phase = q24(m.c + 2.0);
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_jointq_init(&jq, &c));
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_jointq_bus_add(&jb, &jq)); /* again: the same joint */
+    njev = 0;
+    for (i = 0; i < 3; i++) {
+        sweep(&m);
+    }
+    TEST_ASSERT_EQUAL_INT(2, njev);
+    TEST_ASSERT_EQUAL_INT(J288_JOINT_EV_CAL_MISMATCH, jev[1].kind);
+    TEST_ASSERT_DOUBLE_WITHIN(0.2, 2.0, rad(jev[1].value));
+    /* Argument checks, and a joint whose id was overwritten is not the bound one. */
+    TEST_ASSERT_EQUAL_INT(J288_ERR_NULL, j288_jointq_bus_add(NULL, &jq));
+    TEST_ASSERT_EQUAL_INT(J288_ERR_NULL, j288_jointq_bus_set_target(NULL, &jq, &t, NULL));
+    TEST_ASSERT_EQUAL_INT(J288_ERR_NULL, j288_jointq_bus_set_target(&jb, NULL, &t, NULL));
+    TEST_ASSERT_EQUAL_INT(J288_ERR_NULL, j288_jointq_bus_lock(&jb, NULL));
+    other.cfg.id = 15u;
+    TEST_ASSERT_EQUAL_INT(J288_ERR_BAD_ARG, j288_jointq_bus_set_target(&jb, &other, &t, NULL));
+}
+
+/* The hook called directly: no callback, bad ids, a slot of another servo, an unbound id. */
+static void test_binding_hook_inputs(void)
+{
+    j288_jointq_bus_t b;
+    j288_slot_t slot;
+    j288_jointq_config_t c = cfg_for(2u);
+    model_t m = servo_at(0.5, 0.1);
+
+    fake_port_init(&fp);
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_bus_init(&bus, &fp.ops, &fp, NULL));
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_sched_init(&sch, &bus, NULL));
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_jointq_bus_init(&b, &sch, NULL, NULL));
+    c.init_samples = 1u;
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_jointq_init(&jq, &c));
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_jointq_bus_add(&b, &jq));
+    memset(&slot, 0, sizeof slot);
+    slot.reply = reply_of(&m, 2u);
+    j288_jointq_bus_on_reply(&b, 15u, &slot);     /* no such id: nothing */
+    j288_jointq_bus_on_reply(&b, 2u, NULL);       /* nothing */
+    j288_jointq_bus_on_reply(NULL, 2u, &slot);    /* nothing */
+    j288_jointq_bus_on_reply(&b, 3u, &slot);      /* no joint 3: nothing */
+    TEST_ASSERT_FALSE(jq.seen);
+    slot.reply.id = 7u;
+    j288_jointq_bus_on_reply(&b, 2u, &slot);      /* another servo's reply: refused */
+    TEST_ASSERT_FALSE(jq.seen);
+    slot.reply.id = 2u;
+    j288_jointq_bus_on_reply(&b, 2u, &slot);      /* no callback: the state still moves */
+    TEST_ASSERT_TRUE(j288_jointq_state(&jq)->known);
 }
 
 int main(void)
@@ -885,11 +1038,13 @@ int main(void)
     RUN_TEST(test_calibrated_random);
     RUN_TEST(test_range_across_the_wrap_and_turns);
     RUN_TEST(test_power_cycle_and_encoder_fault);
+    RUN_TEST(test_edges_of_the_start);
     RUN_TEST(test_limits_refused_and_clamped);
     RUN_TEST(test_large_rotor_positions);
 #if J288_CONFIG_SI
     RUN_TEST(test_side_by_side_with_float);
 #endif
     RUN_TEST(test_binding);
+    RUN_TEST(test_binding_hook_inputs);
     return UNITY_END();
 }
