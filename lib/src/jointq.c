@@ -10,7 +10,8 @@
 #include "internal.h"
 
 /* ---- constants. Each is the exact value rounded to an integer (pi taken to 60 digits, the
- * gear ratio N = 5767 / 20 exactly); test_jointq checks them against double. */
+ * gear ratio N = 5767 / 20 exactly); test_jointq pins them through the generator's golden
+ * vectors and every reply field's input against double. */
 #define PI_Q J288_JOINTQ_PI          /* pi * 2^24 */
 #define TWO_PI_Q J288_JOINTQ_TWO_PI  /* 2 pi * 2^24 */
 #define FORTY_PI_Q 2108287141        /* 40 pi * 2^24: N * 40 pi is 5767 turns of the rotor */
@@ -48,10 +49,11 @@
 /* u modulo 2^32 as an int32, without an implementation-defined conversion. */
 static int32_t jq_as_i32(uint32_t u)
 {
+    uint32_t below;
     if (u <= (uint32_t)INT32_MAX) {
         return (int32_t)u;
     }
-    uint32_t below = u - 0x80000000u; /* u - 2^32 = below - 2^31, without overflow */
+    below = u - 0x80000000u; /* u - 2^32 = below - 2^31, without overflow */
     return (int32_t)below - INT32_MAX - 1;
 }
 

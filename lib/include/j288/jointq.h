@@ -1,10 +1,11 @@
 /*
  * j288/jointq.h - the joint layer in fixed point, for cores without an FPU (Cortex-M0/M0+,
  * RV32IMAC): the model, the start, the tracking, the limits, the events and the binding of
- * j288/joint.h, in integers only. No floating-point operation, no soft-float library; the
- * 64-bit integer multiply (and, at a start only, a 64-bit division) of the C library's
- * helpers. Compiled with J288_CONFIG_JOINT_FIXED (config.h, default 1), independently of
- * J288_CONFIG_SI: an FPU-less build sets J288_CONFIG_SI=0 and has no floating point at all.
+ * j288/joint.h, in integers only. No floating-point operation, no soft-float library: 32 x 32
+ * -> 64-bit products (inline on Cortex-M0) and, at a start only, 32-bit divisions (the C
+ * library's helper where the core has no divide). Compiled with J288_CONFIG_JOINT_FIXED
+ * (config.h, default 1), independently of J288_CONFIG_SI: an FPU-less build sets
+ * J288_CONFIG_SI=0 and has no floating point at all.
  *
  * Numbers. Angles are j288_q24_t: rad * 2^24 in an int32 (step 60 nrad, range +-128 rad).
  * Speeds, torques and gains are j288_q16_t: the SI value * 2^16 in an int32 (rad/s, N*m,
@@ -14,22 +15,22 @@
  *
  * The contract is j288/joint.h's, function for function (j288_jointq_* for j288_joint_*),
  * with these differences (docs/joint.md, "Fixed point"):
- * - Resolution: the state's angles to within 1 Q24 step (60 nrad) of the exact value of
- *   the model, speed and torque to within 1 Q16 step; the rotor's 0.66 urad and the output
- *   encoder's 0.77 mrad are far coarser.
+ * - Resolution: the state's angles to within 1 urad of the float layer's in double (the Q24
+ *   roundings and the rounded 2 pi of the wraps; 74 nrad measured), speed and torque to
+ *   within 1 Q16 step; the rotor's 0.66 urad and the output encoder's 0.77 mrad are coarser.
  * - Range: the joint angle is kept within +-J288_JOINTQ_MAX_POS (120 rad, 19 output turns);
  *   beyond, the state's angle saturates there (a joint that far beyond its +-64 rad
  *   configuration then fails the tracking check and is lost, unless its encoder has a fault).
  * - Commands round the exact value of the Q16/Q24 target half away from zero, as the float
  *   path does: exactly for torque and gains (rational factors); for speed and position (their
- *   factors contain pi) to within 1e-5 LSB of the exact value, i.e. a value that close to a
+ *   factors contain pi) to within 2^-15 LSB of the exact value, i.e. a value that close to a
  *   half may round either way.
  * - No NaN: J288_ERR_NOT_FINITE is never returned. The calibration fit (j288_cal_*) stays in
  *   floating point, on a host: the phase it gives is configured here as J288_Q24(c).
  *
  * Objects are caller-allocated; nothing is allocated, no global state; calling context as
- * j288/joint.h (one context per joint and binding; the functions take no lock). Conversion
- * functions (j288_cmd_from_q*, j288_reply_to_q) are pure: ISR-safe, reentrant.
+ * j288/joint.h (one context per joint and binding; the functions take no lock). The
+ * conversions (j288_cmd_from_q*, j288_*_to_q) are pure: ISR-safe, reentrant.
  */
 #ifndef J288_JOINTQ_H
 #define J288_JOINTQ_H
@@ -138,7 +139,7 @@ void j288_jointq_target_init(const j288_jointq_t *j, j288_jointq_target_t *t);
 
 /* As j288_joint_command(), without NaN: J288_ERR_NULL; J288_ERR_ANGLE_UNKNOWN or
  * J288_ERR_CAL_MISMATCH; J288_ERR_LIMIT_POS / _SPEED / _TORQUE (refuse mode); then as
- * j288_cmd_from_q() in field order (J288_ERR_RANGE_TAU, _SPEED, _POS, J288_ERR_NEG_GAIN or
+ * j288_cmd_from_q() in field order (J288_ERR_RANGE_TAU, _SPEED, J288_ERR_NEG_GAIN or
  * J288_ERR_RANGE_KP, then KD; clamp mode saturates those); J288_ERR_RANGE_POS when the rotor
  * target would leave the int32 wire range (never clamped). cmd untouched on an error. */
 int j288_jointq_command(const j288_jointq_t *j, const j288_jointq_target_t *t,
@@ -166,7 +167,8 @@ typedef struct {
 
 /* Output side -> raw command, rounding half away from zero (see the top of this file).
  * Errors, first failing field in frame order, raw untouched: J288_ERR_NULL,
- * J288_ERR_RANGE_TAU, _SPEED, _POS, J288_ERR_NEG_GAIN, J288_ERR_RANGE_KP, _KD. */
+ * J288_ERR_RANGE_TAU, _SPEED, J288_ERR_NEG_GAIN, J288_ERR_RANGE_KP, _KD (a Q24 position,
+ * +-128 rad, is always within the wire's int32). */
 int j288_cmd_from_q(const j288_cmd_q_t *q, j288_cmd_raw_t *raw);
 
 /* As j288_cmd_from_q(), saturating instead (J288_FIELD_* bits into *clamped, may be NULL):
