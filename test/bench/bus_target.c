@@ -551,6 +551,57 @@ static uint32_t run_joint_command(void)
 }
 #endif
 
+#if J288_CONFIG_JOINT_FIXED
+/* ---- the fixed-point joint layer (j288/jointq.h), the same work as the rows above. */
+static j288_jointq_t jointq;
+static uint32_t jointq_errors;
+
+static uint32_t run_jointq_reply(void)
+{
+    j288_jointq_config_t jc;
+    j288_reply_raw_t r;
+    uint32_t i, t0, t1;
+    memset(&jc, 0, sizeof jc);
+    memset(&r, 0, sizeof r);
+    jc.id = 3u;
+    r.id = 3u;
+    r.pos = 5000;
+    r.out_pos = 100u;
+    r.speed = 100;
+    r.torque = 10;
+    (void)j288_jointq_init(&jointq, &jc);
+    for (i = 0u; i < J288_JOINT_DEFAULT_INIT_SAMPLES; i++) {
+        (void)j288_jointq_take_reply(&jointq, &r, NULL);
+    }
+    t0 = icount_now();
+    for (i = 0u; i < ITERATIONS; i++) {
+        unsigned ev;
+        r.pos = 5000 + (int32_t)(i & 7u);
+        jointq_errors += (uint32_t)(j288_jointq_take_reply(&jointq, &r, &ev) != J288_OK);
+    }
+    t1 = icount_now();
+    jointq_errors += (uint32_t)!j288_jointq_state(&jointq)->known;
+    return icount_between(t0, t1);
+}
+
+static uint32_t run_jointq_command(void)
+{
+    j288_jointq_target_t t;
+    j288_cmd_raw_t cmd;
+    uint32_t i, t0, t1;
+    j288_jointq_target_init(&jointq, &t);
+    t.kp = J288_Q16(20.0);
+    t.kd = J288_Q16(0.5);
+    t0 = icount_now();
+    for (i = 0u; i < ITERATIONS; i++) {
+        t.pos = (j288_q24_t)(i & 7u) * J288_Q24(0.01);
+        jointq_errors += (uint32_t)(j288_jointq_command(&jointq, &t, &cmd, NULL) != J288_OK);
+    }
+    t1 = icount_now();
+    return icount_between(t0, t1);
+}
+#endif
+
 static const char *backend_name(void)
 {
 #if J288_CONFIG_CRC_BACKEND == J288_CRC_BACKEND_SLICE4
@@ -640,6 +691,15 @@ int main(void)
     row("joint: target -> command", 0u, per_txn(RUN_ROW(32u, run_joint_command()), ipt));
     if (joint_errors != 0u) {
         printf("bus_target: the joint layer failed (%lu)\n", (unsigned long)joint_errors);
+        return 1;
+    }
+#endif
+#if J288_CONFIG_JOINT_FIXED
+    row("joint (fixed): reply -> state", 0u, per_txn(RUN_ROW(32u, run_jointq_reply()), ipt));
+    row("joint (fixed): target -> command", 0u, per_txn(RUN_ROW(32u, run_jointq_command()), ipt));
+    if (jointq_errors != 0u) {
+        printf("bus_target: the fixed-point joint layer failed (%lu)\n",
+               (unsigned long)jointq_errors);
         return 1;
     }
 #endif

@@ -11,13 +11,16 @@ scheduler's completion callback; the application's own callbacks (clock, complet
 come on top. Recursion: the library has none. The one cycle in the static graph is the bus's
 step loop entered again from inside a port call, which returns at once (in_advance), so it
 counts with its own frame. Any other cycle is reported as an ERROR and make size fails.
+Soft float: the floating-point helpers (__aeabi_d*, __aeabi_f*, integer <-> float) linked into
+each probe are listed; in a build without the SI API (variant name ending -nosi or -jointq)
+any of them is an ERROR.
 """
 import os
 import re
 import sys
 from collections import defaultdict
 
-MODULES = ["frame", "crc32", "parser", "bus", "sched", "units", "strerror", "abi", "j288_stm32"]
+MODULES = ["frame", "crc32", "parser", "bus", "sched", "units", "jointq", "strerror", "abi", "j288_stm32"]
 
 
 def parse_map(path):
@@ -53,6 +56,16 @@ def parse_map(path):
         elif sect.startswith((".bss", "COMMON")):
             sizes[mod][1] += size
     return sizes
+
+
+SOFT_FLOAT = re.compile(r"^\s+0x[0-9a-f]+\s+(__aeabi_(?:[df][a-z]\w*|[df]2\w+|u?[il]2[df]))\s*$")
+
+
+def soft_float_symbols(map_path):
+    """Soft-float helpers the probe links (their definitions in the map's memory map)."""
+    text = open(map_path).read()
+    text = text[text.find("Linker script and memory map"):]
+    return sorted({m.group(1) for m in map(SOFT_FLOAT.match, text.splitlines()) if m})
 
 
 def parse_ci(root):
@@ -212,11 +225,27 @@ def main(dirs):
         syms = {}
         for line in os.popen("arm-none-eabi-nm -S --size-sort '%s'" % os.path.join(d, "probe.elf")):
             parts = line.split()
-            if len(parts) == 4 and parts[3] in ("probe_port", "probe_sched", "probe_dma"):
+            if len(parts) == 4 and parts[3] in ("probe_port", "probe_sched", "probe_dma",
+                                                "probe_joints", "probe_jbus"):
                 syms[parts[3]] = int(parts[1], 16)
         print("- %s: j288_stm32_t (includes j288_bus_t) %d, j288_sched_t %d, DMA buffers %d" % (
             os.path.basename(d.rstrip("/")), syms.get("probe_port", 0), syms.get("probe_sched", 0),
-            syms.get("probe_dma", 0)))
+            syms.get("probe_dma", 0)) + (
+                ", 15 j288_jointq_t %d, j288_jointq_bus_t %d" % (syms["probe_joints"], syms.get("probe_jbus", 0))
+                if "probe_joints" in syms else ""))
+    print()
+    soft_errors = []
+    print("Soft-float helpers linked:")
+    print()
+    for d in dirs:
+        name = os.path.basename(d.rstrip("/"))
+        found = soft_float_symbols(os.path.join(d, "probe.map"))
+        print("- %s: %s" % (name, ("%d (%s)" % (len(found), ", ".join(found))) if found else "none"))
+        if found and name.endswith(("-nosi", "-jointq")):
+            soft_errors.append("ERROR: %s has no SI API but links soft float: %s" % (name, ", ".join(found)))
+    for e in soft_errors:
+        print(e)
+        print("size_report.py: " + e, file=sys.stderr)
     print()
     stacks = {}
     all_notes = set()
@@ -238,6 +267,8 @@ def main(dirs):
         print()
         for n in sorted(all_notes):
             print("note: " + n)
+    if soft_errors:
+        return 1
     if all_cycles:
         print()
         for c in sorted(all_cycles):

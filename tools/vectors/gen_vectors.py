@@ -11,7 +11,7 @@ Standard library only. Deterministic: the same output on every run and every Pyt
 
     python3 tools/vectors/gen_vectors.py [--out DIR]     (default DIR: test/vectors)
 
-writes commands.txt, replies.txt, si.txt, si_commands.txt and golden_vectors.h.
+writes commands.txt, replies.txt, si.txt, si_commands.txt, fixed.txt and golden_vectors.h.
 """
 
 import argparse
@@ -566,6 +566,128 @@ def si_command_vectors():
 
 
 # ---------------------------------------------------------------------------------------------
+# The fixed-point joint layer (j288/jointq.h): output-side commands from Q16 (torque, speed,
+# gains) and Q24 (position) integers, and a reply's speed, torque and OutPos in Q16 / Q24.
+
+Q16 = 1 << 16
+Q24 = 1 << 24
+FIXED_SCALE = {"torque": Q16, "speed": Q16, "pos": Q24, "kp": Q16, "kd": Q16}
+# Factors that contain pi: the fixed path rounds them to within 2^-15 LSB of the exact value,
+# so a vector whose exact value lies closer than this to a half is left out.
+FIXED_PI_MARGIN = Fraction(1, 10**4)
+
+
+def fixed_to_raw(q, v):
+    """(expect, raw) for one Q integer, exactly (output side)."""
+    if q in GAINS and v < 0:
+        return "J288_ERR_NEG_GAIN", 0
+    x = Fraction(v, FIXED_SCALE[q]) * lsb_per_unit(q, "output")
+    lo, hi = RANGE[q]
+    r = round_half_away(x)
+    if r < lo or r > hi:
+        return RANGE_ERR[q], 0
+    return "ok", r
+
+
+def fixed_near_half(q, v):
+    if q not in ("speed", "pos"):
+        return False  # rational factors: rounded exactly, ties included
+    x = abs(Fraction(v, FIXED_SCALE[q]) * lsb_per_unit(q, "output"))
+    return abs((x - math.floor(x)) - Fraction(1, 2)) < FIXED_PI_MARGIN
+
+
+def fixed_command_vectors():
+    rows = []
+
+    def add(name, tau, speed, pos, kp, kd):
+        vals = {"torque": tau, "speed": speed, "pos": pos, "kp": kp, "kd": kd}
+        if any(fixed_near_half(q, vals[q]) for q in QUANTITIES):
+            return
+        res = {q: fixed_to_raw(q, vals[q]) for q in QUANTITIES}
+        expect = next((res[q][0] for q in QUANTITIES if res[q][0] != "ok"), "ok")
+        raw = [res[q][1] if expect == "ok" else 0 for q in QUANTITIES]
+        mask, craw = 0, []
+        for bit, q in enumerate(QUANTITIES):
+            e, r = res[q]
+            if e != "ok":
+                mask |= 1 << bit
+                lo, hi = RANGE[q]
+                r = 0 if e == "J288_ERR_NEG_GAIN" else (lo if vals[q] < 0 else hi)
+            craw.append(r)
+        rows.append({"name": name, "q": [tau, speed, pos, kp, kd], "expect": expect,
+                     "raw": raw, "mask": mask, "craw": craw})
+
+    add("zero", 0, 0, 0, 0, 0)
+    add("hold_90deg", 0, 0, round(math.pi / 2 * Q24), 50 * Q16, 2 * Q16)
+    add("spin", 5 * Q16, round(2 * math.pi * Q16), 0, 0, 3 * Q16 // 2)
+    add("negative", -3 * Q16, -Q16, -Q24, 10 * Q16, Q16 // 2)
+    add("tau_tie", 23068, 0, 0, 0, 0)          # 312.5 LSB exactly: away from zero
+    add("tau_tie_neg", -23068, 0, 0, 0, 0)
+    add("kp_tie", 0, 0, 0, 33258289, 0)         # 7812.5 LSB exactly
+    add("tau_max", 2418780, 0, 0, 0, 0)         # 32767.4 LSB
+    add("tau_over", 2418830, 0, 0, 0, 0)        # 32768.1 LSB
+    add("tau_min", -2418830, 0, 0, 0, 0)        # -32768.1: rounds to -32768, in range
+    add("tau_under", -2418900, 0, 0, 0, 0)      # -32769.0
+    add("speed_over", 0, 20000000, 0, 0, 0)
+    add("kp_over", 0, 0, 0, 140000000, 0)
+    add("kd_over", 0, 0, 0, 0, 1400000)
+    add("neg_kp", 0, 0, 0, -1, 0)
+    add("neg_kd", 0, 0, 0, 0, -1)
+    add("pos_extremes", 0, 0, (1 << 31) - 1, 0, 0)
+    add("pos_min", 0, 0, -(1 << 31), 0, 0)
+    add("all_out", -(1 << 31), (1 << 31) - 1, -(1 << 31), (1 << 31) - 1, (1 << 31) - 1)
+    add("all_out_neg_gains", (1 << 31) - 1, -(1 << 31), 0, -(1 << 31), -5)
+    # The inputs closest to a half without being one, both sides, for the rational factors
+    # (torque and gains): x = m num / den has 2 m num = den + t (mod 2 den) for a small t.
+    for q, pos_in in (("torque", 0), ("kp", 3), ("kd", 4)):
+        f = lsb_per_unit(q, "output") / FIXED_SCALE[q]
+        num, den = f.numerator, f.denominator
+        g = math.gcd(2 * num, 2 * den)
+        lo, hi = RANGE[q]
+        for t in (-2 * g, -g, g, 2 * g):
+            if (den + t) % g:
+                continue
+            m = ((den + t) // g) * pow(2 * num // g, -1, 2 * den // g) % (2 * den // g)
+            while m * f < hi - 1:
+                vals = [0, 0, 0, 0, 0]
+                vals[pos_in] = m
+                add("%s_near_half_%+d_%d" % (q, t, m), *vals)
+                m += 2 * den // g * max(1, (hi // 3) // max(1, int((2 * den // g) * f)))
+    rng = XorShift32(0xF1CED0)
+    for i in range(60):
+        vals = []
+        for q in QUANTITIES:
+            lo, hi = RANGE[q]
+            if q == "pos":
+                vals.append(rng.signed(32))
+                continue
+            # around a random raw value, sometimes out of range
+            t = Fraction(rng.below(hi + 2000), 1) + Fraction(rng.below(1000), 1000)
+            if q not in GAINS and rng.below(2):
+                t = -t
+            if q in GAINS and rng.below(16) == 0:
+                t = -t
+            vals.append(round_half_away(t / lsb_per_unit(q, "output") * FIXED_SCALE[q]))
+        add("random_%02d" % i, *vals)
+    return rows
+
+
+def fixed_reply_vectors():
+    """Raw speed, torque, OutPos -> Q16 speed, Q16 torque, Q24 count centre (exact)."""
+    rows = []
+    rng = XorShift32(0xF1CEDB)
+    picks = [(0, 0, 0), (1, 1, 1), (-1, -1, 8191), (32767, 32767, 4095), (-32768, -32768, 4096)]
+    picks += [(rng.signed(16), rng.signed(16), rng.below(8192)) for _ in range(40)]
+    for sp, tq, op in picks:
+        speed = round_half_away(Fraction(sp) / lsb_per_unit("speed", "output") * Q16)
+        torque = round_half_away(Fraction(tq) / lsb_per_unit("torque", "output") * Q16)
+        enc = round_half_away((Fraction(op) + Fraction(1, 2)) * 2 * PI / 8192 * Q24)
+        rows.append({"speed_raw": sp, "torque_raw": tq, "out_pos": op, "speed": speed,
+                     "torque": torque, "encoder": enc})
+    return rows
+
+
+# ---------------------------------------------------------------------------------------------
 # Output.
 
 
@@ -703,16 +825,40 @@ def render(outdir):
             fmt_real(r["si"][3]), fmt_real(r["si"][4]), r["expect"], r["hex"], r["cexpect"], r["mask"], r["chex"]))
     files["si_commands.txt"] = lines
 
-    files["golden_vectors.h"] = render_header(cmds, replies, sis, froms, sicmds)
+    fxc = fixed_command_vectors()
+    fxr = fixed_reply_vectors()
+    lines = ["# j288 fixed-point joint layer conversions (j288/jointq.h); " + HEADER_NOTE,
+             "# Lines starting with cmd: cmd name tau speed pos kp kd expect raw_tau raw_speed",
+             "#   raw_pos raw_kp raw_kd clamp_mask c_tau c_speed c_pos c_kp c_kd",
+             "#   Output side. Inputs are integers: tau, speed, kp, kd in Q16 (value * 2^16),",
+             "#   pos in Q24 (rad * 2^24). expect: ok or the first failing field's error in",
+             "#   frame order; raw_*: the rounded fields (0 on error); c_*: the saturating",
+             "#   variant, clamp_mask bits tau=1 speed=2 pos=4 kp=8 kd=16. Speed and position",
+             "#   vectors whose exact value lies within 1e-4 LSB of a half are left out (their",
+             "#   factors contain pi; the C code rounds them to within 2^-15 LSB).",
+             "# Lines starting with reply: reply speed_raw torque_raw out_pos speed_q16",
+             "#   torque_q16 encoder_q24 (exact, rounded half away from zero; the encoder is",
+             "#   the centre of the OutPos count)."]
+    for r in fxc:
+        lines.append("cmd %s %s %s %s %d %s" % (
+            r["name"], " ".join(str(x) for x in r["q"]), r["expect"],
+            " ".join(str(x) for x in r["raw"]), r["mask"], " ".join(str(x) for x in r["craw"])))
+    for r in fxr:
+        lines.append("reply %d %d %d %d %d %d" % (r["speed_raw"], r["torque_raw"], r["out_pos"],
+                                                 r["speed"], r["torque"], r["encoder"]))
+    files["fixed.txt"] = lines
+
+    files["golden_vectors.h"] = render_header(cmds, replies, sis, froms, sicmds, fxc, fxr)
 
     os.makedirs(outdir, exist_ok=True)
     for name, content in files.items():
         write_text(os.path.join(outdir, name), content)
     return {k: len(v) for k, v in (("commands", cmds), ("replies", replies), ("si", sis),
-                                   ("from_raw", froms), ("si_commands", sicmds))}
+                                   ("from_raw", froms), ("si_commands", sicmds),
+                                   ("fixed commands", fxc), ("fixed replies", fxr))}
 
 
-def render_header(cmds, replies, sis, froms, sicmds):
+def render_header(cmds, replies, sis, froms, sicmds, fxc, fxr):
     q_enum = {"torque": "GOLDEN_Q_TORQUE", "speed": "GOLDEN_Q_SPEED", "pos": "GOLDEN_Q_POS",
               "kp": "GOLDEN_Q_KP", "kd": "GOLDEN_Q_KD", "out_pos": "GOLDEN_Q_OUT_POS",
               "voltage": "GOLDEN_Q_VOLTAGE"}
@@ -721,11 +867,12 @@ def render_header(cmds, replies, sis, froms, sicmds):
          " *",
          " * Golden frames and SI conversions from the independent Python generator, for unit",
          " * tests on hosts and on targets without a file system. The same vectors are in",
-         " * commands.txt, replies.txt, si.txt and si_commands.txt beside this file.",
+         " * commands.txt, replies.txt, si.txt, si_commands.txt and fixed.txt beside this file.",
          " *",
          " * Tables are static; define before including the tables you use (an unused static",
          " * table would warn): GOLDEN_WANT_COMMANDS, GOLDEN_WANT_REPLIES, GOLDEN_WANT_SI,",
-         " * GOLDEN_WANT_SI_COMMANDS, GOLDEN_WANT_NAMES. Needs j288/error.h for the codes and",
+         " * GOLDEN_WANT_SI_COMMANDS, GOLDEN_WANT_FIXED, GOLDEN_WANT_NAMES. Needs j288/error.h for",
+         " * the codes and",
          " * math.h (NAN, INFINITY) for the SI tables.",
          " */",
          "#ifndef J288_GOLDEN_VECTORS_H",
@@ -794,11 +941,29 @@ def render_header(cmds, replies, sis, froms, sicmds):
          "    uint8_t clamp_frame[20];",
          "} golden_si_cmd_t;",
          ""]
+    h += ["typedef struct {",
+          "    const char *name;",
+          "    int32_t q[5];      /* tau, speed, kp, kd in Q16; pos in Q24 */",
+          "    int expect;        /* j288_cmd_from_q() result */",
+          "    int32_t raw[5];    /* tau, speed, pos, kp, kd when expect is J288_OK */",
+          "    unsigned clamp_mask;",
+          "    int32_t craw[5];   /* j288_cmd_from_q_clamped() */",
+          "} golden_fixed_cmd_t;",
+          "",
+          "typedef struct {",
+          "    int16_t speed_raw, torque_raw;",
+          "    uint16_t out_pos;",
+          "    int32_t speed, torque; /* Q16, exact */",
+          "    int32_t encoder;       /* Q24, exact */",
+          "} golden_fixed_reply_t;",
+          ""]
     h += ["#define GOLDEN_CMD_COUNT %du" % len(cmds),
           "#define GOLDEN_REPLY_COUNT %du" % len(replies),
           "#define GOLDEN_SI_COUNT %du" % len(sis),
           "#define GOLDEN_FROM_RAW_COUNT %du" % len(froms),
           "#define GOLDEN_SI_CMD_COUNT %du" % len(sicmds),
+          "#define GOLDEN_FIXED_CMD_COUNT %du" % len(fxc),
+          "#define GOLDEN_FIXED_REPLY_COUNT %du" % len(fxr),
           "#define GOLDEN_FAULT_NAME_COUNT %du" % len(FAULT_NAMES),
           ""]
     h += ["#ifdef GOLDEN_WANT_COMMANDS",
@@ -845,6 +1010,22 @@ def render_header(cmds, replies, sis, froms, sicmds):
                      r["name"], side_enum[r["side"]], r["id"], r["status"], r["wd"],
                      *[c_real(x) for x in r["si"]], c_err(r["expect"]), c_bytes(frame),
                      c_err(r["cexpect"]), r["mask"], c_bytes(cframe)))
+    h += ["};", "#endif", ""]
+    def c_i32(x):
+        return str(x) if x != INT32[0] else "INT32_MIN"
+
+    h += ["#ifdef GOLDEN_WANT_FIXED",
+          "static const golden_fixed_cmd_t golden_fixed_cmds[GOLDEN_FIXED_CMD_COUNT] = {"]
+    for r in fxc:
+        h.append("    {\"%s\", {%s}, %s,\n     {%s}, %du, {%s}}," % (
+            r["name"], ", ".join(c_i32(x) for x in r["q"]), c_err(r["expect"]),
+            ", ".join(c_i32(x) for x in r["raw"]), r["mask"],
+            ", ".join(c_i32(x) for x in r["craw"])))
+    h += ["};", "",
+          "static const golden_fixed_reply_t golden_fixed_replies[GOLDEN_FIXED_REPLY_COUNT] = {"]
+    for r in fxr:
+        h.append("    {%d, %d, %du, %d, %d, %d}," % (r["speed_raw"], r["torque_raw"], r["out_pos"],
+                                                    r["speed"], r["torque"], r["encoder"]))
     h += ["};", "#endif", ""]
     h += ["#ifdef GOLDEN_WANT_NAMES",
           "static const char *const golden_fault_names[GOLDEN_FAULT_NAME_COUNT] = {"]

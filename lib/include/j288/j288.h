@@ -14,6 +14,7 @@
 #include "j288/bus.h"
 #include "j288/sched.h"
 #include "j288/joint.h"
+#include "j288/jointq.h"
 
 #define J288_VERSION_MAJOR 0
 #define J288_VERSION_MINOR 1

@@ -65,7 +65,8 @@
  * every function on a joint, a binding or a calibration is for one context at a time. With
  * a binding, that is the context that advances the bus: the thread that polls, or with
  * advance_in_isr the bus's interrupt (e.g. set targets from the scheduler's on_sweep). The
- * functions take no lock. Compiled only with J288_CONFIG_SI.
+ * functions take no lock. Compiled only with J288_CONFIG_SI (but the event kinds, which the
+ * fixed-point layer of j288/jointq.h shares).
  */
 #ifndef J288_JOINT_H
 #define J288_JOINT_H
@@ -78,13 +79,32 @@
 #include "j288/sched.h"
 #include "j288/units.h"
 
+/* Events, reported by j288_joint_take_reply() (and j288_jointq_take_reply(), j288/jointq.h)
+ * as bits (1u << kind), in this order. Outside J288_CONFIG_SI: the fixed-point layer has them
+ * too. */
+typedef enum {
+    J288_JOINT_EV_ENCODER_FAULT = 0, /* fault bit 12 set: the output encoder is not used */
+    J288_JOINT_EV_ENCODER_OK,        /* fault bit 12 cleared */
+    J288_JOINT_EV_ANGLE_UNKNOWN,     /* first reply since init/reset: the angle is not yet known */
+    J288_JOINT_EV_ANGLE_LOST,        /* rotor and encoder disagree (value: the residual, rad):
+                                        unknown again, lock, the start begins anew */
+    J288_JOINT_EV_CAL_MISMATCH,      /* a calibrated start failed (value: eps, rotor rad);
+                                        reported once until a start succeeds */
+    J288_JOINT_EV_ANGLE_KNOWN,       /* the start is done (value: the joint angle) */
+    J288_JOINT_EV_LIMIT_REACHED,     /* the angle went outside [pos_min, pos_max] (value: it) */
+    J288_JOINT_EV_LIMIT_LEFT         /* back inside by J288_JOINT_LIMIT_HYST (value: it) */
+} j288_joint_event_kind_t;
+
+#define J288_JOINT_EV_BIT(kind) (1u << (unsigned)(kind))
+#define J288_JOINT_EV_COUNT 8u
+#define J288_JOINT_DEFAULT_INIT_SAMPLES 8u /* replies averaged at the start */
+
 #if J288_CONFIG_SI
 
 #ifdef __cplusplus
 extern "C" {
 #endif
 
-#define J288_JOINT_DEFAULT_INIT_SAMPLES 8u /* replies averaged at the start */
 #define J288_JOINT_DEFAULT_TRACK_TOL 0.010 /* rad of output: 13 OutPos counts */
 #define J288_JOINT_DEFAULT_CAL_TOL 1.0     /* rad of rotor: 3.5 mrad of output */
 #define J288_JOINT_LIMIT_HYST 0.001        /* rad: inside the range by this to leave a limit */
@@ -134,23 +154,6 @@ typedef struct {
     j288_real_t kp;     /* N*m/rad, joint frame, >= 0 */
     j288_real_t kd;     /* N*m*s/rad, joint frame, >= 0 */
 } j288_joint_target_t;
-
-/* Events, reported by j288_joint_take_reply() as bits (1u << kind), in this order. */
-typedef enum {
-    J288_JOINT_EV_ENCODER_FAULT = 0, /* fault bit 12 set: the output encoder is not used */
-    J288_JOINT_EV_ENCODER_OK,        /* fault bit 12 cleared */
-    J288_JOINT_EV_ANGLE_UNKNOWN,     /* first reply since init/reset: the angle is not yet known */
-    J288_JOINT_EV_ANGLE_LOST,        /* rotor and encoder disagree (value: the residual, rad):
-                                        unknown again, lock, the start begins anew */
-    J288_JOINT_EV_CAL_MISMATCH,      /* a calibrated start failed (value: eps, rotor rad);
-                                        reported once until a start succeeds */
-    J288_JOINT_EV_ANGLE_KNOWN,       /* the start is done (value: the joint angle) */
-    J288_JOINT_EV_LIMIT_REACHED,     /* the angle went outside [pos_min, pos_max] (value: it) */
-    J288_JOINT_EV_LIMIT_LEFT         /* back inside by J288_JOINT_LIMIT_HYST (value: it) */
-} j288_joint_event_kind_t;
-
-#define J288_JOINT_EV_BIT(kind) (1u << (unsigned)(kind))
-#define J288_JOINT_EV_COUNT 8u
 
 typedef struct {
     /* Private: read with j288_joint_state(). */

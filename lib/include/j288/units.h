@@ -20,6 +20,14 @@
 #include "j288/config.h"
 #include "j288/frame.h"
 
+/* Bits reported by j288_cmd_from_si_clamped() (and the fixed-point j288/jointq.h, which has
+ * them without J288_CONFIG_SI). */
+#define J288_FIELD_TAU 0x01u
+#define J288_FIELD_SPEED 0x02u
+#define J288_FIELD_POS 0x04u
+#define J288_FIELD_KP 0x08u
+#define J288_FIELD_KD 0x10u
+
 #if J288_CONFIG_SI
 
 #ifdef __cplusplus
@@ -45,13 +53,6 @@ typedef double j288_real_t;
 #define J288_SCALE_VOLTAGE 0.5                         /* V per LSB     */
 
 typedef enum { J288_SIDE_ROTOR = 0, J288_SIDE_OUTPUT = 1 } j288_side_t;
-
-/* Bits reported by j288_cmd_from_si_clamped(). */
-#define J288_FIELD_TAU 0x01u
-#define J288_FIELD_SPEED 0x02u
-#define J288_FIELD_POS 0x04u
-#define J288_FIELD_KP 0x08u
-#define J288_FIELD_KD 0x10u
 
 typedef struct {
     uint8_t id;       /* as j288_cmd_raw_t */
