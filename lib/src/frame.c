@@ -64,12 +64,18 @@ static uint32_t pair16(int16_t lo, int16_t hi)
 static J288_INLINE_HOT void cmd_pack(const j288_cmd_raw_t *cmd, uint8_t out[J288_CMD_LEN],
                                      const j288_crc_t *crc)
 {
-    j288_store_le32(&out[0], CMD_HEAD16 |
-                                 ((uint32_t)mode_pack(cmd->id, cmd->status, cmd->watchdog) << 16));
-    j288_store_le32(&out[CMD_TAU], pair16(cmd->tau, cmd->speed));
-    j288_store_le32(&out[CMD_POS], from_i32(cmd->pos));
-    j288_store_le32(&out[CMD_KP], pair16(cmd->kp, cmd->kd));
-    j288_store_le32(&out[CMD_CRC], j288_crc_frame_hot(crc, out, CMD_CRC_WORDS));
+    uint32_t w[CMD_CRC_WORDS];
+    w[0] = CMD_HEAD16 | ((uint32_t)mode_pack(cmd->id, cmd->status, cmd->watchdog) << 16);
+    w[1] = pair16(cmd->tau, cmd->speed);
+    w[2] = from_i32(cmd->pos);
+    w[3] = pair16(cmd->kp, cmd->kd);
+    j288_store_le32(&out[0], w[0]);
+    j288_store_le32(&out[CMD_TAU], w[1]);
+    j288_store_le32(&out[CMD_POS], w[2]);
+    j288_store_le32(&out[CMD_KP], w[3]);
+    /* The CRC from the words as computed: on cores without unaligned loads, reading them back
+     * from out would cost four byte loads a word. */
+    j288_store_le32(&out[CMD_CRC], j288_crc_frame_words(crc, out, w, CMD_CRC_WORDS));
 }
 
 void j288_cmd_pack(const j288_cmd_raw_t *cmd, uint8_t out[J288_CMD_LEN], const j288_crc_t *crc)
@@ -170,6 +176,34 @@ int j288_reply_encode(const j288_reply_raw_t *reply, uint8_t out[J288_REPLY_LEN]
     return J288_OK;
 }
 
+/* The sign of a byte, as as_i16() does it for 16 bits. */
+static int8_t as_i8(uint8_t u)
+{
+    return (int8_t)((u < 0x80u) ? (int)u : (int)u - 256);
+}
+
+/* Word i of w is the reply's bytes 4i+2 .. 4i+5 (little-endian): mode, case temperature,
+ * winding temperature, voltage; torque, speed; position; faults; output position and
+ * warnings, reserved. */
+void j288_reply_unpack_words(const uint32_t w[5], j288_reply_raw_t *reply)
+{
+    uint8_t mode = (uint8_t)(w[0] & 0xFFu);
+    uint16_t out = (uint16_t)(w[4] & 0xFFFFu);
+    reply->id = mode_id(mode);
+    reply->status = mode_status(mode);
+    reply->watchdog_tripped = mode_timeout(mode);
+    reply->case_temp_c = as_i8((uint8_t)((w[0] >> 8) & 0xFFu));
+    reply->winding_temp_c = (uint8_t)((w[0] >> 16) & 0xFFu);
+    reply->voltage_raw = (uint8_t)(w[0] >> 24);
+    reply->torque = as_i16((uint16_t)(w[1] & 0xFFFFu));
+    reply->speed = as_i16((uint16_t)(w[1] >> 16));
+    reply->pos = as_i32(w[2]);
+    reply->faults = w[3];
+    reply->out_pos = (uint16_t)(out & OUT_POS_MASK);
+    reply->warnings = (uint8_t)(out >> EXFLAG_SHIFT);
+    reply->reserved = (uint16_t)(w[4] >> 16);
+}
+
 void j288_reply_unpack(const uint8_t in[J288_REPLY_LEN], j288_reply_raw_t *reply)
 {
     uint8_t mode = in[RPL_MODE];
@@ -177,8 +211,7 @@ void j288_reply_unpack(const uint8_t in[J288_REPLY_LEN], j288_reply_raw_t *reply
     reply->id = mode_id(mode);
     reply->status = mode_status(mode);
     reply->watchdog_tripped = mode_timeout(mode);
-    reply->case_temp_c = (int8_t)((in[RPL_TEMP] < 0x80u) ? (int)in[RPL_TEMP]
-                                                         : (int)in[RPL_TEMP] - 256);
+    reply->case_temp_c = as_i8(in[RPL_TEMP]);
     reply->winding_temp_c = in[RPL_SENSOR];
     reply->voltage_raw = in[RPL_VOL];
     reply->torque = as_i16(j288_get_u16le(&in[RPL_TORQUE]));

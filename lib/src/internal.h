@@ -61,6 +61,27 @@ static inline void j288_store_le32(uint8_t *p, uint32_t v)
 #endif
 }
 
+/* The same for a load: one word load there, inlined even at -Os (where gcc calls the
+ * header's j288_get_u32le() out of line once it has several callers). */
+static J288_INLINE_HOT uint32_t j288_load_le32(const uint8_t *p)
+{
+#if J288_STORE32_AS_WORD
+    uint32_t v;
+    /* cppcheck-suppress misra-c2012-21.15 ; the bytes of a word from a byte buffer, see above */
+    (void)memcpy(&v, p, sizeof v);
+    return v;
+#else
+    return j288_get_u32le(p);
+#endif
+}
+
+#if defined(__BYTE_ORDER__) && defined(__ORDER_LITTLE_ENDIAN__) &&                            \
+    (__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__)
+#define J288_LITTLE_ENDIAN 1
+#else
+#define J288_LITTLE_ENDIAN 0
+#endif
+
 /* Copy a whole frame (J288_CMD_LEN or J288_REPLY_LEN bytes, n a constant at every call).
  * Where the core loads unaligned words, memcpy, which the compiler turns into a few word
  * moves; elsewhere (Cortex-M0, RV32) memcpy is a library call that copies a byte at a time in
@@ -123,20 +144,31 @@ extern const uint32_t j288_crc_slice3[256];
 
 /* One little-endian word into the register, MSB first: XOR it in, then shift the 32 bits out,
  * a byte at a time through T0, or all four bytes at once through T3..T0 (slicing by 4). */
-static inline uint32_t j288_crc_table_word(uint32_t crc, const uint8_t *p)
+static inline uint32_t j288_crc_table_w(uint32_t crc, uint32_t word)
 {
-    uint32_t c = crc ^ j288_get_u32le(p);
+    uint32_t c = crc ^ word;
     c = (c << 8) ^ j288_crc_table256[c >> 24];
     c = (c << 8) ^ j288_crc_table256[c >> 24];
     c = (c << 8) ^ j288_crc_table256[c >> 24];
     return (c << 8) ^ j288_crc_table256[c >> 24];
 }
 
-static inline uint32_t j288_crc_slice4_word(uint32_t crc, const uint8_t *p)
+static inline uint32_t j288_crc_slice4_w(uint32_t crc, uint32_t word)
 {
-    uint32_t c = crc ^ j288_get_u32le(p);
+    uint32_t c = crc ^ word;
     return j288_crc_slice3[c >> 24] ^ j288_crc_slice2[(c >> 16) & 0xFFu] ^
            j288_crc_slice1[(c >> 8) & 0xFFu] ^ j288_crc_table256[c & 0xFFu];
+}
+
+/* The same, the word read from bytes (p: any alignment). */
+static inline uint32_t j288_crc_table_word(uint32_t crc, const uint8_t *p)
+{
+    return j288_crc_table_w(crc, j288_get_u32le(p));
+}
+
+static inline uint32_t j288_crc_slice4_word(uint32_t crc, const uint8_t *p)
+{
+    return j288_crc_slice4_w(crc, j288_get_u32le(p));
 }
 
 /* One word of the default table backend. */
@@ -149,6 +181,19 @@ static inline uint32_t j288_crc_frame_word(uint32_t crc, const uint8_t *p)
 static inline uint32_t j288_crc_frame_word(uint32_t crc, const uint8_t *p)
 {
     return j288_crc_slice4_word(crc, p);
+}
+#endif
+
+/* One word as a value into the default table backend. */
+#if J288_CONFIG_CRC_BACKEND == J288_CRC_BACKEND_TABLE
+static inline uint32_t j288_crc_frame_w(uint32_t crc, uint32_t word)
+{
+    return j288_crc_table_w(crc, word);
+}
+#elif J288_CONFIG_CRC_BACKEND == J288_CRC_BACKEND_SLICE4
+static inline uint32_t j288_crc_frame_w(uint32_t crc, uint32_t word)
+{
+    return j288_crc_slice4_w(crc, word);
 }
 #endif
 
@@ -188,6 +233,71 @@ static inline uint32_t j288_crc_frame_hot(const j288_crc_t *crc, const uint8_t *
     return j288_crc_frame_unrolled(data, nwords);
 }
 
+/* Bytes the compiler knows to be word-aligned (the union's other member), filled a word at a
+ * time with j288_le_word_set(): little-endian whatever the core. */
+/* cppcheck-suppress misra-c2012-19.2 ; C99's only way to align a byte buffer (docs/misra.md) */
+typedef union {
+    uint32_t w[5];
+    uint8_t b[20];
+} j288_le_words_t; /* cppcheck-suppress misra-c2012-19.2 ; see above */
+
+/* cppcheck-suppress misra-c2012-19.2 ; the union above */
+static inline void j288_le_word_set(j288_le_words_t *u, size_t i, uint32_t v)
+{
+#if J288_LITTLE_ENDIAN
+    u->w[i] = v;
+#else
+    j288_put_u32le(&u->b[4u * i], v);
+#endif
+}
+
+/* A frame's CRC in the hot path from its CRC'd words (nwords 4 or 5, a constant at every
+ * call) already read: w holds them as values (word i: bytes 4i..4i+3 little-endian), bytes
+ * the same words as bytes (any alignment), for a run-time engine. The table backends fold
+ * the values (no byte is read again). The CRC unit's function reads bytes: where the core
+ * loads unaligned words, bytes as they are; elsewhere an aligned copy of the words, which an
+ * inlined function loads as whole words (and where the compiler sees through the copy, it
+ * writes the values as they are) instead of four byte loads a word. */
+static J288_INLINE_HOT uint32_t j288_crc_frame_words(const j288_crc_t *crc, const uint8_t *bytes,
+                                                     const uint32_t *w, size_t nwords)
+{
+    if ((crc != NULL) && (crc->fn != NULL)) {
+        return crc->fn(crc->ctx, bytes, nwords);
+    }
+    {
+        /* Straight-line code (gcc -O2 keeps a loop over w, and w on the stack). */
+#if (J288_CONFIG_CRC_BACKEND == J288_CRC_BACKEND_TABLE) ||                                   \
+    (J288_CONFIG_CRC_BACKEND == J288_CRC_BACKEND_SLICE4)
+        uint32_t c = j288_crc_frame_w(J288_CRC32_INIT, w[0]);
+        c = j288_crc_frame_w(c, w[1]);
+        c = j288_crc_frame_w(c, w[2]);
+        c = j288_crc_frame_w(c, w[3]);
+        if (nwords > 4u) {
+            c = j288_crc_frame_w(c, w[4]);
+        }
+        return c;
+#elif (J288_CONFIG_CRC_BACKEND == J288_CRC_BACKEND_HW) && J288_STORE32_AS_WORD
+        /* The core loads unaligned words: the bytes as they are (a copy would cost a function
+         * that is called, not inlined, five stores). */
+        (void)w;
+        return J288_CONFIG_CRC_HW_FUNCTION(bytes, nwords);
+#elif J288_CONFIG_CRC_BACKEND == J288_CRC_BACKEND_HW
+        j288_le_words_t le;
+        j288_le_word_set(&le, 0u, w[0]);
+        j288_le_word_set(&le, 1u, w[1]);
+        j288_le_word_set(&le, 2u, w[2]);
+        j288_le_word_set(&le, 3u, w[3]);
+        if (nwords > 4u) {
+            j288_le_word_set(&le, 4u, w[4]);
+        }
+        return J288_CONFIG_CRC_HW_FUNCTION(le.b, nwords);
+#else
+        (void)w;
+        return j288_crc_default(bytes, nwords);
+#endif
+    }
+}
+
 /* A frame's CRC (nwords at least 4): the run-time engine crc if it has one, else the default
  * backend. j288_crc32_run() for the frame paths. */
 static inline uint32_t j288_crc_frame(const j288_crc_t *crc, const uint8_t *data, size_t nwords)
@@ -216,6 +326,10 @@ static J288_INLINE_HOT bool j288_cmd_crc_ok(const j288_crc_t *crc, const uint8_t
 {
     return j288_crc_frame_hot(crc, f, 4u) == j288_get_u32le(&f[16]);
 }
+
+/* j288_reply_unpack() from the reply's words 1-5 as values (word i: bytes 4i+2 .. 4i+5,
+ * little-endian), e.g. read aligned from the parser's buffer. */
+void j288_reply_unpack_words(const uint32_t w[5], j288_reply_raw_t *reply);
 
 /* ---- commands */
 

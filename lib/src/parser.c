@@ -5,6 +5,21 @@
 
 #include "internal.h"
 
+/* The frame held: from the second byte of the word-aligned store (parser.h). */
+static uint8_t *buf(j288_parser_t *p)
+{
+    return &p->held.bytes[2];
+}
+
+#if J288_STORE32_AS_WORD
+/* Word i of the store (the frame's bytes 4i-2 .. 4i+1): one aligned store, little-endian as
+ * the core (J288_STORE32_AS_WORD holds only on little-endian cores). */
+static void hold_word(j288_parser_t *p, size_t i, uint32_t v)
+{
+    p->held.words[i] = v;
+}
+#endif
+
 int j288_parser_init(j288_parser_t *p, j288_parse_kind_t kind, const j288_crc_t *crc)
 {
     if (p == NULL) {
@@ -48,14 +63,14 @@ static void resync(j288_parser_t *p)
 {
     uint8_t i;
     for (i = 1u; i < p->len; i++) {
-        if ((p->buf[i] == p->head0) &&
-            (((i + 1u) == p->len) || (p->buf[i + 1u] == J288_REPLY_HEAD1))) {
+        if ((buf(p)[i] == p->head0) &&
+            (((i + 1u) == p->len) || (buf(p)[i + 1u] == J288_REPLY_HEAD1))) {
             break;
         }
     }
     p->stats.dropped_bytes += i;
     p->len = (uint8_t)(p->len - i);
-    (void)memmove(p->buf, &p->buf[i], p->len);
+    (void)memmove(buf(p), &buf(p)[i], p->len);
 }
 
 /* A whole frame held in buf failed its CRC: count it and resynchronise inside it. */
@@ -69,7 +84,7 @@ static void drop_frame(j288_parser_t *p)
  * line, so that the byte path's per-byte work stays short. */
 J288_NOINLINE static bool collected(j288_parser_t *p)
 {
-    if (frame_crc_ok(p, p->buf)) {
+    if (frame_crc_ok(p, buf(p))) {
         p->stats.frames++;
         p->len = 0u;
         return true;
@@ -83,7 +98,7 @@ static bool take_byte(j288_parser_t *p, uint8_t b)
 {
     if (p->len == 0u) {
         if (b == p->head0) {
-            p->buf[0] = b;
+            buf(p)[0] = b;
             p->len = 1u;
         } else {
             p->stats.garbage_bytes++;
@@ -99,7 +114,7 @@ static bool take_byte(j288_parser_t *p, uint8_t b)
         }
         return false;
     }
-    p->buf[p->len] = b;
+    buf(p)[p->len] = b;
     p->len++;
     return (p->len == p->frame_len) && collected(p);
 }
@@ -110,7 +125,7 @@ static bool take_byte(j288_parser_t *p, uint8_t b)
 /* A whole frame at f failed its CRC: into buf, dropped as the byte path drops it. */
 static void drop_whole(j288_parser_t *p, const uint8_t *f)
 {
-    (void)memcpy(p->buf, f, p->frame_len);
+    (void)memcpy(buf(p), f, p->frame_len);
     p->len = p->frame_len;
     drop_frame(p);
 }
@@ -154,7 +169,7 @@ J288_NOINLINE static size_t scan_bytes(j288_parser_t *p, const uint8_t *data, si
         }
         i++;
         if (take_byte(p, *f)) {
-            *frame = p->buf;
+            *frame = buf(p);
             return i;
         }
     }
@@ -194,7 +209,7 @@ static J288_INLINE_HOT int scan(j288_parser_t *p, const uint8_t *data, size_t le
         from++;
         if (take_byte(p, data[from - 1u])) {
             *consumed = from;
-            *frame = p->buf;
+            *frame = buf(p);
             return J288_PARSE_FRAME;
         }
     }
@@ -222,6 +237,48 @@ static bool reply_at_start(const j288_parser_t *p, const uint8_t *data, size_t l
            (j288_get_u16le(data) == J288_REPLY_HEAD16);
 }
 
+/* A whole reply at the start of data (reply_at_start()), into buf, and its CRC checked
+ * against its field there. Returns whether it is good; buf holds the reply either way (a bad
+ * one is dropped from there). Each word of the reply is read from data once: where the core
+ * loads unaligned words, as a word that is folded into the CRC and stored in buf (aligned);
+ * elsewhere (Cortex-M0, RV32) the bytes are moved into buf, where the words are then loaded
+ * aligned (fewer values live at once than assembling each word from four bytes). */
+static J288_INLINE_HOT bool take_reply_words(j288_parser_t *p, const uint8_t *data)
+{
+#if J288_STORE32_AS_WORD
+    uint32_t w[5];
+    uint32_t field = j288_load_le32(&data[22]);
+    w[0] = j288_load_le32(&data[2]);
+    w[1] = j288_load_le32(&data[6]);
+    w[2] = j288_load_le32(&data[10]);
+    w[3] = j288_load_le32(&data[14]);
+    w[4] = j288_load_le32(&data[18]);
+    p->held.bytes[2] = J288_REPLY_HEAD0;
+    p->held.bytes[3] = J288_REPLY_HEAD1;
+    hold_word(p, 1u, w[0]);
+    hold_word(p, 2u, w[1]);
+    hold_word(p, 3u, w[2]);
+    hold_word(p, 4u, w[3]);
+    hold_word(p, 5u, w[4]);
+    hold_word(p, 6u, field);
+    return j288_crc_frame_words(p->crc, &buf(p)[2], w, 5u) == field;
+#elif J288_LITTLE_ENDIAN
+    /* The words are read where the CRC needs them (read before the test for a run-time
+     * engine, they would stay live across its call). */
+    j288_copy_frame(buf(p), data, J288_REPLY_LEN);
+    return j288_crc_frame_words(p->crc, &buf(p)[2], &p->held.words[1], 5u) == p->held.words[6];
+#else
+    uint32_t w[5];
+    j288_copy_frame(buf(p), data, J288_REPLY_LEN);
+    w[0] = j288_get_u32le(&buf(p)[2]);
+    w[1] = j288_get_u32le(&buf(p)[6]);
+    w[2] = j288_get_u32le(&buf(p)[10]);
+    w[3] = j288_get_u32le(&buf(p)[14]);
+    w[4] = j288_get_u32le(&buf(p)[18]);
+    return j288_crc_frame_words(p->crc, &buf(p)[2], w, 5u) == j288_get_u32le(&buf(p)[22]);
+#endif
+}
+
 /* j288_parser_feed() when a reply at the start of data failed its CRC: what scan() does
  * there, with one CRC per frame as there: the frame is dropped as take_whole() drops it, and
  * the scan goes on behind it. (The good case is checked inline in j288_parser_feed(); this
@@ -235,17 +292,32 @@ J288_NOINLINE static int feed_after_bad_reply(j288_parser_t *p, const uint8_t *d
     drop_whole(p, data);
     rc = scan(p, &data[J288_REPLY_LEN], len - J288_REPLY_LEN, consumed, &f);
     *consumed += J288_REPLY_LEN;
-    if ((rc == J288_PARSE_FRAME) && (f != p->buf)) {
-        j288_copy_frame(p->buf, f, J288_REPLY_LEN); /* a reply parser: checked where it lies */
+    if ((rc == J288_PARSE_FRAME) && (f != buf(p))) {
+        j288_copy_frame(buf(p), f, J288_REPLY_LEN); /* a reply parser: checked where it lies */
+    }
+    return rc;
+}
+
+/* j288_parser_feed() for everything but a whole reply at the start of data, out of line so
+ * that that common case saves and restores only the registers it needs. */
+J288_NOINLINE static int feed_scan(j288_parser_t *p, const uint8_t *data, size_t len,
+                                   size_t *consumed)
+{
+    const uint8_t *f = NULL;
+    int rc = scan(p, data, len, consumed, &f);
+    if ((rc == J288_PARSE_FRAME) && (f != buf(p))) {
+        /* Checked in the caller's data: the parser keeps its own copy (constant lengths). */
+        if (p->kind == J288_PARSE_REPLY) {
+            j288_copy_frame(buf(p), f, J288_REPLY_LEN);
+        } else {
+            j288_copy_frame(buf(p), f, J288_CMD_LEN);
+        }
     }
     return rc;
 }
 
 int j288_parser_feed(j288_parser_t *p, const uint8_t *data, size_t len, size_t *consumed)
 {
-    const uint8_t *f = NULL;
-    int rc;
-
     if (consumed != NULL) {
         *consumed = 0u;
     }
@@ -253,31 +325,36 @@ int j288_parser_feed(j288_parser_t *p, const uint8_t *data, size_t len, size_t *
         return J288_ERR_NULL;
     }
     if (reply_at_start(p, data, len)) {
-        if (j288_reply_crc_ok(p->crc, data)) {
+        if (take_reply_words(p, data)) {
             p->stats.frames++;
-            j288_copy_frame(p->buf, data, J288_REPLY_LEN);
             *consumed = J288_REPLY_LEN;
             return J288_PARSE_FRAME;
         }
         return feed_after_bad_reply(p, data, len, consumed);
     }
-    rc = scan(p, data, len, consumed, &f);
-    if ((rc == J288_PARSE_FRAME) && (f != p->buf)) {
-        /* Checked in the caller's data: the parser keeps its own copy (constant lengths). */
-        if (p->kind == J288_PARSE_REPLY) {
-            j288_copy_frame(p->buf, f, J288_REPLY_LEN);
-        } else {
-            j288_copy_frame(p->buf, f, J288_CMD_LEN);
-        }
-    }
-    return rc;
+    return feed_scan(p, data, len, consumed);
 }
 
 const uint8_t *j288_parser_frame(const j288_parser_t *p)
 {
     /* A completed frame stays in buf: len went back to 0 but the bytes are untouched until
      * the next byte arrives. */
-    return p->buf;
+    return &p->held.bytes[2];
+}
+
+void j288_parser_reply(const j288_parser_t *p, j288_reply_raw_t *reply)
+{
+#if J288_LITTLE_ENDIAN
+    j288_reply_unpack_words(&p->held.words[1], reply);
+#else
+    uint32_t w[5];
+    w[0] = j288_get_u32le(&p->held.bytes[4]);
+    w[1] = j288_get_u32le(&p->held.bytes[8]);
+    w[2] = j288_get_u32le(&p->held.bytes[12]);
+    w[3] = j288_get_u32le(&p->held.bytes[16]);
+    w[4] = j288_get_u32le(&p->held.bytes[20]);
+    j288_reply_unpack_words(w, reply);
+#endif
 }
 
 int j288_parser_flush(j288_parser_t *p)

@@ -30,10 +30,10 @@
 #define ITERATIONS 300u
 #endif
 /* Rows to run (bits: 1 floors, 2 codec, 4 codec with the CRC unit, 8 poll, 16 sweeps, 32 joint,
- * 64 sweeps with a new command each transaction): a profile of one row under QEMU builds the
+ * 64 sweeps with a new command each transaction, 128 codec with the parser's unpack): a profile of one row under QEMU builds the
  * image with -DBUS_TARGET_ROWS=<bits>. */
 #ifndef BUS_TARGET_ROWS
-#define BUS_TARGET_ROWS 0x7Fu
+#define BUS_TARGET_ROWS 0xFFu
 #endif
 #define RUN_ROW(bit, call) (((BUS_TARGET_ROWS) & (bit)) != 0u ? (call) : 0u)
 #define CAL_LOOPS  100000u
@@ -391,7 +391,12 @@ static uint32_t run_floor_engine(void)
     return icount_between(t0, t1);
 }
 
-static uint32_t run_codec(const j288_crc_t *crc)
+/* The codec rows' loop; with parser_unpacks, the reply is unpacked by j288_parser_reply()
+ * from the parser's aligned buffer instead of j288_reply_unpack(j288_parser_frame()), which
+ * reads bytes of unknown alignment. Always inlined, so that each row's loop is compiled for
+ * its own unpack (a test in the loop would count in both rows). */
+static inline __attribute__((always_inline)) uint32_t codec_loop(const j288_crc_t *crc,
+                                                                 bool parser_unpacks)
 {
     j288_parser_t parser;
     j288_cmd_raw_t cmd = worked_cmd();
@@ -405,13 +410,27 @@ static uint32_t run_codec(const j288_crc_t *crc)
         size_t used;
         (void)j288_cmd_encode(&cmd, frame, crc);
         if (j288_parser_feed(&parser, replies[3], J288_REPLY_LEN, &used) == J288_PARSE_FRAME) {
-            j288_reply_unpack(j288_parser_frame(&parser), &r);
+            if (parser_unpacks) {
+                j288_parser_reply(&parser, &r);
+            } else {
+                j288_reply_unpack(j288_parser_frame(&parser), &r);
+            }
             done_count++;
         }
     }
     t1 = icount_now();
     done_expected += ITERATIONS;
     return icount_between(t0, t1);
+}
+
+static uint32_t run_codec(const j288_crc_t *crc)
+{
+    return codec_loop(crc, false);
+}
+
+static uint32_t run_codec_parser_unpacks(void)
+{
+    return codec_loop(NULL, true);
 }
 
 static uint32_t run_bus_poll(void)
@@ -614,7 +633,7 @@ static void row(const char *name, uint32_t floor, uint32_t lib)
 int main(void)
 {
     const j288_crc_t unit_engine = {unit_crc32, &bench_unit};
-    uint32_t ipt, f_codec, f_unit, f_engine, codec, codec_unit, poll, isr, isr_new;
+    uint32_t ipt, f_codec, f_unit, f_engine, codec, codec_held, codec_unit, poll, isr, isr_new;
     uint8_t id;
 
     for (id = 0u; id < J288_MAX_SERVOS; id++) {
@@ -640,6 +659,7 @@ int main(void)
     f_unit = per_txn(RUN_ROW(1u, run_floor_codec(true)), ipt);
     f_engine = per_txn(RUN_ROW(1u, run_floor_engine()), ipt);
     codec = per_txn(RUN_ROW(2u, run_codec(NULL)), ipt);
+    codec_held = per_txn(RUN_ROW(128u, run_codec_parser_unpacks()), ipt);
     codec_unit = per_txn(RUN_ROW(4u, run_codec(&unit_engine)), ipt);
     poll = per_txn(RUN_ROW(8u, run_bus_poll()), ipt);
     /* (With the CRC unit as the backend, the model's two answers do not fit 15 servos.) */
@@ -654,6 +674,12 @@ int main(void)
         row("codec, CRC unit (compile-time backend)", f_unit, codec);
     } else {
         row("codec only (encode, parse, unpack)", f_codec, codec);
+    }
+    if (HW_BACKEND) {
+        row("codec, CRC unit (compile-time backend), reply unpacked by the parser", f_unit,
+            codec_held);
+    } else {
+        row("codec, reply unpacked by the parser (j288_parser_reply)", f_codec, codec_held);
     }
     row("codec, CRC unit (port crc32 op)", f_unit, codec_unit);
     row("bus, poll mode", 0u, poll);

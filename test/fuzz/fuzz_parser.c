@@ -39,6 +39,17 @@ typedef struct {
     uint32_t truncated;
 } ref_t;
 
+/* Two unpacked replies agree field by field (padding aside). */
+static inline int fuzz_reply_equal(const j288_reply_raw_t *a, const j288_reply_raw_t *b)
+{
+    return (a->id == b->id) && (a->status == b->status) &&
+           (a->watchdog_tripped == b->watchdog_tripped) && (a->case_temp_c == b->case_temp_c) &&
+           (a->winding_temp_c == b->winding_temp_c) && (a->voltage_raw == b->voltage_raw) &&
+           (a->torque == b->torque) && (a->speed == b->speed) && (a->pos == b->pos) &&
+           (a->faults == b->faults) && (a->out_pos == b->out_pos) &&
+           (a->warnings == b->warnings) && (a->reserved == b->reserved);
+}
+
 static int ref_frame_ok(const ref_t *r, const uint8_t *f)
 {
     return (r->flen == J288_REPLY_LEN) ? fuzz_reply_valid(f) : fuzz_cmd_valid(f);
@@ -213,9 +224,13 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
                 FUZZ_CHECK(consumed >= 1u);
                 FUZZ_CHECK(f != NULL);
                 if (kind == J288_PARSE_REPLY) {
-                    j288_reply_raw_t r;
+                    j288_reply_raw_t r, held;
                     FUZZ_CHECK(fuzz_reply_valid(f));
                     FUZZ_CHECK(j288_reply_decode(f, &r, NULL) == J288_OK);
+                    /* The parser's word-wise unpack against the byte-wise one. */
+                    memset(&held, 0, sizeof held);
+                    j288_parser_reply(&parser, &held);
+                    FUZZ_CHECK(fuzz_reply_equal(&r, &held));
                 } else {
                     j288_cmd_raw_t cmd;
                     FUZZ_CHECK(fuzz_cmd_valid(f));

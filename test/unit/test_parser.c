@@ -518,6 +518,55 @@ static void test_only_heads(void)
     TEST_ASSERT_TRUE(j288_parser_pending(&p) < J288_REPLY_LEN);
 }
 
+/* j288_parser_reply(): every golden reply's fields (the generator's, not the codec's), the
+ * reply taken whole (checked where it lies, then moved into the parser) and a byte at a time
+ * (collected in the parser), behind a garbage byte so that the caller's copy is unaligned. */
+static void check_parser_reply(const j288_parser_t *p, const golden_reply_t *g)
+{
+    j288_reply_raw_t r;
+    memset(&r, 0xA5, sizeof r);
+    j288_parser_reply(p, &r);
+    TEST_ASSERT_EQUAL_UINT8_MESSAGE(g->id, r.id, g->name);
+    TEST_ASSERT_EQUAL_UINT8_MESSAGE(g->status, r.status, g->name);
+    TEST_ASSERT_EQUAL_MESSAGE(g->watchdog != 0u, r.watchdog_tripped, g->name);
+    TEST_ASSERT_EQUAL_INT8_MESSAGE(g->case_temp, r.case_temp_c, g->name);
+    TEST_ASSERT_EQUAL_UINT8_MESSAGE(g->winding_temp, r.winding_temp_c, g->name);
+    TEST_ASSERT_EQUAL_UINT8_MESSAGE(g->voltage_raw, r.voltage_raw, g->name);
+    TEST_ASSERT_EQUAL_INT16_MESSAGE(g->torque, r.torque, g->name);
+    TEST_ASSERT_EQUAL_INT16_MESSAGE(g->speed, r.speed, g->name);
+    TEST_ASSERT_EQUAL_INT32_MESSAGE(g->pos, r.pos, g->name);
+    TEST_ASSERT_EQUAL_HEX32_MESSAGE(g->faults, r.faults, g->name);
+    TEST_ASSERT_EQUAL_UINT16_MESSAGE(g->out_pos, r.out_pos, g->name);
+    TEST_ASSERT_EQUAL_UINT8_MESSAGE(g->warnings, r.warnings, g->name);
+    TEST_ASSERT_EQUAL_UINT16_MESSAGE(g->reserved, r.reserved, g->name);
+}
+
+static void test_parser_reply_golden(void)
+{
+    size_t k, i, used;
+    for (k = 0; k < GOLDEN_REPLY_COUNT; k++) {
+        const golden_reply_t *g = &golden_replies[k];
+        j288_parser_t p;
+        if (g->expect != J288_OK) {
+            continue;
+        }
+        stream[0] = 0x00u;
+        memcpy(&stream[1], g->frame, J288_REPLY_LEN);
+        j288_parser_init(&p, J288_PARSE_REPLY, NULL);
+        TEST_ASSERT_EQUAL_INT(J288_PARSE_NONE, j288_parser_feed(&p, stream, 1u, &used));
+        TEST_ASSERT_EQUAL_INT_MESSAGE(J288_PARSE_FRAME,
+                                      j288_parser_feed(&p, &stream[1], J288_REPLY_LEN, &used),
+                                      g->name);
+        check_parser_reply(&p, g);
+        j288_parser_init(&p, J288_PARSE_REPLY, NULL);
+        for (i = 0; i + 1u < J288_REPLY_LEN; i++) {
+            TEST_ASSERT_EQUAL_INT(J288_PARSE_NONE, j288_parser_feed(&p, &g->frame[i], 1u, &used));
+        }
+        TEST_ASSERT_EQUAL_INT(J288_PARSE_FRAME, j288_parser_feed(&p, &g->frame[i], 1u, &used));
+        check_parser_reply(&p, g);
+    }
+}
+
 int main(void)
 {
     UNITY_BEGIN();
@@ -536,5 +585,6 @@ int main(void)
     RUN_TEST(test_reset);
     RUN_TEST(test_noise_with_frames);
     RUN_TEST(test_only_heads);
+    RUN_TEST(test_parser_reply_golden);
     return UNITY_END();
 }

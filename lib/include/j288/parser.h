@@ -43,10 +43,17 @@ typedef struct {
 
 typedef struct {
     /* Private: read through the functions below. */
-    uint8_t len;       /* bytes collected into buf */
+    uint8_t len;       /* bytes of the frame collected */
     uint8_t frame_len;
-    uint8_t buf[J288_REPLY_LEN]; /* 2 bytes into the struct: a reply's CRC'd words align */
     uint8_t head0;
+    /* The frame, from bytes[2]: a reply's CRC'd words and its CRC field are words[1..6], so
+     * that the library reads and writes them as aligned words (the union is what makes the
+     * bytes word-aligned; bytes[0..1] are unused). */
+    /* cppcheck-suppress misra-c2012-19.2 ; C99's only way to align a byte buffer (docs/misra.md) */
+    union {
+        uint32_t words[7];
+        uint8_t bytes[J288_REPLY_LEN + 2u];
+    } held; /* cppcheck-suppress misra-c2012-19.2 ; see above */
     j288_parse_kind_t kind;
     const j288_crc_t *crc;
     j288_parser_stats_t stats;
@@ -70,6 +77,13 @@ int j288_parser_feed(j288_parser_t *p, const uint8_t *data, size_t len, size_t *
 /* The last good frame (frame_len bytes). Valid after J288_PARSE_FRAME until the next feed,
  * flush or reset. */
 const uint8_t *j288_parser_frame(const j288_parser_t *p);
+
+/* A reply parser's last good reply, unpacked: the same as j288_reply_unpack(
+ * j288_parser_frame(p), reply), read from the parser's own buffer a whole word at a time
+ * (where j288_reply_unpack() reads bytes, not knowing its buffer's alignment: four loads a
+ * word on Cortex-M0 and RV32). Same validity as j288_parser_frame(); a command parser's frame
+ * gives meaningless fields. ISR-safe like the rest of the parser. */
+void j288_parser_reply(const j288_parser_t *p, j288_reply_raw_t *reply);
 
 /* The line went idle (or the caller gives up on this frame): drop a partial frame, counting
  * it as truncated. Returns J288_ERR_TRUNCATED when something was dropped, else J288_OK. */
