@@ -103,7 +103,7 @@ INDIRECT_SITES = [
     (r"bus\.c:port_unlock", ["unlock"]),
     (r"(bus|sched)\.c:j288_bus_lock", ["lock"]),
     (r"(bus|sched)\.c:j288_bus_unlock", ["unlock"]),
-    (r"bus\.c:start_attempt", ["set_dir", "start_tx", "start_rx", "now_us"]),
+    (r"bus\.c:start_attempt(_called)?", ["set_dir", "start_tx", "start_rx", "now_us"]),
     (r"bus\.c:advance_from_event", ["now_us"]),
     (r"bus\.c:(take_in_place|tx_done_fast)", ["now_us"]),
     (r"bus\.c:reply_fast", ["now_us", "crc32"]),
@@ -111,13 +111,15 @@ INDIRECT_SITES = [
     (r"^j288_bus_on_rx", ["now_us"]),
     (r"^j288_bus_transfer_blocking", ["wait", "now_us", "lock", "unlock"]),
     (r"^j288_crc32_run", ["crc32"]),
-    (r"^j288_cmd_encode", ["crc32"]),
+    (r"^j288_cmd_(encode|pack)", ["crc32"]),  # the frame's CRC, inlined
+    (r"^j288_parser_feed", ["crc32"]),
+    (r"^j288_sched_set_cmd", ["lock", "unlock", "crc32"]),  # j288_cmd_pack inlined
     (r"frame\.c:j288_crc_frame", ["crc32"]),
     (r"parser\.c:frame_crc_ok", ["crc32"]),
     (r"(parser|bus|frame)\.c:j288_crc_frame_hot", ["crc32"]),
     (r"sched\.c:(next_slot|sched_lock|sched_unlock)", ["lock", "unlock"]),
     (r"sched\.c:(emit|sched_done|take_reply)", ["app"]),
-    (r"^j288_joint_bus_on_reply|joint\.c:report", ["app"]),  # on_event
+    (r"^j288_joint(q)?_bus_on_reply|joint(q)?\.c:report", ["app"]),  # on_event
     (r"j288_stm32\.c:now_of", ["app"]),
 ]
 
