@@ -761,6 +761,15 @@ static bool read_input(sim_io_t *io, j288_sim_bus_t *bus)
     }
 }
 
+/* Woken at now_us for a wake due at wake_us: a wake that late means this process was not
+ * scheduled (a loaded machine); whatever the host sent meanwhile sat unread in the pty, so
+ * the watchdogs must not count the stretch as the host's silence. */
+static void excuse_oversleep(j288_sim_bus_t *bus, uint64_t wake_us, uint64_t now_us)
+{
+    if (now_us > wake_us)
+        j288_sim_bus_excuse_stall(bus, wake_us, now_us);
+}
+
 static void serve(sim_io_t *io, j288_sim_bus_t *bus, uint64_t exit_at_us, const sigset_t *mask)
 {
     uint64_t last_tick = 0;
@@ -791,6 +800,7 @@ static void serve(sim_io_t *io, j288_sim_bus_t *bus, uint64_t exit_at_us, const 
         rc = ppoll(&pfd, 1, &ts, mask);
         if (rc < 0 && errno != EINTR)
             die("poll: %s", strerror(errno));
+        excuse_oversleep(bus, wake, sim_now_us(io));
         if (rc <= 0)
             continue;
         if (!read_input(io, bus) || (pfd.revents & POLLHUP) != 0) {
