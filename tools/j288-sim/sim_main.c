@@ -803,7 +803,9 @@ static void serve(sim_io_t *io, j288_sim_bus_t *bus, uint64_t exit_at_us, const 
         excuse_oversleep(bus, wake, sim_now_us(io));
         if (rc <= 0)
             continue;
-        if (!read_input(io, bus) || (pfd.revents & POLLHUP) != 0) {
+        /* read() decides whether a client is there: the poll's hang-up may be stale (a
+         * client that opened the pty since, and whose first command was just read). */
+        if (!read_input(io, bus)) {
             /* No client: the master reports hang-up until one opens the pty. Nap rather
              * than spin; replies still queued for a departed client are dropped. */
             io->lost_no_client += io->qlen;
