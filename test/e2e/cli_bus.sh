@@ -20,9 +20,12 @@ SIM_DIR=$E2E_TMP
 SIM_WRAP=(timeout -k 2 120)
 BIG_MARGIN=250000
 M=(--margin-us "$BIG_MARGIN")
-# Where absent ids are asked too (scan: 12 ids, 4 tries each; log's probe sweeps), each
-# miss costs a margin: 50 ms, still ten times what a busy machine stalls a pty exchange.
+# Where absent ids are asked too (scan: 12 ids; log's probe sweeps), each miss costs a margin:
+# 50 ms where a retry is allowed for. A scan that must find every servo gets the long margin
+# and no retry instead (3 s for the 12 absent ids): a loaded machine starved the simulator
+# for 0.3-1.6 s at times, past both tries of 50 ms.
 M50=(--margin-us 50000)
+MSCAN=(--margin-us "$BIG_MARGIN" --retries 0)
 
 trap 'sim_cleanup TERM' EXIT
 trap 'exit 130' INT TERM
@@ -65,7 +68,7 @@ log_lines() { grep -c '' "$1" 2>/dev/null || echo 0; }
 start_sim main --ids 1,2,3 --fault 3:0x200 || exit 1
 MAIN=$DEV MAIN_LOG=$E2E_TMP/main.log MAIN_PID=$SIM_PID
 
-e2e_run "$J288" --port "$MAIN" scan "${M50[@]}"
+e2e_run "$J288" --port "$MAIN" scan "${MSCAN[@]}"
 if [ $E2E_RC -eq 0 ] && grep -Eq '^1 +lock' <<<"$E2E_OUT" && grep -Eq '^2 ' <<<"$E2E_OUT" &&
     grep -Eq '^3 .*winding over-temperature' <<<"$E2E_OUT" && grep -q '3 servos answered' <<<"$E2E_OUT"; then
     e2e_pass scan_human
@@ -73,7 +76,7 @@ else
     e2e_fail scan_human "rc $E2E_RC out '$E2E_OUT' err '$E2E_ERR'"
 fi
 
-e2e_run "$J288" scan --port "$MAIN" --json "${M50[@]}"
+e2e_run "$J288" scan --port "$MAIN" --json "${MSCAN[@]}"
 expect_true scan_json_tool bash -c "printf '%s' '$E2E_OUT' | python3 -m json.tool >/dev/null"
 json_check scan_json '
 assert isinstance(o, list) and [s["id"] for s in o] == [1, 2, 3], o
@@ -322,16 +325,21 @@ stop_sim "$SIM_PID"
 # dropped and 5 corrupted (the first logged cycle fails for servos 1 and 2, however few
 # cycles a slow machine runs), and no three replies in a row fail among the first 700 (so the
 # final lock of each servo, three attempts, is always confirmed). --side output: the joint
-# side's probe takes more sweeps (the joints' starts), which would shift that sequence.
+# side's probe takes more sweeps (the joints' starts), which would shift that sequence. A
+# simulator starved past the margin shifts it too (a timeout in the sweep, whose retries then
+# meet replies 4 and 5, or a reply 5 that comes late): where they fell is then checked only
+# when the sweep and the locks took their six transactions and no reply came late.
 start_sim faultylog --ids 1,2,3 --seed 930 --drop 0.05 --corrupt 0.05 --noise 0.05 || exit 1
 e2e_run "$J288" --port "$DEV" log --id 1,2,3 --rate 200 --duration 1 --hold --side output --csv "$E2E_TMP/f.csv" --json "${M[@]}"
 json_check faulty_log_counts "
 b = o['bus']
-assert b['timeouts'] >= 1 and b['crc_errors'] >= 1, b
+assert b['timeouts'] + b['crc_errors'] >= 2, b
 assert b['transactions'] == b['ok'] + b['timeouts'] + b['crc_errors'] + b['wrong_id'] + b['collisions'] + b['line_errors'], b
 s = o['servos']
 assert all(x['replies'] + x['failures'] == o['cycles'] for x in s), s
-assert s[0]['failures'] >= 1 and s[1]['failures'] >= 1, s
+if b['transactions'] - 3 * o['cycles'] == 6 and b['stale_bytes'] == 0:
+    assert b['timeouts'] >= 1 and b['crc_errors'] >= 1, b
+    assert s[0]['failures'] >= 1 and s[1]['failures'] >= 1, s
 import csv
 rows = list(csv.DictReader(open('$E2E_TMP/f.csv')))
 bad = [r for r in rows if r['ok'] == '0']
