@@ -761,12 +761,15 @@ static bool read_input(sim_io_t *io, j288_sim_bus_t *bus)
     }
 }
 
-/* Woken at now_us for a wake due at wake_us: a wake that late means this process was not
- * scheduled (a loaded machine); whatever the host sent meanwhile sat unread in the pty, so
- * the watchdogs must not count the stretch as the host's silence. */
-static void excuse_oversleep(j288_sim_bus_t *bus, uint64_t wake_us, uint64_t now_us)
+/* Woken at now_us for a wake due at wake_us, with the host's bytes waiting: a wake that late
+ * means this process was not scheduled (a loaded machine) while what the host sent sat unread
+ * in the pty, so the watchdogs must not count the stretch as the host's silence. A late wake
+ * with nothing waiting excuses nothing: the host was silent, and the small delays of every
+ * tick on a loaded machine would otherwise add up and hold off a trip the host earned. */
+static void excuse_oversleep(j288_sim_bus_t *bus, bool input_waiting, uint64_t wake_us,
+                             uint64_t now_us)
 {
-    if (now_us > wake_us)
+    if (input_waiting && now_us > wake_us)
         j288_sim_bus_excuse_stall(bus, wake_us, now_us);
 }
 
@@ -800,7 +803,7 @@ static void serve(sim_io_t *io, j288_sim_bus_t *bus, uint64_t exit_at_us, const 
         rc = ppoll(&pfd, 1, &ts, mask);
         if (rc < 0 && errno != EINTR)
             die("poll: %s", strerror(errno));
-        excuse_oversleep(bus, wake, sim_now_us(io));
+        excuse_oversleep(bus, rc > 0 && (pfd.revents & POLLIN) != 0, wake, sim_now_us(io));
         if (rc <= 0)
             continue;
         /* read() decides whether a client is there: the poll's hang-up may be stale (a
