@@ -13,10 +13,10 @@ t_wrap_around_zero() {
     cfg=$(config w0 "  - name: j" "    id: 1" "    limits: [-0.5, 0.5]")
     status_joint j "$cfg" || return 1
     near "$(jget "$E2E_TMP/st.json" joint_pos)" 0.01 0.0004 || return 1
-    move_joint j "$cfg" --pos -0.03 --speed 1 --duration 1 || return 1
+    move_joint j "$cfg" --pos -0.03 --speed 1 --duration "$(e2e_scaled 10)" || return 1
     truth_now && near "$(truth_val 1 theta)" -0.03 0.005 || return 1
     status_joint j "$cfg" && near "$(jget "$E2E_TMP/st.json" joint_pos)" -0.03 0.005 || return 1
-    move_joint j "$cfg" --pos 0.03 --speed 1 --duration 1 || return 1
+    move_joint j "$cfg" --pos 0.03 --speed 1 --duration "$(e2e_scaled 10)" || return 1
     truth_now && near "$(truth_val 1 theta)" 0.03 0.005 || return 1
     stop_sim
 }
@@ -27,7 +27,7 @@ t_wrap_high_range() {
     cfg=$(config w1 "  - name: j" "    id: 1" "    limits: [5.8, 6.8]")
     status_joint j "$cfg" || return 1
     near "$(jget "$E2E_TMP/st.json" joint_pos)" "$(calc '0.3 + 2 * atan2(0, -1)')" 0.0004 || return 1
-    move_joint j "$cfg" --pos 6.2 --speed 1 --duration 1.5 || return 1
+    move_joint j "$cfg" --pos 6.2 --speed 1 --duration "$(e2e_scaled 10)" || return 1
     truth_now && near "$(truth_val 1 theta)" "$(calc '6.2 - 2 * atan2(0, -1)')" 0.005 || return 1
     status_joint j "$cfg" && near "$(jget "$E2E_TMP/st.json" joint_pos)" 6.2 0.005 || return 1
     # log: the CSV in the joint frame; a swing leaving the limits is refused before it starts.
@@ -46,7 +46,7 @@ t_direction() {
     start_sim dir --ids 1 --start-angle 1:0.05 --quiet || return 1
     cfg=$(config d "  - name: j" "    id: 1" "    direction: -1" "    zero: 0.1" "    limits: [-0.5, 0.5]")
     status_joint j "$cfg" && near "$(jget "$E2E_TMP/st.json" joint_pos)" 0.05 0.0004 || return 1
-    move_joint j "$cfg" --pos 0.2 --speed 1 --duration 1 || return 1
+    move_joint j "$cfg" --pos 0.2 --speed 1 --duration "$(e2e_scaled 10)" || return 1
     truth_now && near "$(truth_val 1 theta)" -0.1 0.005 || return 1
     stop_sim
 }
@@ -56,8 +56,9 @@ t_direction() {
 t_power_cycle_while_driving() {
     local pid i rc n0
     start_sim drive --ids 1 --start-angle 1:0 --power-off-ms 100 --quiet || return 1
-    # (--duration bounds the move, which ends once there: 1 s cut it short on a loaded machine)
-    "$J288" --port "$DEV" move --id 1 --pos 1.0 --speed 4 --duration "$(e2e_scaled 10)" "${M[@]}" >/dev/null ||
+    # (--duration bounds the move, which ends once there: 1 s cut it short on a loaded machine;
+    # the watchdog off, as move_joint's: a positioning move, on a machine that may starve it)
+    "$J288" --port "$DEV" move --id 1 --pos 1.0 --speed 4 --duration "$(e2e_scaled 10)" --watchdog off "${M[@]}" >/dev/null ||
         { echo "move to 1.0 failed"; return 1; }
     n0=$(foc_frames 1) # the move's: hold's own 200 are waited for (not a total, which a
     # slower move once reached alone, so that the power cycle came before hold drove)
