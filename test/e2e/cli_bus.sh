@@ -126,14 +126,14 @@ expect_true hold_ends_with_lock bash -c "grep 'id=1 ' '$MAIN_LOG' | tail -n 1 | 
 
 # The output side keeps its old meaning: rotor / N, counted from where the rotor started at
 # power-up (so first, while servo 2 is near there).
-e2e_run "$J288" --port "$MAIN" move --id 2 --side output --pos 0.2 --speed 1 --duration 1.2 --json "${M[@]}"
+e2e_run "$J288" --port "$MAIN" move --id 2 --side output --pos 0.2 --speed 1 --duration "$(e2e_scaled 10)" --json "${M[@]}"
 json_check move_output_side '
 assert o["ended"] == "done" and o["side"] == "output", o
 pos = o["last_reply"]["output"]["pos_rad"]
 assert abs(pos - o["target_pos"]) < 0.02, (pos, o["target_pos"])
 assert abs(o["target_pos"] - 0.2) < 1e-3, o'
 # The joint frame (the default): the move ends at joint angle 0.2 wherever the servo started.
-e2e_run "$J288" --port "$MAIN" move --id 2 --pos 0.2 --speed 5 --duration 1.5 --json "${M[@]}"
+e2e_run "$J288" --port "$MAIN" move --id 2 --pos 0.2 --speed 5 --duration "$(e2e_scaled 10)" --json "${M[@]}"
 json_check move_reaches_target '
 assert o["ended"] == "done" and o["locked"] is True and o["side"] == "joint", o
 assert o["joint_known"] is True, o
