@@ -275,7 +275,9 @@ def test_robot_bus_stops_answering(sims, tmp_path: Path) -> None:
     assert f"margin_us: {SHORT_MARGIN}" in text
     cfg.write_text(text)
     with j288.Robot(str(cfg), down_after=1) as robot:
-        assert robot.cycle().complete
+        # every bus answers before the freeze (cycles until one is complete: the short margin
+        # missed a starved simulator's reply on a loaded machine)
+        assert any(robot.cycle().complete for _ in range(20))
         os.kill(s[2].proc.pid, signal.SIGSTOP)
         try:
             for _ in range(20):  # one sweep without a reply: down (down_after=1); a cycle
