@@ -25,11 +25,11 @@ M=(--margin-us "$BIG_MARGIN")
 # Where the simulator drops replies on purpose, each drop costs a margin: 250 ms there.
 MF=(--margin-us 250000)
 # Where absent ids are asked too (scan: 12 ids; log's probe sweeps), each miss costs a margin:
-# 50 ms where a retry is allowed for. A scan that must find every servo gets 250 ms and no
-# retry instead (3 s for the 12 absent ids): a loaded machine starved the simulator past
-# both tries of 50 ms.
+# 50 ms where a retry is allowed for. A scan that must find every servo gets 500 ms and no
+# retry instead (6 s for the 12 absent ids): a loaded machine starved the simulator past
+# both tries of 50 ms, and past a single 250 ms.
 M50=(--margin-us 50000)
-MSCAN=(--margin-us 250000 --retries 0)
+MSCAN=(--margin-us 500000 --retries 0)
 
 trap 'sim_cleanup TERM' EXIT
 trap 'exit 130' INT TERM
