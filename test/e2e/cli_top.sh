@@ -22,7 +22,10 @@ cleanup() {
     local n
     [ "$BASHPID" = "$$" ] || return 0
     if command -v tmux >/dev/null; then
-        for n in $(seq 0 "$TOP_N"); do tmux -L "j288-top-$$-$n" kill-server 2>/dev/null; done
+        for n in $(seq 0 "$TOP_N"); do
+            tmux -L "j288-top-$$-$n" kill-server 2>/dev/null
+            rm -f "${TMUX_TMPDIR:-/tmp}/tmux-$(id -u)/j288-top-$$-$n"
+        done
     fi
     sim_cleanup TERM
 }
