@@ -637,6 +637,26 @@ static void test_a_second_session_after_a_stop_is_obeyed(void)
     TEST_ASSERT_FALSE(sv.watchdog_tripped);
 }
 
+/* A silent servo's transaction with every re-send (3) and a long margin outlasts the
+ * estop's bound: the runner still drives it to its end, and the next transfer goes out (it was
+ * refused "bus busy" for ever: nothing polled the unfinished one). */
+static void test_transfer_after_a_long_silent_one(void)
+{
+    j288_robot_options_t o;
+    j288_cmd_raw_t c;
+    memset(&o, 0, sizeof o);
+    o.margin_us = 250000u;
+    o.retries = 3u;
+    sim_start(0, "1");
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_robot_open_port(&g_robot, g_sim[0].pty, &o));
+    memset(&c, 0, sizeof c);
+    c.id = 9; /* absent */
+    c.status = J288_MODE_LOCK;
+    TEST_ASSERT_EQUAL_INT(J288_ERR_TIMEOUT, j288_robot_transfer(&g_robot, 0, &c, NULL, NULL));
+    c.id = 1;
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_robot_transfer(&g_robot, 0, &c, NULL, NULL));
+}
+
 /* A servo left tripped (its host went silent under FOC): an exchange clears it, the command is
  * obeyed, and the reply and an event say so; a lock exchange goes out with the bit 0. */
 static void test_exchange_clears_and_reports_a_trip(void)
@@ -748,6 +768,7 @@ int main(void)
     RUN_TEST(test_exchange_clears_and_reports_a_trip);
     RUN_TEST(test_cycles_clear_and_report_a_trip);
     RUN_TEST(test_hold_without_gains_uses_the_defaults);
+    RUN_TEST(test_transfer_after_a_long_silent_one);
     RUN_TEST(test_stop_on_bus_loss);
     return UNITY_END();
 }
