@@ -131,6 +131,13 @@ unit-tests: $(UNIT_TESTS)
 test: $(HOST_TESTS) $(TEST_DEPS)
 	$(call RUN_TESTS,$(HOST_TESTS) $(TEST_SCRIPTS))
 
+# make test N times in a row, with stress-ng --cpu LOAD beside it (scripts/test-loop.sh).
+N ?= 10
+LOAD ?= 0
+.PHONY: test-loop
+test-loop: $(HOST_TESTS) $(TEST_DEPS)
+	BUILD=$(BUILD) bash scripts/test-loop.sh $(N) $(LOAD)
+
 # ---- install ---------------------------------------------------------------------------------
 # CMake's install (cmake/j288_install.cmake) from $(CMAKE_BUILD) for PREFIX under DESTDIR;
 # uninstall removes what it listed ($(INSTALLED)) and the j288 directories left empty.
@@ -156,6 +163,7 @@ help:
 	@echo "make                build library, tools, example and host tests into $(BUILD)/"
 	@echo "make test           every host test (fetches Unity on first use)"
 	@echo "make demo           the CLI against the built-in servo simulator"
+	@echo "make test-loop      make test N times (10), stress-ng --cpu LOAD (0) beside it"
 	@echo "make install        cmake --install: libraries, headers, CMake package, j288.pc, j288,"
 	@echo "                    j288-sim, man pages, completion, Python package (PREFIX, DESTDIR)"
 	@echo "make uninstall      removes what make install installed"

@@ -1061,12 +1061,26 @@ static void txn_done(void *user, const j288_txn_t *txn)
     b->txn_done = true;
 }
 
+/* The longest one submit on bus b can take: each attempt a reply budget and, after a failure,
+ * a guard of one more (bus.h), plus the stop's flushing allowance; never less than the estop's
+ * bound (stop_bound_us), which alone was too short: a silent servo's every re-send outlasted
+ * it, and the submit was then left unfinished, the bus refusing every later one as busy. */
+static uint32_t txn_bound_us(const j288_robot_t *r, const j288_robot_bus_t *b)
+{
+    uint64_t t = (uint64_t)j288_bus_reply_budget_us(&b->bus) * 2u * (b->bus.cfg.retries + 1u) +
+                 J288_ROBOT_STOP_TIMEOUT_US;
+    uint32_t stop = stop_bound_us(r);
+    if (t > 60000000u)
+        t = 60000000u;
+    return (uint32_t)t > stop ? (uint32_t)t : stop;
+}
+
 /* One submit, driven by the runner's loop until it ends (its retries and reply budgets, the
- * guard: bounded as a stop is). */
+ * guard: bounded by txn_bound_us). */
 static int run_txn(j288_robot_t *r, j288_robot_bus_t *b, const j288_cmd_raw_t *cmd,
                    j288_txn_t *out)
 {
-    uint32_t start = j288_linux_now_us(), bound = stop_bound_us(r);
+    uint32_t start = j288_linux_now_us(), bound = txn_bound_us(r, b);
     int rc;
     b->txn_done = false;
     rc = j288_bus_submit(&b->bus, cmd, start, txn_done, b);

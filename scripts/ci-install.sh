@@ -27,6 +27,7 @@ packages=(
     gcc-riscv64-unknown-elf picolibc-riscv64-unknown-elf qemu-system-misc
     python3-pytest python3-numpy    # scripts/python-test.sh (make test: the Python package)
     pkg-config                      # libyaml (mk/tools.mk); check-consumers.sh; mk/dds.mk
+    stress-ng                       # make test-loop LOAD=N (scripts/test-loop.sh: the suite beside a CPU load)
     tmux                            # test/e2e/cli_top.sh: j288 top on a terminal (required
                                     # under CI=true, skipped with a notice elsewhere)
     cyclonedds-dev cyclonedds-tools # j288-dds (mk/dds.mk): libddsc, its pkg-config file, idlc

@@ -68,12 +68,19 @@ t_command_moves_a_joint() {
     near "$got" "$want" 0.002 || { echo "leg0_2 published $got, true $want"; return 1; }
 }
 t_silence_holds() {
-    local a b
+    # a speed command until the joint has moved 0.1 rad (a condition: a loaded machine ran
+    # fewer of 1 s's commands, and the joint moved 0.097), then silence
+    local a b i p
     a=$(truth 1 1) || return 1
-    "$PEER" command --for 1 --hz 50 leg1_1 - 0.8 - || return 1
-    wait_err 'joint leg1_1: no command for 100 ms: holding where it is' || return 1
-    b=$(truth 1 1) || return 1
+    "$PEER" command --for 60 --hz 50 leg1_1 - 0.8 - & p=$!
+    for i in $(seq 1 "$(e2e_scaled 100)"); do
+        b=$(truth 1 1) || break
+        near "$a" "$b" 0.1 || break
+        sleep 0.2
+    done
+    kill $p 2>/dev/null; wait $p 2>/dev/null
     near "$a" "$b" 0.1 && { echo "the speed command did not move leg1_1 ($a -> $b)"; return 1; }
+    wait_err 'joint leg1_1: no command for 100 ms: holding where it is' || return 1
     comes_to_rest 1 1 || return 1 # it was moving: the hold brings it to rest
     "$PEER" diag >"$SIM_DIR/diag" || return 1
     grep -q '^j288-dds: joint leg1_1|command=timed out' "$SIM_DIR/diag" &&
@@ -119,11 +126,18 @@ t_refusals_in_diagnostics() {
 t_watchdog_trip_reported() {
     # the bridge frozen for 1.5 s while leg1_2 follows commands (watchdog bit 1): the servo's
     # watchdog trips; once the bridge runs again the runner clears it and the bridge says so
-    "$PEER" command --for 6 --hz 50 leg1_2 0.3 - - & local p=$!
-    sleep 1
+    # (frozen once the servo has FOC commands with the watchdog bit: the peer's first command
+    # came after 1 s on a loaded machine, and nothing tripped)
+    local n i
+    n=$(grep -c '' "$SIM_DIR/log.1")
+    "$PEER" command --for "$(e2e_scaled 20)" --hz 50 leg1_2 0.3 - - & local p=$!
+    for i in $(seq 1 "$(e2e_scaled 200)"); do
+        tail -n +"$((n + 1))" "$SIM_DIR/log.1" | grep -q ' id=2 status=1 wd=1' && break
+        sleep 0.05
+    done
     kill -STOP "$BRIDGE_PID"; sleep 1.5; kill -CONT "$BRIDGE_PID"
     wait_err "joint leg1_2: the servo's watchdog had tripped \\(cleared\\)" || { kill $p; return 1; }
-    wait $p
+    kill $p 2>/dev/null; wait $p
     "$PEER" diag >"$SIM_DIR/diag" && grep -Eq '^j288-dds: joint leg1_2\|watchdog_trips=[1-9]' "$SIM_DIR/diag"
 }
 t_ctrl_c_locks_every_bus() {
@@ -185,10 +199,11 @@ t_bad_options() {
 }
 t_stale_truth_fails() {
     # the harness itself: a simulator that never rewrites its truth file fails the check
-    # (within truth's 8 s) instead of handing over the stale angle
+    # (given 2 s here: a negative check waits out its whole bound) instead of handing over the
+    # stale angle
     local rc
     kill -STOP "$SIM_PID_1"
-    truth 1 1 >/dev/null 2>&1; rc=$?
+    truth 1 1 2 >/dev/null 2>&1; rc=$?
     kill -CONT "$SIM_PID_1"
     [ $rc -ne 0 ] || { echo "truth returned 0 for a stale file"; return 1; }
     truth 1 1 >/dev/null

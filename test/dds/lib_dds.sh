@@ -70,15 +70,18 @@ near() {
         if (d < 0) d += p; if (d > p / 2) d = p - d; exit !(d <= t) }'
 }
 
-# truth K ID: servo ID's true output angle on simulator K (asks for it with SIGWINCH and waits
-# until the truth file is rewritten, up to 8 s). Fails (a message, no angle) when the file is
-# not rewritten: a stale angle would let a check pass on old data. Callers check its status.
+# truth K ID [S]: servo ID's true output angle on simulator K (asks for it with SIGWINCH and
+# waits until the truth file is rewritten, up to S seconds, default 8, scaled). Fails (a
+# message, no angle) when the file is not rewritten: a stale angle would let a check pass on
+# old data. Callers check its status. The bound is the clock's, not a count of polls (400 polls
+# of a nominal 20 ms took 25 s on a loaded machine).
 truth() {
-    local f=$SIM_DIR/truth.$1 seq pid i
+    local f=$SIM_DIR/truth.$1 seq pid s=$(e2e_scaled "${3:-8}") end
     eval "pid=\$SIM_PID_$1"
     seq=$(sed -n '1s/.*seq=\([0-9]*\).*/\1/p' "$f" 2>/dev/null)
     kill -s WINCH "$pid"
-    for i in $(seq 1 400); do
+    end=$((${EPOCHREALTIME//[!0-9]/} + s * 1000000))
+    while [ "${EPOCHREALTIME//[!0-9]/}" -lt "$end" ]; do
         if [ "$(sed -n '1s/.*seq=\([0-9]*\).*/\1/p' "$f" 2>/dev/null)" != "$seq" ]; then
             awk -v id="$2" '$1 == "id=" id { sub("theta=", "", $2); print $2; found = 1 }
                 END { exit !found }' "$f"
@@ -86,7 +89,7 @@ truth() {
         fi
         sleep 0.02
     done
-    echo "simulator $1 did not rewrite $f in 8 s" >&2
+    echo "simulator $1 did not rewrite $f in $s s" >&2
     return 1
 }
 

@@ -21,11 +21,18 @@ SIM_DIR=$E2E_TMP
 # limit (300 s, scaled). A fixed 120 s ended the main simulator mid-script under memcheck on a
 # loaded machine ("no such device" from port_in_use on).
 SIM_WRAP=(timeout -k 2 "$(e2e_scaled 300)")
-BIG_MARGIN=250000
+# (1 s: beside stress-ng --cpu 2 the simulator went unscheduled for 0.3-1.6 s at times, and a
+# 250 ms margin failed a command's start-up read; it costs nothing where the reply comes.)
+BIG_MARGIN=1000000
 M=(--margin-us "$BIG_MARGIN")
-# Where absent ids are asked too (scan: 12 ids, 4 tries each; log's probe sweeps), each
-# miss costs a margin: 50 ms, still ten times what a busy machine stalls a pty exchange.
+# Where the simulator drops replies on purpose, each drop costs a margin: 250 ms there.
+MF=(--margin-us 250000)
+# Where absent ids are asked too (scan: 12 ids; log's probe sweeps), each miss costs a margin:
+# 50 ms where a retry is allowed for. A scan that must find every servo gets 500 ms and no
+# retry instead (6 s for the 12 absent ids): a loaded machine starved the simulator past
+# both tries of 50 ms, and past a single 250 ms.
 M50=(--margin-us 50000)
+MSCAN=(--margin-us 500000 --retries 0)
 
 trap 'sim_cleanup TERM' EXIT
 trap 'exit 130' INT TERM
@@ -68,7 +75,7 @@ log_lines() { grep -c '' "$1" 2>/dev/null || echo 0; }
 start_sim main --ids 1,2,3 --fault 3:0x200 || exit 1
 MAIN=$DEV MAIN_LOG=$E2E_TMP/main.log MAIN_PID=$SIM_PID
 
-e2e_run "$J288" --port "$MAIN" scan "${M50[@]}"
+e2e_run "$J288" --port "$MAIN" scan "${MSCAN[@]}"
 if [ $E2E_RC -eq 0 ] && grep -Eq '^1 +lock' <<<"$E2E_OUT" && grep -Eq '^2 ' <<<"$E2E_OUT" &&
     grep -Eq '^3 .*winding over-temperature' <<<"$E2E_OUT" && grep -q '3 servos answered' <<<"$E2E_OUT"; then
     e2e_pass scan_human
@@ -76,7 +83,7 @@ else
     e2e_fail scan_human "rc $E2E_RC out '$E2E_OUT' err '$E2E_ERR'"
 fi
 
-e2e_run "$J288" scan --port "$MAIN" --json "${M50[@]}"
+e2e_run "$J288" scan --port "$MAIN" --json "${MSCAN[@]}"
 expect_true scan_json_tool bash -c "printf '%s' '$E2E_OUT' | python3 -m json.tool >/dev/null"
 json_check scan_json '
 assert isinstance(o, list) and [s["id"] for s in o] == [1, 2, 3], o
@@ -122,21 +129,21 @@ expect_true hold_ends_with_lock bash -c "grep 'id=1 ' '$MAIN_LOG' | tail -n 1 | 
 
 # The output side keeps its old meaning: rotor / N, counted from where the rotor started at
 # power-up (so first, while servo 2 is near there).
-e2e_run "$J288" --port "$MAIN" move --id 2 --side output --pos 0.2 --speed 1 --duration 1.2 --json "${M[@]}"
+e2e_run "$J288" --port "$MAIN" move --id 2 --side output --pos 0.2 --speed 1 --duration "$(e2e_scaled 10)" --json "${M[@]}"
 json_check move_output_side '
 assert o["ended"] == "done" and o["side"] == "output", o
 pos = o["last_reply"]["output"]["pos_rad"]
 assert abs(pos - o["target_pos"]) < 0.02, (pos, o["target_pos"])
 assert abs(o["target_pos"] - 0.2) < 1e-3, o'
 # The joint frame (the default): the move ends at joint angle 0.2 wherever the servo started.
-e2e_run "$J288" --port "$MAIN" move --id 2 --pos 0.2 --speed 5 --duration 1.5 --json "${M[@]}"
+e2e_run "$J288" --port "$MAIN" move --id 2 --pos 0.2 --speed 5 --duration "$(e2e_scaled 10)" --json "${M[@]}"
 json_check move_reaches_target '
 assert o["ended"] == "done" and o["locked"] is True and o["side"] == "joint", o
 assert o["joint_known"] is True, o
 assert abs(o["joint_pos"] - 0.2) < 0.02, o["joint_pos"]
 assert abs(o["target_pos"] - 0.2) < 1e-9, o
-# A healthy servo and a 250 ms margin: a failed refresh is a fault (one is tolerated, for a
-# machine frozen for a quarter of a second).
+# A healthy servo and the long margin: a failed refresh is a fault (one is tolerated, for a
+# machine frozen longer than the margin).
 assert o["commands"] >= 1 and o["replies"] + o["failures"] == o["commands"], o
 assert o["failures"] <= max(1, o["commands"] // 20), o'
 expect_true move_ends_with_lock bash -c "grep 'id=2 ' '$MAIN_LOG' | tail -n 1 | grep -q 'status=0'"
@@ -164,7 +171,7 @@ CSV=$E2E_TMP/log.csv
 e2e_run "$J288" --port "$MAIN" log --id 1,2,3 --rate 200 --duration 0.5 --swing 0.1 --csv "$CSV" --json "${M[@]}"
 # Counters, not speed: a slow machine runs fewer cycles (and skips ticks) but never more
 # than the 100 ticks of 0.5 s at 200 Hz; with the long margin a healthy servo's failure is a
-# fault (one each is tolerated, for a machine frozen for a quarter of a second).
+# fault (one each is tolerated, for a machine frozen longer than the margin).
 json_check log_json "
 assert 1 <= o['cycles'] <= 100 and o['achieved_hz'] > 0, o
 assert o['cycles'] + o['skipped_ticks'] <= o['elapsed_s'] * 200 + 1, o
@@ -325,16 +332,21 @@ stop_sim "$SIM_PID"
 # dropped and 5 corrupted (the first logged cycle fails for servos 1 and 2, however few
 # cycles a slow machine runs), and no three replies in a row fail among the first 700 (so the
 # final lock of each servo, three attempts, is always confirmed). --side output: the joint
-# side's probe takes more sweeps (the joints' starts), which would shift that sequence.
+# side's probe takes more sweeps (the joints' starts), which would shift that sequence. A
+# simulator starved past the margin shifts it too (a timeout in the sweep, whose retries then
+# meet replies 4 and 5, or a reply 5 that comes late): where they fell is then checked only
+# when the sweep and the locks took their six transactions and no reply came late.
 start_sim faultylog --ids 1,2,3 --seed 930 --drop 0.05 --corrupt 0.05 --noise 0.05 || exit 1
-e2e_run "$J288" --port "$DEV" log --id 1,2,3 --rate 200 --duration 1 --hold --side output --csv "$E2E_TMP/f.csv" --json "${M[@]}"
+e2e_run "$J288" --port "$DEV" log --id 1,2,3 --rate 200 --duration 1 --hold --side output --csv "$E2E_TMP/f.csv" --json "${MF[@]}"
 json_check faulty_log_counts "
 b = o['bus']
-assert b['timeouts'] >= 1 and b['crc_errors'] >= 1, b
+assert b['timeouts'] + b['crc_errors'] >= 2, b
 assert b['transactions'] == b['ok'] + b['timeouts'] + b['crc_errors'] + b['wrong_id'] + b['collisions'] + b['line_errors'], b
 s = o['servos']
 assert all(x['replies'] + x['failures'] == o['cycles'] for x in s), s
-assert s[0]['failures'] >= 1 and s[1]['failures'] >= 1, s
+if b['transactions'] - 3 * o['cycles'] == 6 and b['stale_bytes'] == 0:
+    assert b['timeouts'] >= 1 and b['crc_errors'] >= 1, b
+    assert s[0]['failures'] >= 1 and s[1]['failures'] >= 1, s
 import csv
 rows = list(csv.DictReader(open('$E2E_TMP/f.csv')))
 bad = [r for r in rows if r['ok'] == '0']
@@ -347,7 +359,7 @@ stop_sim "$SIM_PID"
 # three attempts). (Under a shared simulator this once failed on a loaded machine: the
 # position query met a fault because the sequence had moved on by a speed-dependent count.)
 start_sim faultymove --ids 2 --seed 32 --drop 0.1 --corrupt 0.1 || exit 1
-e2e_run "$J288" --port "$DEV" move --id 2 --pos 0.1 --duration 1 --retries 0 --json "${M[@]}"
+e2e_run "$J288" --port "$DEV" move --id 2 --pos 0.1 --duration 1 --retries 0 --json "${MF[@]}"
 json_check faulty_move_completes '
 assert o["ended"] == "done" and o["locked"] is True, o
 assert o["failures"] >= 1 and o["replies"] + o["failures"] == o["commands"], o'

@@ -13,11 +13,20 @@ cd "$(dirname "$0")/../.."
 . test/e2e/lib_e2e.sh
 SIM_DIR=$E2E_TMP
 . test/e2e/lib_sim.sh
-TMUX_SOCK=j288-top-$$
+# Each session gets a server of its own (socket j288-top-PID-N): a session started while the
+# last one's server was still exiting met "server exited unexpectedly" on a loaded machine.
+TOP_N=0
+TMUX_SOCK=j288-top-$$-$TOP_N
 tmux_do() { tmux -L "$TMUX_SOCK" -f /dev/null "$@"; }
 cleanup() {
+    local n
     [ "$BASHPID" = "$$" ] || return 0
-    command -v tmux >/dev/null && tmux_do kill-server 2>/dev/null
+    if command -v tmux >/dev/null; then
+        for n in $(seq 0 "$TOP_N"); do
+            tmux -L "j288-top-$$-$n" kill-server 2>/dev/null
+            rm -f "${TMUX_TMPDIR:-/tmp}/tmux-$(id -u)/j288-top-$$-$n"
+        done
+    fi
     sim_cleanup TERM
 }
 trap cleanup EXIT
@@ -78,6 +87,8 @@ fi
 # start_top: j288 top in a fresh tmux session; its exit status goes to top.rc.
 start_top() {
     rm -f "$E2E_TMP/top.rc"
+    TOP_N=$((TOP_N + 1))
+    TMUX_SOCK=j288-top-$$-$TOP_N
     tmux_do new-session -d -s top -x 150 -y 30 \
         "env -u J288_QUIET '$J288' top --config '$CFG' --interval 0.1 --rate 50; echo \$? >'$E2E_TMP/top.rc'"
 }

@@ -21,11 +21,10 @@ PY=${PYTHON:-python3}
 export J288_LIB=${J288_LIB:-$BUILD/lib/libj288.so}
 export PYTHONPATH=${J288_PYTHON_DIR:-$PWD/python}${PYTHONPATH:+:$PYTHONPATH}
 SILENCE=1.5 # longer than the servo's 1 s watchdog: the scenario, not a bound
-SAG_MAX=0.1 # rad: kp 20 against 2 N*m holds within 0.1 rad; a tripped servo falls freely
-# Under memcheck (make test-valgrind sets TEST_TIME_SCALE) the tool's hold loop runs far below
-# its rate, so the joint sags further between commands (0.157 rad seen); a tripped servo still
-# falls by radians.
-[ "${TEST_TIME_SCALE:-1}" -gt 1 ] && SAG_MAX=0.3
+# rad: kp 20 against 2 N*m holds within 0.1 rad at the hold's rate; where the hold loop runs
+# far below its rate (a loaded machine: 0.128 rad seen; memcheck: 0.157) the joint sags
+# further between commands, and a tripped servo falls by radians: 0.3 tells the two apart.
+SAG_MAX=0.3
 
 logged() { # FILE NEEDLE [FROM_LINE]: wait (bounded, 20 s) until the simulator has logged it
     for _ in $(seq 1 400); do
@@ -232,7 +231,7 @@ t_cli_reports_a_trip() {
         fi
         pid=$!
         BG_PIDS+=("$pid")
-        logged "$LOG" ' id=1 status=1 wd=1' || { echo "$form: no FOC"; return 1; }
+        logged "$LOG" ' id=1 status=1 wd=1' || { echo "$form: no FOC: $(cat "$SIM_DIR/t.err")"; return 1; }
         kill -STOP "$pid"; sleep "$SILENCE"; kill -CONT "$pid"
         wait_exit "$pid" 60; rc=$?
         [ $rc -eq 1 ] && grep -q 'had tripped its watchdog' "$SIM_DIR/t.err" ||

@@ -38,7 +38,7 @@ t_beyond_limit() {
     timeout -k 2 "$CMD_TIMEOUT" "$J288" calibrate --joint j --config "$cfg" "${M[@]}" >"$E2E_TMP/cal.out" 2>&1 ||
         { echo "calibrate at the limit: $(cat "$E2E_TMP/cal.out")"; return 1; }
     grep -q '^    phase: ' "$cfg" || { echo "no phase written: $(cat "$cfg")"; return 1; }
-    move_joint j "$cfg" --pos 0.1 --speed 1 --duration 1 || return 1
+    move_joint j "$cfg" --pos 0.1 --speed 1 --duration "$(e2e_scaled 10)" || return 1
     truth_now && near "$(truth_val 1 theta)" 0.302 0.005 || return 1
     cfg=$(config b2 "  - name: j" "    id: 1" "    zero: 0.5" "    limits: [0.0, 0.5]")
     expect_bad beyond_limit_far_refused 2 "^j288 move: joint j: at -0.19[0-9]* rad, 0.19[0-9]* rad outside its limits \\[0, 0.5\\] \\(more than 0.05\\): move it inside by hand or with --side output; servo locked$" \

@@ -14,6 +14,8 @@ SIM_DIR=$E2E_TMP
 # (3 retries: a simulator starved past the margin twice in a row, seen at load 18, is not a
 # failure of what these scripts check; every check is on where the joint ended)
 M=(--margin-us 250000 --retries 3)
+# A move's --duration is a bound ("$(e2e_scaled 10)"): the move ends once there, and 1-2.5 s
+# cut moves short on a loaded machine (exit 1).
 E2E_CMD_TIMEOUT=60
 CMD_TIMEOUT=$(e2e_scaled 60)
 

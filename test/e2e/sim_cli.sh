@@ -119,19 +119,27 @@ t_fault_switch() {
     kill -s TERM "$SIM_PID"; wait_exit "$SIM_PID" 20 || return 1
     grep -q '^j288-sim: stats: .* commands 18 .* replies 16 dropped 2 ' "$E2E_TMP/err"
 }
-# A reply delayed before SIGUSR1 still goes out when due (counted as sent); it does not
-# disturb the clean exchanges after the switch.
+# A reply delayed before SIGUSR1 still goes out when due (counted as sent, nothing lost); it
+# does not disturb the clean exchanges after the switch. The test keeps the pty open (fd 9,
+# raw), so that the status client's exit is no hang-up (which drops what was queued for the
+# departed client), and waits for the late reply's 26 bytes on it: a condition, not a sleep.
+# The delay (3 s, scaled, at most the simulator's 10 s) is far beyond the stalls of a loaded
+# machine: the failing status must have given up long before the reply comes.
 t_fault_switch_late_in_flight() {
+    local late_s=$(($(e2e_scaled 3) < 10 ? $(e2e_scaled 3) : 10)) rc
     [ -x "$J288" ] || { echo "$J288 not built"; return 1; }
-    start_sim --ids 1 --late 1 --late-us 400000 --exit-after "$(e2e_scaled 120)" || return 1
-    status_fails || { echo "status succeeded with the reply 400 ms late"; return 1; }
+    start_sim --ids 1 --late 1 --late-us "${late_s}000000" --exit-after "$(e2e_scaled 120)" || return 1
+    exec 9<>"$SIM_PTY" && stty raw -echo <&9 || return 1
+    status_fails || { echo "status succeeded with the reply $late_s s late"; return 1; }
     kill -s USR1 "$SIM_PID"
     wait_err '^j288-sim: faults off: stats: .* late 1 ' || { echo "no ack"; return 1; }
     status_ok || { echo "status failed after SIGUSR1: $(cat "$E2E_TMP/st")"; return 1; }
-    sleep 0.5 # the late reply is out now
+    timeout "$((late_s + $(e2e_scaled 20)))" head -c 26 <&9 >"$E2E_TMP/late"; rc=$?
+    exec 9<&-
+    [ $rc -eq 0 ] && [ "$(wc -c <"$E2E_TMP/late")" -eq 26 ] || { echo "the late reply never came"; return 1; }
     status_ok || { echo "status failed after the late reply: $(cat "$E2E_TMP/st")"; return 1; }
     kill -s TERM "$SIM_PID"; wait_exit "$SIM_PID" 20 || return 1
-    grep -q '^j288-sim: stats: .* commands 17 .* replies 17 dropped 0 corrupted 0 late 1 ' "$E2E_TMP/err"
+    grep -q '^j288-sim: stats: .* commands 17 .* replies 17 dropped 0 corrupted 0 late 1 .* lost 0 ' "$E2E_TMP/err"
 }
 
 # ---- the joint and the truth file ---------------------------------------------------------

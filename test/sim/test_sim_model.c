@@ -241,6 +241,23 @@ static void test_watchdog_trips_and_clears(void)
     TEST_ASSERT_FALSE(s->wd_tripped);
 }
 
+/* A stretch the simulator did not run (starved) is not the host's silence; the silence
+ * before and after it still counts. */
+static void test_watchdog_excuses_the_simulators_stall(void)
+{
+    j288_cmd_raw_t c = lock_cmd(1, true);
+    j288_sim_servo_t *s;
+    bus_up(1u << 1, NULL, NULL);
+    s = j288_sim_bus_servo(&g_bus, 1);
+    send_cmd(&c, 0);
+    j288_sim_bus_advance(&g_bus, 100000);
+    j288_sim_bus_excuse_stall(&g_bus, 100000, 900000); /* 0.8 s asleep */
+    j288_sim_bus_advance(&g_bus, 1700000);               /* 0.9 s of silence counted */
+    TEST_ASSERT_FALSE(s->wd_tripped);
+    j288_sim_bus_advance(&g_bus, 1801000); /* 1.001 s */
+    TEST_ASSERT_TRUE(s->wd_tripped);
+}
+
 static void test_watchdog_fed_by_commands(void)
 {
     j288_cmd_raw_t c = lock_cmd(1, true);
@@ -784,6 +801,7 @@ int main(void)
     RUN_TEST(test_foc_law_torque_sign_and_saturation);
     RUN_TEST(test_watchdog_trips_and_clears);
     RUN_TEST(test_watchdog_fed_by_commands);
+    RUN_TEST(test_watchdog_excuses_the_simulators_stall);
     RUN_TEST(test_bad_crc_no_reply_and_checksum_fault);
     RUN_TEST(test_broadcast_obeyed_silently);
     RUN_TEST(test_split_and_noisy_input);

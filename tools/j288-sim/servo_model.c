@@ -441,6 +441,27 @@ j288_sim_servo_t *j288_sim_bus_servo(j288_sim_bus_t *b, uint8_t id)
     return &b->servo[id];
 }
 
+/* The watchdog's silence clock held over [from_us, to_us): its last command moves later by
+ * the part of the stretch that came after it. */
+static void excuse_stall(j288_sim_servo_t *s, uint64_t from_us, uint64_t to_us)
+{
+    uint64_t start = s->last_cmd_us > from_us ? s->last_cmd_us : from_us;
+    if (start < to_us)
+        s->last_cmd_us += to_us - start;
+}
+
+void j288_sim_bus_excuse_stall(j288_sim_bus_t *b, uint64_t from_us, uint64_t to_us)
+{
+    uint8_t id;
+    for (id = 0u; id < J288_MAX_SERVOS; id++) {
+        if ((b->present & (1u << id)) == 0u)
+            continue;
+        excuse_stall(&b->servo[id], from_us, to_us);
+        if (has_dup(b, id))
+            excuse_stall(&b->dup[id], from_us, to_us);
+    }
+}
+
 void j288_sim_bus_advance(j288_sim_bus_t *b, uint64_t now_us)
 {
     uint8_t id;

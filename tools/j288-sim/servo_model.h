@@ -252,6 +252,12 @@ void j288_sim_bus_feed(j288_sim_bus_t *b, const uint8_t *data, size_t len, uint6
 /* Advance every servo to now_us (call now and then, e.g. every 10 ms, when idle). */
 void j288_sim_bus_advance(j288_sim_bus_t *b, uint64_t now_us);
 
+/* The simulator itself did not run from from_us to to_us (a starved process woke late):
+ * what the host sent meanwhile waits unread, so no servo's watchdog counts that stretch as
+ * the host's silence (each one's silence clock is held for it). Call before the servos
+ * advance past from_us. */
+void j288_sim_bus_excuse_stall(j288_sim_bus_t *b, uint64_t from_us, uint64_t to_us);
+
 /* Servo id's state, or NULL when it is not on the bus. */
 j288_sim_servo_t *j288_sim_bus_servo(j288_sim_bus_t *b, uint8_t id);
 

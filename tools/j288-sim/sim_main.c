@@ -761,6 +761,18 @@ static bool read_input(sim_io_t *io, j288_sim_bus_t *bus)
     }
 }
 
+/* Woken at now_us for a wake due at wake_us, with the host's bytes waiting: a wake that late
+ * means this process was not scheduled (a loaded machine) while what the host sent sat unread
+ * in the pty, so the watchdogs must not count the stretch as the host's silence. A late wake
+ * with nothing waiting excuses nothing: the host was silent, and the small delays of every
+ * tick on a loaded machine would otherwise add up and hold off a trip the host earned. */
+static void excuse_oversleep(j288_sim_bus_t *bus, bool input_waiting, uint64_t wake_us,
+                             uint64_t now_us)
+{
+    if (input_waiting && now_us > wake_us)
+        j288_sim_bus_excuse_stall(bus, wake_us, now_us);
+}
+
 static void serve(sim_io_t *io, j288_sim_bus_t *bus, uint64_t exit_at_us, const sigset_t *mask)
 {
     uint64_t last_tick = 0;
@@ -791,9 +803,12 @@ static void serve(sim_io_t *io, j288_sim_bus_t *bus, uint64_t exit_at_us, const 
         rc = ppoll(&pfd, 1, &ts, mask);
         if (rc < 0 && errno != EINTR)
             die("poll: %s", strerror(errno));
+        excuse_oversleep(bus, rc > 0 && (pfd.revents & POLLIN) != 0, wake, sim_now_us(io));
         if (rc <= 0)
             continue;
-        if (!read_input(io, bus) || (pfd.revents & POLLHUP) != 0) {
+        /* read() decides whether a client is there: the poll's hang-up may be stale (a
+         * client that opened the pty since, and whose first command was just read). */
+        if (!read_input(io, bus)) {
             /* No client: the master reports hang-up until one opens the pty. Nap rather
              * than spin; replies still queued for a departed client are dropped. */
             io->lost_no_client += io->qlen;
