@@ -22,9 +22,11 @@ export J288_LIB=${J288_LIB:-$BUILD/lib/libj288.so}
 export PYTHONPATH=${J288_PYTHON_DIR:-$PWD/python}${PYTHONPATH:+:$PYTHONPATH}
 SILENCE=1.5 # longer than the servo's 1 s watchdog: the scenario, not a bound
 # rad: kp 20 against 2 N*m holds within 0.1 rad at the hold's rate; where the hold loop runs
-# far below its rate (a loaded machine: 0.128 rad seen; memcheck: 0.157) the joint sags
-# further between commands, and a tripped servo falls by radians: 0.3 tells the two apart.
-SAG_MAX=0.3
+# far below its rate the joint sags further between commands (a loaded machine: 0.128 rad
+# seen; memcheck: 0.157, and 0.345 in one CI run). What tells a held joint from a tripped
+# servo is the simulator's own count of watchdog trips (sim_trips); the sag only confirms
+# that the second session moved the joint toward its pose.
+SAG_MAX=0.6
 
 logged() { # FILE NEEDLE [FROM_LINE]: wait (bounded, 20 s) until the simulator has logged it
     for _ in $(seq 1 400); do
@@ -43,16 +45,42 @@ fresh_sim() { # NAME [more simulator options]
     local name=$1; shift
     [ -n "${SIM_PID:-}" ] && stop_sim "$SIM_PID"
     sim_start_linked "$name" --ids 1 --load-torque 2 --exit-after "$(e2e_scaled 120)" "$@" || return 1
+    SIM_NAME=$name
+    STATS_SIG=USR1
     LOG=$SIM_DIR/$name.log
     CFG=$SIM_DIR/$name.yaml
     printf 'buses:\n  - {name: b, port: %s, margin_us: 250000}\njoints:\n  - {name: hip, bus: b, id: 1, clamp: true}\n' \
         "$DEV" >"$CFG"
 }
 
+# sim_trips: TRIPS = the simulator's watchdog trips so far, from the statistics line it prints when
+# its wire faults are switched (none are configured here: SIGUSR1 and SIGUSR2 in turn).
+# Bounded (10 s, scaled); fails when no line came.
+STATS_SIG=USR1
+sim_trips() {
+    local err=$SIM_DIR/$SIM_NAME.err n
+    n=$(grep -c 'stats: ' "$err")
+    kill -s "$STATS_SIG" "$SIM_PID" || return 1
+    if [ "$STATS_SIG" = USR1 ]; then STATS_SIG=USR2; else STATS_SIG=USR1; fi
+    for _ in $(seq 1 "$(e2e_scaled 200)"); do
+        if [ "$(grep -c 'stats: ' "$err")" -gt "$n" ]; then
+            TRIPS=$(grep 'stats: ' "$err" | tail -n 1 | sed -n 's/.* watchdog-trips \([0-9]*\) .*/\1/p')
+            [ -n "$TRIPS" ]
+            return
+        fi
+        sleep 0.05
+    done
+    echo "no statistics from the simulator" >&2
+    return 1
+}
+
 # second_hold: the second session after the silence: the robot form's hold (by log --hold,
-# which writes the positions), exit 0, and the joint held: its last angle within SAG_MAX of
-# the hold pose.
+# which writes the positions), exit 0, no watchdog trip from the start of the silence to the
+# end of the hold, and the joint held: its last angle within SAG_MAX of the hold pose.
 second_hold() {
+    local before
+    sim_trips || return 1
+    before=$TRIPS
     sleep "$SILENCE"
     "$J288" --config "$CFG" log --hold --duration 1 --rate 200 --csv "$SIM_DIR/h.csv" \
         >"$SIM_DIR/h.out" 2>"$SIM_DIR/h.err" || { echo "log --hold: $(cat "$SIM_DIR/h.err")"; return 1; }
@@ -63,7 +91,9 @@ second_hold() {
             last = $col["pos_rad"]; if (first == "") first = last
             des = col["pos_des_rad"] ? $col["pos_des_rad"] : first }
         END { sag = des - last; if (sag < 0) sag = -sag; print "sag " sag " rad";
-              exit !(last != "" && sag < max) }' "$SIM_DIR/h.csv"
+              exit !(last != "" && sag < max) }' "$SIM_DIR/h.csv" || return 1
+    sim_trips || return 1
+    [ "$TRIPS" = "$before" ] || { echo "watchdog trips $before -> $TRIPS"; return 1; }
 }
 
 t_after_cli_single() {
