@@ -129,7 +129,7 @@ $(eval $(call STM32_HOST_TEST,test_stm32_port_h7,stm32host-h7,-DJ288_STUB_H7))
 HOST_TESTS += $(CLI_TEST) $(foreach v,$(CODEC_CRC_VARIANTS),$(CODEC_CRC_TEST_NAMES:%=$(BUILD)/crc-$(v)/test/%)) \
     $(FUZZ_REPLAY_TESTS) $(LINUX_PORT_TEST) $(CONFIG_TEST) $(SIM_MODEL_TEST) $(STM32_TEST) \
     $(STM32_G4_TEST) $(STM32_H7_TEST)
-TEST_SCRIPTS += test/e2e/cli_offline.sh test/e2e/cli_bus.sh tools/vectors/check-drift.sh \
+TEST_SCRIPTS += test/e2e/cli_offline.sh test/e2e/cli_bus.sh test/e2e/cli_bus_faults.sh tools/vectors/check-drift.sh \
     test/e2e/sim_cli.sh test/e2e/example_linux.sh test/abi/check-abi.sh
 # The joint frame end to end against the simulator's truth (the tool, the config, the sim),
 # in three scripts that run side by side (test/e2e/lib_joint.sh).

@@ -45,7 +45,7 @@ offers commands "j288 " $cmds
 offers_exactly command_prefix "j288 cal" calibrate
 offers global_options "j288 --" --port --baud --config --version
 offers_exactly global_option_prefix "j288 --con" --config
-offers move_options "j288 move --" --pos --speed --side --id --joint --config --duration
+offers move_options "j288 move --" --pos --speed --side --id --joint --config --duration --arrive
 offers move_options_after_port "j288 --port /dev/ttyUSB0 move --po" --port --pos
 offers_exactly side_values "j288 move --side " "joint output rotor"
 cfg=$E2E_TMP/robot.yaml

@@ -56,9 +56,9 @@ t_direction() {
 t_power_cycle_while_driving() {
     local pid i rc n0
     start_sim drive --ids 1 --start-angle 1:0 --power-off-ms 100 --quiet || return 1
-    # (--duration bounds the move, which ends once there: 1 s cut it short on a loaded machine;
+    # (--duration bounds the move, which ends once settled: 1 s cut it short on a loaded machine;
     # the watchdog off, as move_joint's: a positioning move, on a machine that may starve it)
-    "$J288" --port "$DEV" move --id 1 --pos 1.0 --speed 4 --duration "$(e2e_scaled 10)" --watchdog off "${M[@]}" >/dev/null ||
+    "$J288" --port "$DEV" move --id 1 --pos 1.0 --speed 4 --duration "$(e2e_scaled 10)" "${ARRIVE[@]}" --watchdog off "${M[@]}" >/dev/null ||
         { echo "move to 1.0 failed"; return 1; }
     n0=$(foc_frames 1) # the move's: hold's own 200 are waited for (not a total, which a
     # slower move once reached alone, so that the power cycle came before hold drove)

@@ -25,7 +25,7 @@ t_seed() {
     done
     # move --pos X ends at joint angle X (the servo's own control: a few mrad).
     target=$(python3 -c 'import random, sys; random.seed(int(sys.argv[1])); print(round(random.uniform(-2.5, 2.5), 4))' "$seed")
-    e2e_run "$J288" --port "$DEV" move --id 1 --pos "$target" --speed 4 --duration "$(e2e_scaled 10)" --watchdog off --json "${M[@]}"
+    e2e_run "$J288" --port "$DEV" move --id 1 --pos "$target" --speed 4 --duration "$(e2e_scaled 10)" "${ARRIVE[@]}" --watchdog off --json "${M[@]}"
     [ "$E2E_RC" -eq 0 ] || { echo "seed $seed: move: $E2E_ERR"; return 1; }
     truth_now || return 1
     near "$(truth_val 1 theta)" "$target" 0.005 "$TWO_PI" || { echo "seed $seed: move to $target ended off"; return 1; }

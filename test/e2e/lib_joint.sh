@@ -14,8 +14,10 @@ SIM_DIR=$E2E_TMP
 # (3 retries: a simulator starved past the margin twice in a row, seen at load 18, is not a
 # failure of what these scripts check; every check is on where the joint ended)
 M=(--margin-us 250000 --retries 3)
-# A move's --duration is a bound ("$(e2e_scaled 10)"): the move ends once there, and 1-2.5 s
-# cut moves short on a loaded machine (exit 1).
+# A move's --duration is a bound ("$(e2e_scaled 10)"; 1-2.5 s cut moves short on a loaded
+# machine, exit 1); it ends once settled within ARRIVE (rad, rad/s): below the checks' 0.005
+# and above the simulator's steady error at the default kp (friction: some 3 mrad).
+ARRIVE=(--arrive 0.004)
 E2E_CMD_TIMEOUT=60
 CMD_TIMEOUT=$(e2e_scaled 60)
 
@@ -74,7 +76,7 @@ status_joint() { # NAME CONFIG: status --joint NAME --config CONFIG (the port fr
 # on where the joint ends, the watchdog has its own tests)
 move_joint() { # NAME CONFIG MOVE-OPTIONS...: move --joint NAME --config CONFIG, quiet unless it fails
     local name=$1 cfg=$2; shift 2
-    timeout -k 2 "$CMD_TIMEOUT" "$J288" move --joint "$name" --config "$cfg" --watchdog off "${M[@]}" "$@" >/dev/null 2>"$E2E_TMP/mv.err" ||
+    timeout -k 2 "$CMD_TIMEOUT" "$J288" move --joint "$name" --config "$cfg" --watchdog off "${ARRIVE[@]}" "${M[@]}" "$@" >/dev/null 2>"$E2E_TMP/mv.err" ||
         { echo "move --joint $name $*: exit $?: $(cat "$E2E_TMP/mv.err")"; return 1; }
 }
 foc_frames() { grep -c "id=$1 status=1 " "$SLOG"; }

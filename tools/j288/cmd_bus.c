@@ -147,6 +147,7 @@ enum {
     OPT_DURATION,
     OPT_WATCHDOG,
     OPT_KEEP,
+    OPT_ARRIVE,
     OPT_RANGE
 };
 
@@ -329,6 +330,7 @@ typedef struct {
     double duration_s; /* < 0: until a signal */
     bool watchdog;
     bool keep;
+    double arrive; /* move --arrive: the tolerance in rad (on the move's side); < 0: none */
     /* The joint (side joint) */
     cli_joint_sel_t sel;
     j288_joint_t j;
@@ -404,6 +406,15 @@ static int parse_drive_opt(void *ctx, int key, const char *v)
         return 0;
     case OPT_KEEP:
         d->keep = true;
+        return 0;
+    case OPT_ARRIVE:
+        if (cli_parse_real("--arrive", v, &d->arrive) != 0) {
+            return -1;
+        }
+        if (!(d->arrive > 0.0 && d->arrive <= 1.0)) {
+            cli_error("--arrive: %s is out of range (0, 1] rad", v);
+            return -1;
+        }
         return 0;
     default:
         return 1;
@@ -602,6 +613,7 @@ typedef struct {
     j288_cmd_raw_t last_cmd;
     double last_target; /* side joint: the latest target position */
     bool reached;       /* move: the ramp got to --pos */
+    bool arrived;       /* move --arrive: reached, and the servo within the tolerance */
     bool progress;      /* a progress line is on the terminal */
     double shown_s;     /* when it was last redrawn */
 } drive_result_t;
@@ -705,7 +717,7 @@ static void drive_report(const drive_args_t *d, const drive_result_t *r, const c
 }
 
 typedef enum {
-    DRIVE_END_DONE,   /* --duration reached */
+    DRIVE_END_DONE,   /* --duration reached, or the move arrived (--arrive) */
     DRIVE_END_SIGNAL, /* SIGINT or SIGTERM */
     DRIVE_END_GONE,   /* the device went away: nothing can be sent any more */
     DRIVE_END_SILENT, /* the servo stopped answering: lock already sent */
@@ -778,6 +790,24 @@ static int joint_command_at(drive_args_t *d, const drive_plan_t *p, double t,
     return 0;
 }
 
+/* --arrive: the servo within TOL rad of --pos and slower than TOL rad/s (settled, so that
+ * the lock that follows does not leave it coasting), from the latest reply, on the move's
+ * side. */
+static bool drive_settled(const drive_args_t *d, const drive_plan_t *p, const drive_result_t *r)
+{
+    double err, speed;
+    if (d->side == SIDE_JOINT) {
+        const j288_joint_state_t *st = j288_joint_state(&d->j);
+        err = (double)st->pos - d->pos;
+        speed = (double)st->speed;
+    } else {
+        err = (double)j288_pos_from_raw(r->last.pos, side_of(d)) -
+              (double)j288_pos_from_raw(p->target_pos, side_of(d));
+        speed = (double)j288_speed_from_raw(r->last.speed, side_of(d));
+    }
+    return fabs(err) <= d->arrive && fabs(speed) <= d->arrive;
+}
+
 /* One refresh: the command at time t, sent and counted. Returns the transfer's result, or
  * J288_ERR_ANGLE_UNKNOWN when the joint refused the target or lost its angle (reported). */
 static int drive_step(cli_bus_t *b, drive_args_t *d, const drive_plan_t *p, double t,
@@ -812,6 +842,7 @@ static int drive_step(cli_bus_t *b, drive_args_t *d, const drive_plan_t *p, doub
                 return J288_ERR_ANGLE_UNKNOWN;
             }
         }
+        res->arrived = d->arrive > 0.0 && res->reached && drive_settled(d, p, res);
     } else if (rc != J288_ERR_OFFLINE) {
         res->failed++;
     }
@@ -837,6 +868,9 @@ static drive_end_t drive_loop_run(cli_bus_t *b, drive_args_t *d, const drive_pla
         }
         rc = drive_step(b, d, p, t, res);
         drive_progress(d, res, t);
+        if (res->arrived) {
+            return DRIVE_END_DONE;
+        }
         if (rc == J288_ERR_OFFLINE) {
             drive_progress_end(res);
             cli_report_txn_failure(b, (uint8_t)d->id, rc);
@@ -892,11 +926,14 @@ static int drive_finish(cli_bus_t *b, const drive_args_t *d, const drive_result_
             return cli_stop_signal != 0 ? cli_signal_exit_code() : CLI_EXIT_FAIL;
         }
     }
-    if (d->kind == DRIVE_MOVE && end == DRIVE_END_DONE && !res->reached) {
-        /* --duration ended the ramp before --pos: say so, and fail (a script must know). */
+    if (d->kind == DRIVE_MOVE && end == DRIVE_END_DONE &&
+        !(d->arrive > 0.0 ? res->arrived : res->reached)) {
+        /* --duration ended the move before --pos (or before the servo got there, with
+         * --arrive): say so, and fail (a script must know). */
         drive_report(d, res, "cut short by --duration", json);
-        cli_error("the move ended after --duration %g s before reaching --pos %g (%s)",
-                  d->duration_s, d->pos, d->keep ? "last target left in force" : "servo locked");
+        cli_error("the move ended after --duration %g s before %s --pos %g (%s)", d->duration_s,
+                  res->reached ? "the servo settled within --arrive of" : "reaching", d->pos,
+                  d->keep ? "last target left in force" : "servo locked");
         return CLI_EXIT_FAIL;
     }
     drive_report(d, res, end == DRIVE_END_SIGNAL ? "stopped by signal" : "done", json);
@@ -974,6 +1011,7 @@ static void drive_args_init(drive_args_t *d, drive_kind_t kind)
     d->rate_hz = DEFAULT_RATE_HZ;
     d->duration_s = -1.0;
     d->watchdog = true;
+    d->arrive = -1.0;
 }
 
 static const char hold_help[] =
@@ -1008,6 +1046,10 @@ static const char move_help[] =
     "joint or output side), then hold there. On the joint side (the default) --pos is the\n"
     "absolute joint angle: the move ends at joint angle RAD whatever the rotor did since\n"
     "power-up. Default gains: the config's kp and kd, else kp 20 N*m/rad, kd 2.5 N*m*s/rad.\n"
+    "  --arrive TOL     end (done, exit 0) as soon as the ramp is at --pos and the servo\n"
+    "                   has settled there: within TOL rad, slower than TOL rad/s (on the\n"
+    "                   move's side; 0 < TOL <= 1); --duration then bounds the wait: not\n"
+    "                   there by then, the move is cut short (exit 1)\n"
     DRIVE_COMMON_HELP "\n" CLI_BUS_COMMON_HELP;
 
 int cli_cmd_move(int argc, char **argv, const cli_global_t *g)
@@ -1016,6 +1058,7 @@ int cli_cmd_move(int argc, char **argv, const cli_global_t *g)
                                      {"--speed", true, OPT_SPEED},
                                      {"--kp", true, OPT_KP},
                                      {"--kd", true, OPT_KD},
+                                     {"--arrive", true, OPT_ARRIVE},
                                      DRIVE_OPTS,
                                      {NULL, false, 0}};
     static drive_args_t d;
