@@ -53,13 +53,15 @@ t_path_link_exit_after() {
     [ ! -e "$E2E_TMP/bus" ] && grep -q '^j288-sim: stats: ' "$E2E_TMP/err"
 }
 t_signals() {
-    local sig
+    local sig rc
     for sig in TERM INT; do
         start_sim --exit-after "$(e2e_scaled 120)" || return 1
-        [ -n "$SIM_PTY" ] || return 1
+        [ -n "$SIM_PTY" ] || { echo "SIG$sig: no path line: $(cat "$E2E_TMP/err")"; return 1; }
         kill -s "$sig" "$SIM_PID"
-        wait_exit "$SIM_PID" 20 || return 1
-        grep -q '^j288-sim: stats: ' "$E2E_TMP/err" || return 1
+        wait_exit "$SIM_PID" 20
+        rc=$?
+        [ $rc -eq 0 ] && grep -q '^j288-sim: stats: ' "$E2E_TMP/err" ||
+            { echo "SIG$sig: exit $rc, stderr: $(cat "$E2E_TMP/err")"; return 1; }
     done
 }
 # wait_file FILE PATTERN: up to 30 s (a loaded machine, or valgrind) for a line of FILE to
