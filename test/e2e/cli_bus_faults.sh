@@ -30,17 +30,22 @@ stop_sim "$SIM_PID"
 # final lock of each servo, three attempts, is always confirmed). --side output: the joint
 # side's probe takes more sweeps (the joints' starts), which would shift that sequence. A
 # simulator starved past the margin shifts it too (a timeout in the sweep, whose retries then
-# meet replies 4 and 5, or a reply 5 that comes late): where they fell is then checked only
-# when the sweep and the locks took their six transactions and no reply came late.
+# meet replies 4 and 5, or a reply 5 that comes late): where they fell, and that each attempt
+# ended in exactly one outcome, is then checked only when the sweep and the locks took their
+# six transactions and no reply came late.
 start_sim faultylog --ids 1,2,3 --seed 930 --drop 0.05 --corrupt 0.05 --noise 0.05 || exit 1
 e2e_run "$J288" --port "$DEV" log --id 1,2,3 --rate 200 --duration 1 --hold --side output --csv "$E2E_TMP/f.csv" --json "${MF[@]}"
 json_check faulty_log_counts "
 b = o['bus']
 assert b['timeouts'] + b['crc_errors'] >= 2, b
-assert b['transactions'] == b['ok'] + b['timeouts'] + b['crc_errors'] + b['wrong_id'] + b['collisions'] + b['line_errors'], b
+seen = b['ok'] + b['timeouts'] + b['crc_errors'] + b['wrong_id'] + b['collisions'] + b['line_errors']
+assert seen >= b['transactions'], b
 s = o['servos']
 assert all(x['replies'] + x['failures'] == o['cycles'] for x in s), s
-if b['transactions'] - 3 * o['cycles'] == 6 and b['stale_bytes'] == 0:
+# (a window may also see a late reply of the window before, as a frame of another id or as
+# stale bytes, where the simulator was starved past the margin)
+if b['transactions'] - 3 * o['cycles'] == 6 and b['stale_bytes'] == 0 and b['wrong_id'] == 0:
+    assert seen == b['transactions'], b
     assert b['timeouts'] >= 1 and b['crc_errors'] >= 1, b
     assert s[0]['failures'] >= 1 and s[1]['failures'] >= 1, s
 import csv

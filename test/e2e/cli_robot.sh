@@ -69,11 +69,11 @@ t_sigint_stops_every_bus() {
 }
 t_bad_configs() {
     printf 'buses:\n  - {name: a, port: %s}\n  - {name: a, port: /dev/null}\njoints:\n  - {name: j, bus: a, id: 1}\n' \
-        "$(head -n1 "$E2E_TMP/pty.0")" >"$E2E_TMP/twice.yaml"
+        "$E2E_TMP/bus.0" >"$E2E_TMP/twice.yaml"
     "$J288" --config "$E2E_TMP/twice.yaml" status >"$E2E_TMP/out" 2>"$E2E_TMP/err"; [ $? -eq 1 ] || return 1
     [ ! -s "$E2E_TMP/out" ] && grep -q "twice.yaml:3" "$E2E_TMP/err" || return 1
     printf 'buses:\n  - {name: a, port: %s}\njoints:\n  - {name: j, bus: a, id: 1}\n  - {name: k, bus: a, id: 1}\n' \
-        "$(head -n1 "$E2E_TMP/pty.0")" >"$E2E_TMP/ids.yaml"
+        "$E2E_TMP/bus.0" >"$E2E_TMP/ids.yaml"
     "$J288" --config "$E2E_TMP/ids.yaml" log 2>"$E2E_TMP/err"; [ $? -eq 1 ] && grep -q "ids.yaml:5" "$E2E_TMP/err" || return 1
     printf 'buses:\n  - {name: a, port: /dev/j288-no-such}\njoints:\n  - {name: j, bus: a, id: 1}\n' >"$E2E_TMP/gone.yaml"
     "$J288" --config "$E2E_TMP/gone.yaml" status 2>"$E2E_TMP/err"; [ $? -eq 1 ] || return 1
@@ -113,10 +113,16 @@ t_one_bus_stops_answering() {
     grep -q '^bus leg2: .*, not answering$' "$E2E_TMP/out" && grep -q '^joint leg2_1: ' "$E2E_TMP/out" || return 1
     ! grep -q '^bus leg[01]: .*not answering' "$E2E_TMP/out" || return 1
     # A joint of leg0 or leg1 listed as stale: only for a time-out on its own bus (a loaded
-    # machine may starve a simulator past its margin once), never for leg2's freeze.
+    # machine may starve a simulator past its margin once), or in the one cycle cut at the 1 s
+    # limit (a host starved that long: 0.8-1 s was seen beside stress-ng), never for leg2's
+    # freeze (which would leave them stale cycle after cycle).
+    local cut=0
+    grep -Eq '^robot: .*worst cycle (1[0-9]{6}|[2-9][0-9]{6}) us' "$E2E_TMP/out" && cut=1
     for k in 0 1; do
-        ! grep -q "^joint leg${k}_" "$E2E_TMP/out" || grep -q "^bus leg$k: .* [1-9][0-9]* timeouts" "$E2E_TMP/out" ||
-            { echo "leg$k's joints stale without a time-out of their own"; return 1; }
+        grep -q "^bus leg$k: .* [1-9][0-9]* timeouts" "$E2E_TMP/out" && continue
+        ! grep -Eq "^joint leg${k}_.*stale in ([2-9]|[1-9][0-9]+)$" "$E2E_TMP/out" &&
+            { [ $cut -eq 1 ] || ! grep -q "^joint leg${k}_" "$E2E_TMP/out"; } ||
+            { echo "leg$k's joints stale without a time-out of their own:"; cat "$E2E_TMP/out"; return 1; }
     done
     # leg0 answered on after leg2's last reply (its last fresh cycle is later); leg2 ends stale.
     last_fresh() {
@@ -131,12 +137,13 @@ t_one_bus_gone() {
     kill -TERM "$SIM_PID_1"; wait_exit "$SIM_PID_1" >/dev/null
     "$J288" --config "$E2E_TMP/robot.yaml" log --rate 0 --duration 0.5 >"$E2E_TMP/out" 2>"$E2E_TMP/err"
     # The device is gone at open: a clear error naming the bus, exit 1.
-    [ $? -eq 1 ] && grep -q "bus 'leg1'" "$E2E_TMP/err" || return 1
+    [ $? -eq 1 ] && grep -q "bus 'leg1'" "$E2E_TMP/err" || { echo "log: $(cat "$E2E_TMP/err")"; return 1; }
     # stop still reaches the other buses.
     for k in 0 2; do : >"$E2E_TMP/log.$k"; done
-    "$J288" --config "$E2E_TMP/robot.yaml" stop >"$E2E_TMP/out" 2>"$E2E_TMP/err"; [ $? -eq 1 ] || return 1
-    grep -q 'broadcast lock sent on 2 of 3 buses' "$E2E_TMP/out" && grep -q '^j288 stop: bus leg1: ' "$E2E_TMP/err" || return 1
-    for k in 0 2; do logged "$E2E_TMP/log.$k" ' id=15 status=0 wd=0' || return 1; done
+    "$J288" --config "$E2E_TMP/robot.yaml" stop >"$E2E_TMP/out" 2>"$E2E_TMP/err"
+    [ $? -eq 1 ] && grep -q 'broadcast lock sent on 2 of 3 buses' "$E2E_TMP/out" &&
+        grep -q '^j288 stop: bus leg1: ' "$E2E_TMP/err" || { echo "stop: $(cat "$E2E_TMP/out" "$E2E_TMP/err")"; return 1; }
+    for k in 0 2; do logged "$E2E_TMP/log.$k" ' id=15 status=0 wd=0' || { echo "no lock on leg$k"; return 1; }; done
 }
 
 e2e_check status t_status

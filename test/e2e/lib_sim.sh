@@ -81,18 +81,23 @@ sim_start_linked() {
     return 1
 }
 
-# start_sims N [sim options...]: simulators 0..N-1 with servos 1, 2, 3, each one's pty path in
-# $SIM_DIR/pty.K, its pid in SIM_PID_K; "{k}" in an option stands for K (--log "$d/log.{k}").
-# Waits (up to 30 s each) for the path lines.
+# start_sims N [sim options...]: simulators 0..N-1 with servos 1, 2, 3, each serving on the
+# link $SIM_DIR/bus.K (its pty path in $SIM_DIR/pty.K), its pid in SIM_PID_K; "{k}" in an
+# option stands for K (--log "$d/log.{k}"). Waits (up to 30 s each) for the links. (Configs
+# name the link: a simulator that exits removes it, where its /dev/pts number goes to the
+# next pty opened, another test's simulator's when tests run side by side.)
 start_sims() {
     local n=$1 k; shift
     for k in $(seq 0 $((n - 1))); do
-        "$SIM" --ids 1,2,3 --quiet "${@//\{k\}/$k}" >"$SIM_DIR/pty.$k" 2>/dev/null &
+        "$SIM" --ids 1,2,3 --quiet --link "$SIM_DIR/bus.$k" "${@//\{k\}/$k}" >"$SIM_DIR/pty.$k" 2>/dev/null &
         SIM_PIDS+=($!)
         eval "SIM_PID_$k=$!"
     done
     for k in $(seq 0 $((n - 1))); do
-        for _ in $(seq 1 "$(e2e_scaled 600)"); do [ -s "$SIM_DIR/pty.$k" ] && break; sleep 0.05; done
+        for _ in $(seq 1 "$(e2e_scaled 600)"); do
+            [ -s "$SIM_DIR/pty.$k" ] && [ -L "$SIM_DIR/bus.$k" ] && break
+            sleep 0.05
+        done
     done
 }
 
@@ -102,7 +107,7 @@ robot_config() {
     local n=$1 k j
     { echo "buses:"
       for k in $(seq 0 $((n - 1))); do
-          echo "  - {name: leg$k, port: $(head -n1 "$SIM_DIR/pty.$k"), margin_us: $3}"
+          echo "  - {name: leg$k, port: $SIM_DIR/bus.$k, margin_us: $3}"
       done
       echo "joints:"
       for k in $(seq 0 $((n - 1))); do
