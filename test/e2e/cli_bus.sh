@@ -17,7 +17,7 @@ if [ $E2E_RC -eq 0 ] && grep -Eq '^1 +lock' <<<"$E2E_OUT" && grep -Eq '^2 ' <<<"
     grep -Eq '^3 .*winding over-temperature' <<<"$E2E_OUT" && grep -q '3 servos answered' <<<"$E2E_OUT"; then
     e2e_pass scan_human
 else
-    e2e_fail scan_human "rc $E2E_RC out '$E2E_OUT' err '$E2E_ERR'"
+    e2e_fail scan_human "rc $E2E_RC out '$E2E_OUT' err '$E2E_ERR' (the simulator logged $(log_lines "$MAIN_LOG") frames)"
 fi
 
 e2e_run "$J288" scan --port "$MAIN" --json "${MSCAN[@]}"
