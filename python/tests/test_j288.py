@@ -28,9 +28,10 @@ PKG_PATH = str(Path(j288.__file__).resolve().parents[1])
 # (1 s: beside stress-ng --cpu 2 a simulator went unscheduled for 0.3-1.6 s at times, past a
 # 250 ms margin; a long margin costs nothing where the reply comes)
 MARGIN = 1000000
-# A scan asks the 13 absent ids too: each costs its margin, so a scan gets 500 ms (250 ms
-# missed a starved simulator's reply beside stress-ng --cpu 2).
-SCAN_MARGIN = 500000
+# A scan asks the 13 absent ids too: each costs its margin (13 s at 1 s), yet 250 ms and then
+# 500 ms each missed a starved simulator's reply beside stress-ng --cpu 2: the one scan that
+# must find every servo takes the long margin too.
+SCAN_MARGIN = MARGIN
 # A USB adapter's margin, where a check wants short waits; the long one when the simulator
 # runs under valgrind (make test-valgrind), which answers later than 20 ms.
 SHORT_MARGIN = MARGIN if os.environ.get("J288_VALGRIND") else 20000

@@ -130,13 +130,16 @@ t_watchdog_trip_reported() {
     # came after 1 s on a loaded machine, and nothing tripped)
     local n i
     n=$(grep -c '' "$SIM_DIR/log.1")
-    "$PEER" command --for "$(e2e_scaled 20)" --hz 50 leg1_2 0.3 - - & local p=$!
-    for i in $(seq 1 "$(e2e_scaled 200)"); do
+    "$PEER" command --for "$(e2e_scaled 30)" --hz 50 leg1_2 0.3 - - & local p=$!
+    for i in $(seq 1 "$(e2e_scaled 400)"); do
         tail -n +"$((n + 1))" "$SIM_DIR/log.1" | grep -q ' id=2 status=1 wd=1' && break
         sleep 0.05
     done
+    tail -n +"$((n + 1))" "$SIM_DIR/log.1" | grep -q ' id=2 status=1 wd=1' ||
+        { echo "leg1_2 got no FOC command within 20 s"; kill $p; return 1; }
     kill -STOP "$BRIDGE_PID"; sleep 1.5; kill -CONT "$BRIDGE_PID"
-    wait_err "joint leg1_2: the servo's watchdog had tripped \\(cleared\\)" || { kill $p; return 1; }
+    wait_err "joint leg1_2: the servo's watchdog had tripped \\(cleared\\)" "$(e2e_scaled 20)" ||
+        { kill $p; return 1; }
     kill $p 2>/dev/null; wait $p
     "$PEER" diag >"$SIM_DIR/diag" && grep -Eq '^j288-dds: joint leg1_2\|watchdog_trips=[1-9]' "$SIM_DIR/diag"
 }
