@@ -542,13 +542,6 @@ static bool deliver_due(j288_linux_t *lp, uint32_t now)
     return any;
 }
 
-/* Whether the timer or the idle event is due at now. */
-static bool any_due(const j288_linux_t *lp, uint32_t now)
-{
-    return (lp->timer_armed && us_until(lp->timer_us, now) <= 0) ||
-           (lp->idle_pending && us_until(lp->last_rx_us + lp->opt.idle_us, now) <= 0);
-}
-
 /* Read and deliver what the device has, once it wants reading. Returns -1 when it is gone. */
 static int take_input(j288_linux_t *lp)
 {
@@ -567,11 +560,12 @@ static int port_wait(void *ctx, uint32_t until_us)
     j288_linux_t *lp = ctx;
     uint32_t now = j288_linux_now_us();
     int32_t left = us_until(until_us, now);
+    uint32_t at;
     int rc;
     if (lp->fd < 0 || lp->gone)
         return J288_ERR_OFFLINE;
     lp->stats.waits++;
-    if (any_due(lp, now)) {
+    if (j288_linux_next_deadline(lp, &at) && us_until(at, now) <= 0) {
         /* Bytes already here go to the bus before a deadline is judged (the engine takes its
          * events before its deadline too): a host that wakes past the deadline, on a loaded
          * machine, must not time out a reply that came in time and then count it as stale

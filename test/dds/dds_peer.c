@@ -43,7 +43,6 @@
 
 static dds_domainid_t domain;
 static const char *ns;
-static const char *state_topic = "joint_states"; /* the bridge's; lowstate for lowcmd */
 
 static void topic_name(char *out, size_t cap, const char *name)
 {
@@ -338,12 +337,10 @@ static int cmd_lowstate(double timeout_s)
  * participant's endpoint announcements, the writer's (made first) with them: its best-effort
  * command reader drops what a writer it does not know yet sends (a loaded machine lost some of
  * a test's counted commands that way). False when none came: the caller goes on regardless. */
-static int bridge_knows_us(dds_entity_t pp, double timeout_s)
+static int bridge_knows_us(dds_entity_t pp, int unitree, double timeout_s)
 {
-    int unitree = strcmp(state_topic, "lowstate") == 0;
-    dds_entity_t tp = make_topic(pp, unitree ? &unitree_go_msg_dds__LowState__desc
-                                             : &sensor_msgs_msg_dds__JointState__desc,
-                                 state_topic);
+    dds_entity_t tp = unitree ? make_topic(pp, &unitree_go_msg_dds__LowState__desc, "lowstate")
+                              : make_topic(pp, &sensor_msgs_msg_dds__JointState__desc, "joint_states");
     dds_entity_t r = dds_create_reader(pp, tp, NULL, NULL);
     void *ptrs[1] = {NULL};
     dds_sample_info_t si;
@@ -376,7 +373,7 @@ static dds_entity_t writer_for(const dds_topic_descriptor_t *d, const char *name
     do { /* until the bridge's reader is there, then until the bridge knows this writer */
         dds_get_publication_matched_status(w, &st);
         if (st.current_count > 0) {
-            (void)bridge_knows_us(pp, 5.0);
+            (void)bridge_knows_us(pp, d == &unitree_go_msg_dds__LowCmd__desc, 5.0);
             return w;
         }
         dds_sleepfor(DDS_MSECS(20));
@@ -477,7 +474,6 @@ static int cmd_lowcmd(int count, double seconds, double hz, int bad_crc, char **
     mc->kp = strtof(argv[5], NULL);
     mc->kd = strtof(argv[6], NULL);
     c.m.crc = lowcmd_crc(&c.m) ^ (bad_crc ? 1u : 0u);
-    state_topic = "lowstate";
     c.w = writer_for(&unitree_go_msg_dds__LowCmd__desc, "lowcmd");
     if (c.w < 0)
         return 1;

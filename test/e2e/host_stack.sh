@@ -55,8 +55,7 @@ fresh_sim() { # NAME [more simulator options]
 
 # sim_trips: TRIPS = the simulator's watchdog trips so far, from the statistics line it prints when
 # its wire faults are switched (none are configured here: SIGUSR1 and SIGUSR2 in turn).
-# Bounded (10 s, scaled); fails when no line came.
-STATS_SIG=USR1
+# Bounded (10 s, scaled); fails when no line came. (STATS_SIG: the next signal, set by fresh_sim.)
 sim_trips() {
     local err=$SIM_DIR/$SIM_NAME.err n
     n=$(grep -c 'stats: ' "$err")
