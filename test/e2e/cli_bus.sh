@@ -19,6 +19,10 @@ if [ $E2E_RC -eq 0 ] && grep -Eq '^1 +lock' <<<"$E2E_OUT" && grep -Eq '^2 ' <<<"
 else
     e2e_fail scan_human "rc $E2E_RC out '$E2E_OUT' err '$E2E_ERR' (the simulator logged $(log_lines "$MAIN_LOG") frames)"
 fi
+# --ids: ids 0 and 4 asked (absent), nothing beyond them
+expect_true scan_ids_addressed bash -c "grep -q 'id=0 ' '$MAIN_LOG' && grep -q 'id=4 ' '$MAIN_LOG' &&
+    ! grep -Eq 'id=([5-9]|1[0-4]) ' '$MAIN_LOG'"
+expect_bad scan_ids_bad 2 '--ids' "$J288" --port "$MAIN" scan --ids 1,15
 
 e2e_run "$J288" scan --port "$MAIN" --json "${MSCAN[@]}"
 expect_true scan_json_tool bash -c "printf '%s' '$E2E_OUT' | python3 -m json.tool >/dev/null"
@@ -222,7 +226,7 @@ stop_sim "$MAIN_PID"
 
 start_sim silent --ids 1 --drop 1 || exit 1
 SECONDS_BEFORE=$SECONDS
-expect_bad silent_bus_scan 1 'no servo answered' "$J288" --port "$DEV" scan
+expect_bad silent_bus_scan 1 'no servo answered .*ids 0-14 tried' "$J288" --port "$DEV" scan
 expect_bad silent_bus_status 1 'no reply from servo 1' "$J288" --port "$DEV" status --id 1
 expect_bad silent_bus_log 1 'no reply from servo 1' "$J288" --port "$DEV" log --id 1 --rate 100 --duration 0.2
 expect_bad silent_bus_hold 1 'no reply from servo 1' "$J288" --port "$DEV" hold --id 1

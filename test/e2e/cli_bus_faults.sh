@@ -17,10 +17,11 @@ cd "$(dirname "$0")/../.."
 # simulator's generator (splitmix64, 60 draws at start, 6 per reply) and say what they need.
 
 # Seed 7: the first replies of servos 1, 2 and 3 come through; later ones are dropped,
-# corrupted or preceded by noise. A 50 ms margin: a slow host adds no timeout (and so no
-# retry that would shift the sequence) while the twelve absent ids stay quick.
+# corrupted or preceded by noise. Ids 0-4 at a 250 ms margin: a slow host adds no timeout
+# (and so no retry that would shift the sequence) while the two absent ids stay quick (4
+# tries each).
 start_sim faulty --ids 1,2,3 --seed 7 --drop 0.1 --corrupt 0.1 --noise 0.1 || exit 1
-e2e_run "$J288" --port "$DEV" scan --json --retries 3 "${M50[@]}"
+e2e_run "$J288" --port "$DEV" scan --json --ids 0,1,2,3,4 --retries 3 "${MF[@]}"
 json_check faulty_scan_with_retries 'assert [s["id"] for s in o] == [1, 2, 3], o'
 stop_sim "$SIM_PID"
 

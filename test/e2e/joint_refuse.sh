@@ -95,8 +95,9 @@ t_config_errors() {
     printf 'joints:\n  - name: j\n    id: 1\n    limits: [-0.1, 0.1]\n' >"$E2E_TMP/id.yaml"
     expect_bad config_by_id 2 'limits \[-0.1, 0.1\]' "$J288" --port "$DEV" move --config "$E2E_TMP/id.yaml" --id 1 --pos 0.5
     # scan and stop take the port from the file, stop the servo from the joint's name.
-    # (the 250 ms margin: a loaded machine starved the simulator past 50 ms, and scan has no retry)
-    e2e_run "$J288" scan --config "$cfg" --margin-us 250000
+    # (id 1 alone at a 1 s margin: a loaded machine starved the simulator past 50 ms, and
+    # scan has no retry; the default range would cost a margin for each of 14 absent ids)
+    e2e_run "$J288" scan --config "$cfg" --ids 1 --margin-us 1000000
     [ "$E2E_RC" -eq 0 ] && grep -q '^1 servo answered on ' <<<"$E2E_OUT" || { echo "scan: $E2E_OUT $E2E_ERR"; return 1; }
     expect_ok stop_by_joint 'servo 1 locked (mode lock)' "$J288" stop --joint j --config "$cfg"
     # Two buses use id 1: --id needs --port to say which (or --joint); the file's port is used.
