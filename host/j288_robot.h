@@ -294,9 +294,11 @@ void j288_robot_set_stop_flag(j288_robot_t *r, const volatile sig_atomic_t *flag
 /*
  * One cycle: start a sweep on every bus (a down bus's sweep only if its previous one ended),
  * drive them all from one loop until every bus that is up has finished, then call on_cycle.
- * timeout_us bounds the cycle (0: 1 s). Returns J288_OK when every joint got fresh state,
- * J288_ERR_TIMEOUT when some did not (*info says how many; a cycle cut by the timeout leaves
- * the remaining sweeps running into the next cycle), J288_ERR_OFFLINE when every bus is gone
+ * timeout_us bounds the cycle (0: 1 s; at most 2^31 - 1 us, about 35 min: more is taken as
+ * that). Returns J288_OK when every joint got fresh state, J288_ERR_TIMEOUT when some did not
+ * (*info says how many; a cycle at its bound first takes the replies that have arrived, as a
+ * host woken late would otherwise lose them, then leaves the remaining sweeps running into
+ * the next cycle), J288_ERR_OFFLINE when every bus is gone
  * (with stop_on_bus_loss: when one went down or vanished; every bus is then stopped),
  * J288_ERR_ABORTED after a stop on the stop flag, J288_ERR_NULL. info may be NULL.
  */

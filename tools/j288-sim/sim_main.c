@@ -765,7 +765,10 @@ static bool read_input(sim_io_t *io, j288_sim_bus_t *bus)
  * means this process was not scheduled (a loaded machine) while what the host sent sat unread
  * in the pty, so the watchdogs must not count the stretch as the host's silence. A late wake
  * with nothing waiting excuses nothing: the host was silent, and the small delays of every
- * tick on a loaded machine would otherwise add up and hold off a trip the host earned. */
+ * tick on a loaded machine would otherwise add up and hold off a trip the host earned.
+ * When within the stall the bytes came is unknown, so the whole stall is excused (no false
+ * trip): a host silent for just over 1 s while this process was starved across the trip
+ * time is not tripped. Tests that want a trip stay silent for several seconds. */
 static void excuse_oversleep(j288_sim_bus_t *bus, bool input_waiting, uint64_t wake_us,
                              uint64_t now_us)
 {
