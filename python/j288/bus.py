@@ -76,6 +76,9 @@ class Bus(_native.Handle):
         margin_us: reply deadline margin for host latency (default 20 ms: USB adapters with
             the default latency timer; a pseudo-terminal or a 1 ms timer wants less).
         frame: "joint" (default) or "output" (rotor / 288.35, relative to power-up).
+        retries: re-sends of a command that got no good reply, 0-3 (default 0, as `j288
+            --retries`); each waits margin_us again, so an absent id costs a scan that many
+            more margins.
     Raises:
         J288Error: the device cannot be opened (OfflineError: it does not exist), is in use
             by another program, or is not a serial device.
@@ -85,15 +88,16 @@ class Bus(_native.Handle):
     _kind = "bus"
 
     def __init__(self, port: Union[str, "os.PathLike[str]"], baud: int = 0, margin_us: int = 0,
-                 frame: str = "joint") -> None:
+                 frame: str = "joint", retries: int = 0) -> None:
         dev = path_arg(port, "port")
         baud = int_arg(baud, "baud", 0, 100000000)
         margin_us = int_arg(margin_us, "margin_us", 0, 1000000)
+        retries = int_arg(retries, "retries", 0, 3)
         if frame not in FRAMES:
             raise ValueError(f"frame {frame!r}: one of {', '.join(FRAMES)}")
         self._joint = frame == "joint"
         self._r: Optional[ctypes.Array] = _native.new_robot()
-        opt = _native.Options(port=None, baud=baud, margin_us=margin_us)
+        opt = _native.Options(port=None, baud=baud, margin_us=margin_us, retries=retries)
         rc = LIB.j288_robot_open_port(self._r, dev, ctypes.byref(opt))
         self._open(rc, os.fsdecode(dev))
         self.port = os.fsdecode(dev)
