@@ -769,9 +769,9 @@ static void test_a_cycle_at_its_bound_takes_the_replies_waiting(void)
 
     TEST_ASSERT_EQUAL_INT(0, kill(g_sim[0].pid, SIGSTOP));
     g_sim[0].stopped = true;
-    /* bus 1's sweep ends (a cycle or a few, on a slow machine), bus 0's command to servo 1
-     * waits in the stopped simulator's pty (its first re-send due after 1 s) */
-    for (i = 0; i < 5u; i++) {
+    /* bus 1's sweep ends (a cycle or a few, on a slow machine: at most 2 s, before bus 0's
+     * second re-send), bus 0's command to servo 1 waits in the stopped simulator's pty */
+    for (i = 0; i < 8u; i++) {
         TEST_ASSERT_EQUAL_INT(J288_ERR_TIMEOUT, j288_robot_cycle(&g_robot, 250000u, &info));
         if (!j288_sched_busy(j288_robot_bus_sched(&g_robot, 1)))
             break;
