@@ -57,6 +57,9 @@ int cli_parse_real_in(const char *opt, const char *text, double lo, double hi, d
 /* One of choices (NULL-terminated); *out is its index. */
 int cli_parse_choice(const char *opt, const char *text, const char *const *choices, int *out);
 
+/* A mask (bit per id) of every servo id, 0 to J288_MAX_ID. */
+#define CLI_ALL_IDS ((uint32_t)((1ul << (J288_MAX_ID + 1u)) - 1u))
+
 /* Comma-separated servo ids, each in [0, max_id], no duplicates: sets bits of *mask. */
 int cli_parse_id_list(const char *opt, const char *text, unsigned max_id, uint32_t *mask);
 

@@ -61,7 +61,7 @@ int cli_cmd_scan(int argc, char **argv, const cli_global_t *g)
         return ec;
     }
     if (ids == 0u) {
-        ids = (1ul << (J288_MAX_ID + 1u)) - 1u;
+        ids = CLI_ALL_IDS;
     }
     if (cli_robot_load(&g_robot, o.config) != 0) {
         return CLI_EXIT_USAGE;
@@ -93,7 +93,7 @@ int cli_cmd_scan(int argc, char **argv, const cli_global_t *g)
     }
     if (found == 0u) {
         cli_error("no servo answered on %s (%s tried): check power, wiring and --baud", b.dev,
-                  ids == (1ul << (J288_MAX_ID + 1u)) - 1u ? "ids 0-14" : "the ids of --ids");
+                  ids == CLI_ALL_IDS ? "ids 0-14" : "the ids of --ids");
         cli_bus_close(&b);
         return CLI_EXIT_FAIL;
     }

@@ -322,7 +322,7 @@ int cli_cmd_top(int argc, char **argv, const cli_global_t *g)
     memset(&a, 0, sizeof a);
     a.rate_hz = 100.0;
     a.interval_s = 0.2;
-    a.ids = (1ul << (J288_MAX_ID + 1u)) - 1u;
+    a.ids = CLI_ALL_IDS;
     cli_bus_opts_init(&o, g);
     if (cli_parse_bus_args(argc, argv, opts, top_help, &o, parse_top_opt, &a, &ec) != 0)
         return ec;
