@@ -469,8 +469,11 @@ def test_ctrl_c_stops_every_bus(sims, tmp_path: Path, loop: str) -> None:
     s0, s1 = sims("1,2,3"), sims("1,2,3")
     cfg = write_config(tmp_path, [s0.pty, s1.pty])
     ready = tmp_path / "ready"
+    # (the child restores Ctrl-C's default: a test run started in the background inherits
+    # SIGINT ignored, and Python then never raises KeyboardInterrupt)
     script = textwrap.dedent(f"""\
-        import pathlib, j288
+        import pathlib, signal, j288
+        signal.signal(signal.SIGINT, signal.default_int_handler)
         with j288.Robot({str(cfg)!r}) as robot:
             while not all(robot.read()[3]):
                 robot.cycle()
