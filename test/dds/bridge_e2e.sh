@@ -124,12 +124,10 @@ t_refusals_in_diagnostics() {
         '^j288-dds: bus leg1|sweeps=' '^j288-dds: joint leg0_1|winding_temp_c='
 }
 t_watchdog_trip_reported() {
-    # the bridge frozen for 3 s while leg1_2 follows commands (watchdog bit 1): the servo's
-    # watchdog trips; once the bridge runs again the runner clears it and the bridge says so
-    # (frozen once the servo has FOC commands with the watchdog bit: the peer's first command
-    # came after 1 s on a loaded machine, and nothing tripped; 3 s, not 1.5: a simulator
-    # starved across the trip time excuses its whole stall, not knowing when the bridge's
-    # next command came, and stalls of up to 1.6 s were seen beside stress-ng)
+    # the bridge frozen (E2E_TRIP_SILENCE) while leg1_2 follows commands (watchdog bit 1): the
+    # servo's watchdog trips; once the bridge runs again the runner clears it and the bridge
+    # says so (frozen once the servo has FOC commands with the watchdog bit: the peer's first
+    # command came after 1 s on a loaded machine, and nothing tripped)
     local n i
     n=$(grep -c '' "$SIM_DIR/log.1")
     "$PEER" command --for "$(e2e_scaled 30)" --hz 50 leg1_2 0.3 - - & local p=$!
@@ -139,7 +137,7 @@ t_watchdog_trip_reported() {
     done
     tail -n +"$((n + 1))" "$SIM_DIR/log.1" | grep -q ' id=2 status=1 wd=1' ||
         { echo "leg1_2 got no FOC command within 20 s"; kill $p; return 1; }
-    kill -STOP "$BRIDGE_PID"; sleep 3; kill -CONT "$BRIDGE_PID"
+    kill -STOP "$BRIDGE_PID"; sleep "$E2E_TRIP_SILENCE"; kill -CONT "$BRIDGE_PID"
     wait_err "joint leg1_2: the servo's watchdog had tripped \\(cleared\\)" "$(e2e_scaled 20)" ||
         { kill $p; return 1; }
     kill $p 2>/dev/null; wait $p

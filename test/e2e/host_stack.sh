@@ -21,10 +21,6 @@ PY=${PYTHON:-python3}
 export J288_LIB=${J288_LIB:-$BUILD/lib/libj288.so}
 export PYTHONPATH=${J288_PYTHON_DIR:-$PWD/python}${PYTHONPATH:+:$PYTHONPATH}
 SILENCE=1.5 # longer than the servo's 1 s watchdog: the scenario, not a bound
-# A freeze that must trip the watchdog: 3 s, so that a simulator starved across the trip time
-# (it excuses its whole stall, not knowing when within it the next command came; stalls of up
-# to 1.6 s were seen beside stress-ng) still sees more than 1 s of silence.
-TRIP_SILENCE=3
 # rad: kp 20 against 2 N*m holds within 0.1 rad at the hold's rate; where the hold loop runs
 # far below its rate the joint sags further between commands (a loaded machine: 0.128 rad
 # seen; memcheck: 0.157, and 0.345 in one CI run). What tells a held joint from a tripped
@@ -267,7 +263,7 @@ t_stop_on_bus_loss() {
     logged "$LOG" ' id=15 status=0 wd=0'
 }
 
-# A trip in the middle of a run (the tool frozen 3 s: its servo's watchdog fires) is
+# A trip in the middle of a run (the tool frozen E2E_TRIP_SILENCE s: its servo's watchdog fires) is
 # cleared and reported, and the command fails: the single-servo form and the robot form.
 t_cli_reports_a_trip() {
     local form pid rc
@@ -281,7 +277,7 @@ t_cli_reports_a_trip() {
         pid=$!
         BG_PIDS+=("$pid")
         logged "$LOG" ' id=1 status=1 wd=1' || { echo "$form: no FOC: $(cat "$SIM_DIR/t.err")"; return 1; }
-        kill -STOP "$pid"; sleep "$TRIP_SILENCE"; kill -CONT "$pid"
+        kill -STOP "$pid"; sleep "$E2E_TRIP_SILENCE"; kill -CONT "$pid"
         wait_exit "$pid" 60; rc=$?
         [ $rc -eq 1 ] && grep -q 'had tripped its watchdog' "$SIM_DIR/t.err" ||
             { echo "$form: exit $rc, stderr $(cat "$SIM_DIR/t.err")"; return 1; }

@@ -27,6 +27,10 @@ e2e_fail() { # name reason
 # for every time bound and poll count, so that a slow machine or valgrind raises them all.
 TEST_TIME_SCALE=${TEST_TIME_SCALE:-1}
 e2e_scaled() { echo $(($1 * TEST_TIME_SCALE)); }
+# Seconds of host silence that must trip a servo's 1 s watchdog: 3, so that a simulator
+# starved across the trip time (it excuses its whole stall, not knowing when within it the
+# next command came; stalls of up to 1.6 s were seen beside stress-ng) still sees more than 1 s.
+E2E_TRIP_SILENCE=3
 
 # Run a command with a time bound (E2E_CMD_TIMEOUT seconds, default 20, scaled), capturing
 # stdout, stderr and status into E2E_OUT, E2E_ERR, E2E_RC.
