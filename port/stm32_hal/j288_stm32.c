@@ -106,10 +106,12 @@ void J288_STM32_RX_SINK(j288_bus_t *bus, const uint8_t *data, size_t len);
 /* IDLE and the error flags clear by a read of SR then a read of DR. SR is read again here,
  * right before DR (not taken from the interrupt's entry, with the transmit's end between): a
  * byte that came meanwhile (RXNE) is the DMA's, whose own read of DR then ends the sequence;
- * otherwise our read does. Returns what this read saw: what the sequence clears. */
-static uint32_t uart_clear(USART_TypeDef *u)
+ * otherwise our read does. Returns what this read saw: what the sequence clears. (entry_sr, the
+ * interrupt's first read, is stale by then.) */
+static uint32_t uart_clear(USART_TypeDef *u, uint32_t entry_sr)
 {
     uint32_t sr = UART_STATUS(u);
+    (void)entry_sr;
     if ((sr & USART_SR_RXNE) == 0u) {
         (void)J288_STM32_DR_READ(u);
     }
@@ -136,12 +138,12 @@ static void uart_clear_tc(USART_TypeDef *u) { J288_STM32_SR_CLEAR(u, USART_SR_TC
  * given to the DMA; an overrun loses one too. */
 #define UART_LOST (USART_ISR_PE | USART_ISR_FE | USART_ISR_NE | USART_ISR_ORE)
 #define UART_CLEARABLE (USART_ICR_IDLECF | USART_ICR_PECF | USART_ICR_FECF | USART_ICR_NECF | USART_ICR_ORECF)
-/* The ICR bits are the ISR bits of the same flags. */
-static uint32_t uart_clear(USART_TypeDef *u)
+/* The ICR bits are the ISR bits of the same flags: those the entry saw are cleared (one
+ * raised since stays, for the next entry). */
+static uint32_t uart_clear(USART_TypeDef *u, uint32_t entry_sr)
 {
-    uint32_t sr = UART_STATUS(u);
-    R(u->ICR) = sr & UART_CLEARABLE;
-    return sr;
+    R(u->ICR) = entry_sr & UART_CLEARABLE;
+    return entry_sr;
 }
 static void uart_clear_all(USART_TypeDef *u) { R(u->ICR) = UART_CLEARABLE; }
 static void uart_clear_tc(USART_TypeDef *u) { R(u->ICR) = USART_ICR_TCCF; }
@@ -210,45 +212,30 @@ static void dma_direct(dma_regs_t *s) { (void)s; } /* a channel has no FIFO */
 static bool dma_stop(dma_regs_t *s)
 {
     DMA_CTRL(s) &= ~(uint32_t)DMA_EN;
+#if defined(DMA_SxCR_EN)
     for (uint32_t i = 0; (i < J288_STM32_STOP_SPINS) && ((DMA_CTRL(s) & DMA_EN) != 0u); i++) {
     }
     return (DMA_CTRL(s) & DMA_EN) == 0u;
+#else
+    return true;
+#endif
 }
-
-/* A short section against the bus's own interrupts from thread context (a polled bus runs
- * start_tx unlocked): interrupts masked, the caller's mask restored, nesting-safe. */
-static uint32_t irq_save(void)
-{
-    uint32_t pm = __get_PRIMASK();
-    __disable_irq();
-    return pm;
-}
-
-static void irq_restore(uint32_t pm) { __set_PRIMASK(pm); }
 
 /* ---- the receive position ---------------------------------------------------------------
- * Positions are absolute byte counts (modulo 2^32): rx_abs where the RX stream was last seen,
- * rx_pos how far bytes were handed over or skipped; the buffer index of each is kept beside
- * it (rx_last, rx_idx). Bytes still in the buffer are rx_abs - rx_pos, at most a buffer. */
+ * Indices in the circular buffer: rx_pos, the next byte to hand over; the stream's head, read
+ * from its counter at each event. Less than a buffer passes between two events within the
+ * timing budget; beyond it, the half/complete flags show the lap (lapped). */
 
-/* Index the RX stream has reached in the circular buffer. */
 static uint32_t rx_head(const j288_stm32_t *p)
 {
     uint32_t left = DMA_COUNT((dma_regs_t *)p->rx_stream);
     return (left - 1u < J288_STM32_RX_BUF_SIZE) ? J288_STM32_RX_BUF_SIZE - left : 0u;
 }
 
-/* Read the stream's position: rx_abs moves by what it wrote since the last look (less than a
- * buffer, unless a lap went unseen: rx_laps_seen() adds those). */
-static void rx_look(j288_stm32_t *p)
+/* Bytes from index `from` forward to index `to` (0 when equal). */
+static uint32_t idx_sub(uint32_t to, uint32_t from)
 {
-    uint32_t h = rx_head(p);
-    uint32_t d = h - p->rx_last;
-    if (h < p->rx_last) {
-        d += J288_STM32_RX_BUF_SIZE;
-    }
-    p->rx_abs += d;
-    p->rx_last = h;
+    return (to >= from) ? to - from : to + J288_STM32_RX_BUF_SIZE - from;
 }
 
 static uint32_t idx_add(uint32_t idx, uint32_t n)
@@ -257,74 +244,65 @@ static uint32_t idx_add(uint32_t idx, uint32_t n)
     return (idx >= J288_STM32_RX_BUF_SIZE) ? idx - J288_STM32_RX_BUF_SIZE : idx;
 }
 
-/* Bytes up to position `to` that are not handed over: heard before a transmit (nobody's) or
- * our own echo. Never backwards. */
+/* Bytes up to index `to` that are not handed over: heard before a transmit (nobody's) or our
+ * own echo. */
 static void rx_skip(j288_stm32_t *p, uint32_t to)
 {
-    uint32_t n = to - p->rx_pos;
-    if ((int32_t)n > 0) {
-        p->stats.rx_skipped += n;
-        p->rx_idx = idx_add(p->rx_idx, (n > J288_STM32_RX_BUF_SIZE) ? n % J288_STM32_RX_BUF_SIZE : n);
-        p->rx_pos = to;
-    }
+    p->stats.rx_skipped += idx_sub(to, p->rx_pos);
+    p->rx_pos = to;
 }
 
-/* More than a buffer came since the bytes were last handed over: the oldest were overwritten
- * before anyone read them. What is left is not in order: skipped, the bus told (overrun). */
+/* The stream went round more than once since the bytes were last handed over: the oldest were
+ * overwritten before anyone read them, and what is left is not in order: skipped, the bus told
+ * (overrun). */
 PORT_NOINLINE static void rx_lap(j288_stm32_t *p, uint32_t to)
 {
+    p->lapped = false;
     p->stats.rx_laps++;
+    p->stats.rx_skipped += J288_STM32_RX_BUF_SIZE;
     rx_skip(p, to);
     j288_bus_on_error(&p->bus, J288_LINE_OVERRUN);
 }
 
-/* Hand the bus the received bytes from rx_pos up to position `to`, in order, once. */
+/* Hand the bus the received bytes from rx_pos up to index `to`, in order, once. */
 static void rx_take(j288_stm32_t *p, uint32_t to)
 {
     const uint8_t *rx = p->cfg.dma->rx;
-    uint32_t from = p->rx_idx;
-    uint32_t n = to - p->rx_pos;
+    uint32_t from = p->rx_pos;
+    uint32_t n = idx_sub(to, from);
 
-    if ((n == 0u) || ((int32_t)n < 0)) {
-        return;
-    }
-    if (n > J288_STM32_RX_BUF_SIZE) {
+    if (p->lapped) {
         rx_lap(p, to);
         return;
     }
     cache_invalidate(p->cfg.dma->rx, J288_STM32_RX_BUF_SIZE);
-    p->rx_idx = idx_add(from, n);
     p->rx_pos = to;
     p->stats.rx_bytes += n;
-    if (from + n <= J288_STM32_RX_BUF_SIZE) {
+    if (to >= from) { /* (nothing, when equal: the bus takes no empty run) */
         J288_STM32_RX_SINK(&p->bus, &rx[from], n);
     } else if (n <= J288_STM32_BOUNCE_SIZE) { /* wrapped: one piece for the bus's fast path */
         uint32_t tail = J288_STM32_RX_BUF_SIZE - from;
         memcpy(p->bounce, &rx[from], tail);
-        memcpy(&p->bounce[tail], rx, n - tail);
+        memcpy(&p->bounce[tail], rx, to);
         J288_STM32_RX_SINK(&p->bus, p->bounce, n);
     } else {
         J288_STM32_RX_SINK(&p->bus, &rx[from], J288_STM32_RX_BUF_SIZE - from);
-        J288_STM32_RX_SINK(&p->bus, rx, n - (J288_STM32_RX_BUF_SIZE - from));
+        J288_STM32_RX_SINK(&p->bus, rx, to);
     }
 }
 
-/* Bytes from the index `from` to the index `to` going forward (a full buffer when equal). */
-static uint32_t idx_dist(uint32_t from, uint32_t to)
-{
-    return (to > from) ? to - from : to + J288_STM32_RX_BUF_SIZE - from;
-}
-
 /* The half/complete flags witness laps the counter cannot show: each flag raised means the
- * stream crossed that boundary (half or end of the buffer) since the flags were last cleared
- * (at position flag_abs). A flag whose boundary lies beyond what the counter says was written
- * since then means the stream went round once more. */
-PORT_NOINLINE static void rx_laps_seen(j288_stm32_t *p, uint32_t flags)
+ * stream crossed that boundary (half or end of the buffer) since the flags were last cleared,
+ * at index flag_idx. A flag whose boundary lies beyond what the counter says was written since
+ * (to index head) means the stream went round once more. */
+static void rx_laps_seen(j288_stm32_t *p, uint32_t flags, uint32_t head)
 {
-    uint32_t since = p->rx_abs - p->flag_abs;
-    if ((((flags & DMA_F_HT) != 0u) && (idx_dist(p->flag_idx, J288_STM32_RX_BUF_SIZE / 2u) > since)) ||
-        (((flags & DMA_F_TC) != 0u) && (idx_dist(p->flag_idx, 0u) > since))) {
-        p->rx_abs += J288_STM32_RX_BUF_SIZE;
+    uint32_t since = idx_sub(head, p->flag_idx);
+    /* the first crossing of a boundary after flag_idx: 1 to a whole buffer away */
+    if ((((flags & DMA_F_HT) != 0u) &&
+         (idx_sub(J288_STM32_RX_BUF_SIZE / 2u - 1u, p->flag_idx) + 1u > since)) ||
+        (((flags & DMA_F_TC) != 0u) && (J288_STM32_RX_BUF_SIZE - p->flag_idx > since))) {
+        p->lapped = true;
     }
 }
 
@@ -364,13 +342,19 @@ static void op_set_dir(void *ctx, j288_dir_t dir)
  * still running; either way it must be disabled before its count is written. */
 static bool tx_stream_ready(j288_stm32_t *p, dma_regs_t *s)
 {
-    if ((DMA_CTRL(s) & DMA_EN) == 0u) {
+    uint32_t ctrl = DMA_CTRL(s);
+    if ((ctrl & DMA_EN) == 0u) {
         return true;
     }
     if (DMA_COUNT(s) != 0u) {
         p->stats.dma_resets++;
     }
+#if defined(DMA_SxCR_EN)
     return dma_stop(s);
+#else
+    DMA_CTRL(s) = ctrl & ~(uint32_t)DMA_EN; /* a channel stops at once */
+    return true;
+#endif
 }
 
 PORT_NOINLINE static bool rx_restart(j288_stm32_t *p);
@@ -380,7 +364,6 @@ static int op_start_tx(void *ctx, const uint8_t *data, size_t len)
     j288_stm32_t *p = ctx;
     dma_regs_t *s = p->tx_stream;
     USART_TypeDef *u = p->uart;
-    uint32_t pm;
 
     if ((data == NULL) || (len == 0u) || (len > J288_CMD_LEN)) {
         return J288_ERR_BAD_ARG;
@@ -399,18 +382,20 @@ static int op_start_tx(void *ctx, const uint8_t *data, size_t len)
     __DMB(); /* the buffer's writes before the stream's first read */
     *p->tx_ifcr = (uint32_t)DMA_F_ALL << p->tx_shift;
     DMA_COUNT(s) = (uint32_t)len;
-    uart_clear_tc(u); /* before tx_on: a TC left from the last transmit must not end this one */
-    /* The echo starts here; what was heard before is nobody's (skipped at the end). Taken with
-     * the interrupts masked: an event between would hand bytes over, then skip them again. */
-    pm = irq_save();
-    rx_look(p);
-    p->tx_start = p->rx_abs;
-    p->tx_len = (uint16_t)len;
-    p->echo_doubt = false;
+    if (p->tc_irq) {
+        uart_clear_tc(u); /* a TC left from the last transmit must not end this one */
+    }
+    /* The echo starts at the stream's head; what was heard before is nobody's (skipped at the
+     * end). In this order, with no lock (a polled bus calls it unlocked): the count first, so
+     * that no interrupt can end the transmit early; then tx_on, from which an interrupt hands
+     * nothing over; then the echo's start, read after it. */
+    p->echo_len = p->cfg.deaf_while_transmitting ? 0u : (uint16_t)len; /* a deaf line: none */
     p->tx_on = true;
-    irq_restore(pm);
+    p->tx_start = rx_head(p);
     p->stats.tx_frames++;
-    R(u->CR1) |= USART_CR1_TCIE;
+    if (p->tc_irq) {
+        R(u->CR1) |= USART_CR1_TCIE;
+    }
     DMA_CTRL(s) |= DMA_EN;
     return J288_OK;
 }
@@ -917,13 +902,11 @@ PORT_NOINLINE static bool rx_restart(j288_stm32_t *p)
         DMA_CTRL(rx) |= DMA_EN;
         ok = (DMA_CTRL(rx) & DMA_EN) != 0u;
     }
-    p->stats.rx_skipped += p->rx_abs - p->rx_pos;
-    p->rx_pos = p->rx_abs;
-    p->rx_idx = 0u;
-    p->rx_last = 0u;
-    p->flag_abs = p->rx_abs;
+    p->rx_pos = 0u;
     p->flag_idx = 0u;
-    p->echo_doubt = true; /* an echo under way lost its bytes */
+    p->tx_start = 0u;
+    p->lapped = false;
+    p->echo_len = 0u; /* an echo under way lost its bytes: none to count */
     p->rx_dead = !ok;
     return ok;
 }
@@ -1005,6 +988,7 @@ int j288_stm32_init(j288_stm32_t *p, const j288_stm32_config_t *cfg,
     memset(p, 0, sizeof *p);
     p->cfg = *cfg;
     p->echo = (bus_cfg != NULL) && bus_cfg->echo;
+    p->tc_irq = (cfg->de_port != NULL) || cfg->deaf_while_transmitting;
     pick_ops(p, (bus_cfg != NULL) && bus_cfg->advance_in_isr);
     take_registers(p);
     rc = j288_bus_init(&p->bus, &p->ops, p, bus_cfg);
@@ -1111,45 +1095,62 @@ PORT_NOINLINE static void line_errors(j288_stm32_t *p, uint32_t sr)
  * been raised by a stall of the TX stream before it wrote that byte (the F4 clears TC only with
  * an SR read and a DR write, so a TC from a stall survives the stream's next write). Waited
  * for, a bounded number of reads (J288_STM32_ECHO_SPINS: a character and more). */
-PORT_NOINLINE static void echo_wait(j288_stm32_t *p)
+PORT_NOINLINE static uint32_t echo_wait(const j288_stm32_t *p, uint32_t start, uint32_t head)
 {
-    for (uint32_t i = 0; (i < J288_STM32_ECHO_SPINS) && (p->rx_abs - p->tx_start < p->tx_len); i++) {
-        rx_look(p);
+    for (uint32_t i = 0; (i < J288_STM32_ECHO_SPINS) && (idx_sub(head, start) < p->echo_len); i++) {
+        head = rx_head(p);
     }
+    return head;
 }
 
-/* The end of a transmit, at transmit complete with the TX stream's count at 0. DE drops first,
- * before anything else is done. The echo's end: the line hears us and no byte of it was lost
- * (no flag says so): tx_len bytes from where it started; otherwise everything from there on
- * goes to the bus after the transmit's end, whose parser finds the reply among our bytes. */
-static void tx_end(j288_stm32_t *p, uint32_t sr)
+/* The end of a transmit: transmit complete (TC) with the TX stream's count at 0, taken at TC's
+ * interrupt with a DE pin or a deaf line (DE drops first, before anything else is done), else
+ * at the idle line after the echo (or a later one, when the reply follows at once). The echo's
+ * end: the line hears us and no byte of it was lost (no flag says so): tx_len bytes from where
+ * it started, or what came of them (cut short by a collision); otherwise every byte from its
+ * start goes to the bus after the transmit's end, whose parser finds the reply among our bytes.
+ * Returns the stream's head (the transmit still on if an idle line came mid-frame). */
+static uint32_t tx_end(j288_stm32_t *p, uint32_t sr, uint32_t head)
 {
-    uint32_t end = p->tx_start;
-    rx_look(p);
-    if (!p->cfg.deaf_while_transmitting && ((sr & UART_LOST) == 0u) && !p->echo_doubt) {
-        end += p->tx_len;
-        if (p->rx_abs - p->tx_start < p->tx_len) {
-            echo_wait(p);
+    uint32_t start = p->tx_start;
+    uint32_t len = p->echo_len;
+    uint32_t in = idx_sub(head, start);
+    uint32_t end = start;
+    bool whole = (sr & UART_LOST) == 0u;
+
+    if (!whole || (in < len)) {
+        /* at an idle line, with the echo not (known to be) all in: the end only if the TX
+         * stream has written everything (a stall mid-frame idles the line too) */
+        if (!p->tc_irq && (DMA_COUNT((dma_regs_t *)p->tx_stream) != 0u)) {
+            return head;
+        }
+        if (whole) {
+            head = echo_wait(p, start, head);
+            in = idx_sub(head, start);
         }
     }
-    de_write(p, false);
-    R(p->uart->CR1) &= ~(uint32_t)USART_CR1_TCIE;
+    if (p->tc_irq) {
+        de_write(p, false);
+        R(p->uart->CR1) &= ~(uint32_t)USART_CR1_TCIE;
+    }
     p->tx_on = false;
-    if ((int32_t)(end - p->rx_abs) > 0) {
-        end = p->rx_abs; /* the echo was cut short (a collision): it ends where the bytes end */
+    if (whole) {
+        end = (in < len) ? head : idx_add(start, len);
     }
-    rx_skip(p, p->tx_start);
     if (p->echo) {
+        rx_skip(p, start);
         rx_take(p, end);
+    } else {
+        rx_skip(p, end);
     }
-    rx_skip(p, end);
     j288_bus_on_tx_done(&p->bus);
+    return head;
 }
 
 void j288_stm32_on_uart_irq(j288_stm32_t *p)
 {
     USART_TypeDef *u;
-    uint32_t sr;
+    uint32_t sr, head;
 
     if (p == NULL) {
         return;
@@ -1160,20 +1161,24 @@ void j288_stm32_on_uart_irq(j288_stm32_t *p)
     }
     u = p->uart;
     sr = UART_STATUS(u);
+    head = rx_head(p);
     if (p->tx_on && ((sr & UART_TC) != 0u)) {
-        if (DMA_COUNT((dma_regs_t *)p->tx_stream) != 0u) {
+        if (!p->tc_irq) {
+            if ((sr & UART_IDLE) != 0u) {
+                head = tx_end(p, sr, head); /* the echo all in: the stream wrote everything */
+            }
+        } else if (DMA_COUNT((dma_regs_t *)p->tx_stream) != 0u) {
             uart_clear_tc(u); /* mid-frame: the TX stream stalled; TC comes again at the end */
             p->stats.tx_stalls++;
         } else {
-            tx_end(p, sr);
+            head = tx_end(p, sr, head);
         }
     }
     if ((sr & (UART_IDLE | UART_ERRORS)) != 0u) {
-        sr |= uart_clear(u);
+        sr |= uart_clear(u, sr);
         p->stats.rx_events++;
-        rx_look(p);
-        if (!p->tx_on) {
-            rx_take(p, p->rx_abs);
+        if (!p->tx_on && (head != p->rx_pos)) {
+            rx_take(p, head);
         }
         if ((sr & UART_ERRORS) != 0u) {
             line_errors(p, sr);
@@ -1183,10 +1188,10 @@ void j288_stm32_on_uart_irq(j288_stm32_t *p)
 
 /* A transfer error stops the stream: what it had stored is handed over, it is restarted at the
  * start of its buffer, and the bus told. */
-PORT_NOINLINE static void rx_error(j288_stm32_t *p)
+PORT_NOINLINE static void rx_error(j288_stm32_t *p, uint32_t head)
 {
     if (!p->tx_on) {
-        rx_take(p, p->rx_abs);
+        rx_take(p, head);
     }
     p->stats.dma_errors++;
     /* A stream that will not restart leaves the bus deaf: the line is gone for the bus (the
@@ -1194,12 +1199,15 @@ PORT_NOINLINE static void rx_error(j288_stm32_t *p)
     j288_bus_on_error(&p->bus, rx_restart(p) ? J288_LINE_DMA : (J288_LINE_DMA | J288_LINE_GONE));
 }
 
-/* Half and complete: the bytes up to the stream's position are handed over at each (not
- * during a transmit: its end decides which are the echo); their flags also say whether the
- * stream went round more than its counter shows. A transfer error restarts the stream. */
+/* Half and complete: the bytes up to the stream's head are handed over once a quarter of the
+ * buffer waits (so that a reply usually goes whole at its idle line; not during a transmit: its
+ * end decides which are the echo). This sets the timing budget: after a half event that left
+ * less than a quarter waiting, the next event comes half a buffer later and must be served
+ * within a quarter buffer less a character. The flags also say whether the stream went round
+ * more than its counter shows. A transfer error restarts the stream. */
 void j288_stm32_on_dma_rx_irq(j288_stm32_t *p)
 {
-    uint32_t flags, seen, seen_idx;
+    uint32_t flags, before, head;
 
     if (p == NULL) {
         return;
@@ -1208,21 +1216,19 @@ void j288_stm32_on_dma_rx_irq(j288_stm32_t *p)
         not_live(p);
         return;
     }
-    seen = p->rx_abs;
-    seen_idx = p->rx_last;
+    before = rx_head(p); /* where the flags read next may have been raised from */
     flags = (*p->rx_isr >> p->rx_shift) & (DMA_F_HT | DMA_F_TC | DMA_F_TE);
     *p->rx_ifcr = flags << p->rx_shift;
+    head = rx_head(p);
     p->stats.rx_events++;
-    rx_look(p);
     if ((flags & DMA_F_TE) != 0u) {
-        rx_error(p);
+        rx_error(p, head);
         return;
     }
-    rx_laps_seen(p, flags);
-    p->flag_abs = seen;
-    p->flag_idx = seen_idx;
-    if (!p->tx_on) {
-        rx_take(p, p->rx_abs);
+    rx_laps_seen(p, flags, head);
+    p->flag_idx = before;
+    if (!p->tx_on && ((idx_sub(head, p->rx_pos) >= J288_STM32_RX_BUF_SIZE / 4u) || p->lapped)) {
+        rx_take(p, head);
     }
 }
 

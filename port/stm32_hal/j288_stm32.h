@@ -13,12 +13,13 @@
  *    so there is no moment at the turnaround where a reply byte can be lost. The line hears
  *    our own 20 bytes (unless it is deaf_while_transmitting): with the bus's echo option they
  *    are handed to the bus, which checks them (collisions); without, skipped.
- *  - A transmit ends at the UART's transmit complete (TC) with the TX stream's count at 0 (a TC
- *    raised mid-frame by a stall of the stream is cleared and waited past). There DE drops
- *    first; then the echo's end is where it started plus its length when the line hears us and
- *    no flag says a byte of it was lost; otherwise every byte from its start goes to the bus
- *    after the transmit's end, whose parser finds the reply among them: a lost echo byte costs
- *    nothing, and a broadcast ends.
+ *  - A transmit ends at the UART's transmit complete (TC) with the TX stream's count at 0: at
+ *    TC's interrupt with a DE pin (dropped first thing there) or a deaf line, else at the idle
+ *    line after the echo, TC then being set (a TC raised mid-frame by a stall of the stream is
+ *    waited past). The echo's end is where it started plus its length when the line hears us
+ *    and no flag says a byte of it was lost; otherwise every byte from its start goes to the
+ *    bus after the transmit's end, whose parser finds the reply among them: a lost echo byte
+ *    costs nothing, and a broadcast ends.
  *  - The receive position is read from the stream's counter (NDTR/CNDTR) at every event: idle
  *    line, half and whole buffer. The events may come in any order, late or twice: every byte
  *    is handed to the bus once, in order, as long as each event is served within the timing
@@ -29,9 +30,9 @@
  *    reception. Flags seen at the next event are counted and reported to the bus.
  *
  * Timing budget (docs/stm32.md works it out): each of the bus's interrupts (UART, RX stream)
- * must be served within J288_STM32_RX_BUF_SIZE/2 - 1 character times of being raised (105 us
- * at the default 256 bytes and 6 Mbps, 52 us at 128): later, bytes are overwritten before they
- * are handed over (reported, not silent). The DE pin drops within the UART interrupt's latency
+ * must be served within J288_STM32_RX_BUF_SIZE/4 - 1 character times of being raised (105 us
+ * at the default 256 bytes and 6 Mbps, 52 us at 128): later, bytes may be overwritten before
+ * they are handed over (reported as J288_LINE_OVERRUN, rx_laps, not silent). The DE pin drops within the UART interrupt's latency
  * of the last stop bit; a servo answering sooner meets our driver still on (hardware DE,
  * de_hardware, has no such delay).
  *
@@ -319,18 +320,18 @@ typedef struct j288_stm32 {
     uint8_t tx_shift;
     uint8_t rx_shift;
     bool echo;                 /* the bus checks the echo: hand it over */
+    bool tc_irq;               /* TC's interrupt ends a transmit (a DE pin to drop at once, or a
+                                  deaf line); else the echo's idle line does */
     volatile bool live;        /* registered: the IRQ entries serve it */
     volatile bool tx_on;       /* a transmit is in flight */
-    volatile bool echo_doubt;  /* its echo lost bytes to a stream restart */
-    volatile bool rx_dead;     /* the RX stream would not restart (retried at a transmit) */
-    volatile uint16_t tx_len;  /* bytes of the last transmit (its echo) */
-    /* Receive positions, absolute byte counts (mod 2^32) with their buffer index. */
-    volatile uint32_t rx_pos;  /* handed over or skipped up to here */
-    volatile uint32_t rx_idx;
-    volatile uint32_t rx_abs;  /* the RX stream's position when last looked at */
-    volatile uint32_t rx_last;
-    volatile uint32_t flag_abs; /* where the half/complete flags were last cleared */
-    volatile uint32_t flag_idx;
+    bool rx_dead;              /* the RX stream would not restart (retried at a transmit) */
+    bool lapped;               /* the RX stream went round unseen: what waits is overwritten */
+    uint16_t echo_len;         /* bytes of the last transmit's echo: its length, or 0 (a deaf
+                                  line, or lost to a stream restart) */
+    /* Indices in the receive buffer. Written in the bus's interrupts, and by start_tx in an
+     * order that needs no lock (j288_stm32.c). */
+    uint32_t rx_pos;           /* the next byte to hand over */
+    uint32_t flag_idx;         /* where the half/complete flags were last cleared */
     volatile uint32_t tx_start; /* where the last transmit's echo starts */
     uint8_t bounce[J288_STM32_BOUNCE_SIZE]; /* a wrapped run, handed over in one piece */
     volatile uint32_t tim_deadline; /* last arm_timeout deadline (now_us clock) */

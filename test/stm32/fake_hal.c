@@ -1463,7 +1463,12 @@ void fake_hal_dma_rx_error(UART_HandleTypeDef *huart, unsigned how)
     bits |= ((how & FAKE_DMA_ALSO_DME) != 0u) ? D_DME : 0u;
 #endif
     f->rx.on = false; /* a transfer error disables the stream / channel */
+#if defined(J288_STUB_CHANNELS)
+    (void)how;
+    f->rx.stopping = false; /* a channel stops at once */
+#else
     f->rx.stopping = (how & FAKE_DMA_STUCK) != 0u; /* ... or its EN bit keeps reading 1 */
+#endif
     f->rx.off_at = now_t + 100000u;
     f->rx_take_at = FAKE_NEVER;
     stream_flag_set(f, true, bits);

@@ -154,8 +154,8 @@ void fake_hal_tx_stall(UART_HandleTypeDef *huart, size_t index, uint32_t ticks);
 /* Ticks a stream's EN bit keeps reading 1 after software clears it (default 3). */
 void fake_hal_dma_stop_delay(uint32_t ticks);
 /* A transfer error on the RX stream: it stops, TEIF rises; with FAKE_DMA_ALSO_DME the stream's
- * direct mode error flag too (a channel has none); with FAKE_DMA_STUCK its EN bit keeps reading
- * 1 for 100000 ticks (a stream that cannot be stopped). */
+ * direct mode error flag too (a channel has none); with FAKE_DMA_STUCK a stream's EN bit keeps
+ * reading 1 for 100000 ticks (a stream that cannot be stopped; a channel stops at once). */
 #define FAKE_DMA_ALSO_DME 0x1u
 #define FAKE_DMA_STUCK 0x2u
 void fake_hal_dma_rx_error(UART_HandleTypeDef *huart, unsigned how);

@@ -427,9 +427,8 @@ static void test_init_puts_the_streams_in_direct_mode(void)
     fake_hal_tx_stream(&huart1)->FCR = DMA_SxFCR_DMDIS | 0x1u;
     init_port1(NULL, false, true);
     TEST_ASSERT_EQUAL_HEX32(0u, fake_hal_rx_stream(&huart1)->FCR & DMA_SxFCR_DMDIS);
-    if (NEW_PORT) {
-        TEST_ASSERT_EQUAL_HEX32(0u, fake_hal_tx_stream(&huart1)->FCR & DMA_SxFCR_DMDIS);
-    }
+    TEST_ASSERT_EQUAL_HEX32_MESSAGE(0u, fake_hal_tx_stream(&huart1)->FCR & DMA_SxFCR_DMDIS,
+                                    "the TX stream left in FIFO mode: its count would reach 0 with bytes still queued");
 #endif
 }
 
@@ -1186,12 +1185,12 @@ static void test_a_lap_is_reported(void)
     TEST_ASSERT_TRUE(sink_len < sizeof bytes);
 }
 
-/* The timing budget: a continuous stream, each interrupt served up to RX_BUF_SIZE/2 - 1
+/* The timing budget: a continuous stream, each interrupt served up to RX_BUF_SIZE/4 - 1
  * characters late, UART or stream first: every byte reaches the bus once, in order, no lap. */
 static void test_interrupts_served_within_the_budget_lose_nothing(void)
 {
     static uint8_t stream[5u * J288_STM32_RX_BUF_SIZE];
-    static const uint32_t late_chars[] = {0u, 1u, 7u, J288_STM32_RX_BUF_SIZE / 4u, J288_STM32_RX_BUF_SIZE / 2u - 1u};
+    static const uint32_t late_chars[] = {0u, 1u, 7u, J288_STM32_RX_BUF_SIZE / 8u, J288_STM32_RX_BUF_SIZE / 4u - 1u};
     for (size_t i = 0; i < sizeof stream; i++) {
         stream[i] = (uint8_t)(i * 7u + i / 256u);
     }
@@ -1339,6 +1338,8 @@ static void scenario_init(const scenario_t *s)
     j288_bus_config_t bc;
     memset(&bc, 0, sizeof bc);
     bc.echo = s->echo;
+    /* the reply deadline covers the interrupt latency (a character is 1.67 us) */
+    bc.margin_us = J288_DEFAULT_MARGIN_US + 2u * s->late_chars;
     c.deaf_while_transmitting = s->deaf;
     fake_hal_line_deaf(&huart1, s->deaf);
     if (s->de == DE_GPIO) {
@@ -1576,6 +1577,9 @@ static void test_a_stream_that_will_not_stop(void)
  * restart again and, the stream free by then, the bus hears again. */
 static void test_a_stream_that_will_not_restart(void)
 {
+#if defined(J288_STUB_CHANNELS)
+    TEST_IGNORE_MESSAGE("a DMA channel stops at once: it always restarts");
+#endif
     init_port1(NULL, false, false);
     send_foc3();
     fake_hal_dma_stop_delay(100000u);
@@ -1690,17 +1694,31 @@ static void test_the_last_echo_byte_still_in_the_data_register(void)
     }
 }
 
-/* A line that should hear us and does not (a transceiver's receiver off by mistake): the
- * transmit still ends at transmit complete after the bounded wait, and the reply is heard. */
-static void test_an_echo_that_never_comes(void)
+/* A line declared hearing that does not hear us (a transceiver's receiver off with DE, and
+ * deaf_while_transmitting not set): a misconfiguration the counters show (docs/stm32.md,
+ * bring-up): the transmit ends at the reply's idle line and the reply's first 20 bytes are taken
+ * for the echo (rx_skipped), so the transaction fails; a broadcast, with nothing heard, never
+ * ends its transmit (J288_ERR_TX_TIMEOUT). Nothing hangs. */
+static void test_a_line_that_does_not_hear_itself_shows_in_the_counters(void)
 {
     init_port1(NULL, false, false);
     fake_hal_line_deaf(&huart1, true);
     fake_hal_reply_after_tx(&huart1, k_reply3, J288_REPLY_LEN, 10u * FAKE_TICKS_PER_US, NULL);
     submit_foc3();
     run_until_done();
-    assert_reply_ok();
-    TEST_ASSERT_EQUAL_UINT32(0u, j288_stm32_stats(&port1)->rx_skipped);
+    TEST_ASSERT_EQUAL_INT(1, done_count);
+    TEST_ASSERT_TRUE(last_txn.result != J288_OK);
+    TEST_ASSERT_EQUAL_UINT32(J288_CMD_LEN, j288_stm32_stats(&port1)->rx_skipped);
+    TEST_ASSERT_EQUAL_UINT32(J288_REPLY_LEN - J288_CMD_LEN, j288_stm32_stats(&port1)->rx_bytes);
+    fake_hal_run_us(3u * j288_bus_reply_budget_us(j288_stm32_bus(&port1)));
+    poll1();
+    done_count = 0;
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_bus_estop(j288_stm32_bus(&port1), clock_us()));
+    for (unsigned i = 0; (i < 1000u) && !j288_bus_is_idle(j288_stm32_bus(&port1)); i++) {
+        fake_hal_run_us(5u);
+        poll1();
+    }
+    TEST_ASSERT_TRUE(j288_bus_stats(j288_stm32_bus(&port1))->timeouts >= 1u);
 }
 
 /* ---- timer ---------------------------------------------------------------------------- */
@@ -2045,7 +2063,7 @@ int main(void)
     RUN_TEST(test_a_stale_entry_leaves_the_new_bus_alone);
     RUN_TEST(test_timer_every_channel);
     RUN_TEST(test_the_last_echo_byte_still_in_the_data_register);
-    RUN_TEST(test_an_echo_that_never_comes);
+    RUN_TEST(test_a_line_that_does_not_hear_itself_shows_in_the_counters);
     RUN_TEST(test_timeout_from_timer_channel);
     RUN_TEST(test_polled_bus_leaves_the_timer_alone);
     RUN_TEST(test_timer_on_16_bit_counter_wraps);
