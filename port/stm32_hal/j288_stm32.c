@@ -1106,7 +1106,7 @@ PORT_NOINLINE static uint32_t echo_wait(const j288_stm32_t *p, uint32_t start, u
 /* The end of a transmit: transmit complete (TC) with the TX stream's count at 0, taken at TC's
  * interrupt with a DE pin or a deaf line (DE drops first, before anything else is done), else
  * at the idle line after the echo (or a later one, when the reply follows at once). The echo's
- * end: the line hears us and no byte of it was lost (no flag says so): tx_len bytes from where
+ * end: the line hears us and no byte of it was lost (no flag says so): echo_len bytes from where
  * it started, or what came of them (cut short by a collision); otherwise every byte from its
  * start goes to the bus after the transmit's end, whose parser finds the reply among our bytes.
  * Returns the stream's head (the transmit still on if an idle line came mid-frame). */
@@ -1122,6 +1122,7 @@ static uint32_t tx_end(j288_stm32_t *p, uint32_t sr, uint32_t head)
         /* at an idle line, with the echo not (known to be) all in: the end only if the TX
          * stream has written everything (a stall mid-frame idles the line too) */
         if (!p->tc_irq && (DMA_COUNT((dma_regs_t *)p->tx_stream) != 0u)) {
+            p->stats.tx_stalls++;
             return head;
         }
         if (whole) {

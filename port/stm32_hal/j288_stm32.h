@@ -32,8 +32,10 @@
  * Timing budget (docs/stm32.md works it out): each of the bus's interrupts (UART, RX stream)
  * must be served within J288_STM32_RX_BUF_SIZE/4 - 1 character times of being raised (105 us
  * at the default 256 bytes and 6 Mbps, 52 us at 128): later, bytes may be overwritten before
- * they are handed over (reported as J288_LINE_OVERRUN, rx_laps, not silent). The DE pin drops within the UART interrupt's latency
- * of the last stop bit; a servo answering sooner meets our driver still on (hardware DE,
+ * they are handed over (reported as J288_LINE_OVERRUN, rx_laps, not silent). A reply reaches
+ * the bus at its idle line plus the UART interrupt's latency: the bus's margin_us (20 us by
+ * default) must cover that latency. The DE pin drops within the UART interrupt's latency of
+ * the last stop bit; a servo answering sooner meets our driver still on (hardware DE,
  * de_hardware, has no such delay).
  *
  * What the application does (examples/stm32_hal/, docs/stm32.md):
@@ -277,8 +279,9 @@ typedef struct {
     uint32_t dma_errors;   /* RX stream transfer errors: the stream was restarted */
     uint32_t dma_resets;   /* transmits found still running from an earlier transaction and
                               stopped before the next (a lost TX complete interrupt) */
-    uint32_t tx_stalls;    /* transmit-complete flags raised mid-frame (the TX stream stalled
-                              a character or more) and waited past */
+    uint32_t tx_stalls;    /* transmits found idle mid-frame (the TX stream stalled a
+                              character or more: TC, or the echo's idle line, raised early) and
+                              waited past; seen only when the interrupt comes during the stall */
     uint32_t timer_events; /* compare interrupts taken (timer_rearms included) */
     uint32_t timer_rearms; /* of those, early ones (before the deadline): re-armed for the
                               rest, the bus not called */

@@ -1041,19 +1041,30 @@ static void test_tx_stall_mid_frame_keeps_the_transmit_going(void)
 {
     for (size_t at = 1u; at < J288_CMD_LEN; at++) {
         for (uint32_t chars = 2u; chars <= 5u; chars += 3u) {
-            char msg[64];
-            fake_hal_tx_info_t tx;
-            setUp();
-            init_port1(NULL, false, true);
-            fake_hal_tx_stall(&huart1, at, chars * FAKE_CHAR);
-            fake_hal_reply_after_tx(&huart1, k_reply3, J288_REPLY_LEN, 5u * FAKE_TICKS_PER_US, NULL);
-            submit_foc3();
-            run_until_done();
-            tx = fake_hal_tx_info(&huart1);
-            snprintf(msg, sizeof msg, "a %u-character stall before byte %u", (unsigned)chars, (unsigned)at);
-            TEST_ASSERT_TRUE_MESSAGE(fake_hal_de_active_at(&huart1, tx.last_end - FAKE_BIT / 2u), msg);
-            assert_reply_ok_msg(msg);
-            tearDown();
+            for (unsigned de = 0u; de < 2u; de++) {
+                char msg[64];
+                fake_hal_tx_info_t tx;
+                setUp();
+                init_port1(NULL, false, de != 0u);
+                fake_hal_tx_stall(&huart1, at, chars * FAKE_CHAR);
+                fake_hal_reply_after_tx(&huart1, k_reply3, J288_REPLY_LEN, 5u * FAKE_TICKS_PER_US, NULL);
+                submit_foc3();
+                run_until_done();
+                tx = fake_hal_tx_info(&huart1);
+                snprintf(msg, sizeof msg, "a %u-character stall before byte %u%s", (unsigned)chars, (unsigned)at,
+                         de ? ", DE pin" : "");
+                if (de != 0u) {
+                    TEST_ASSERT_TRUE_MESSAGE(fake_hal_de_active_at(&huart1, tx.last_end - FAKE_BIT / 2u), msg);
+                }
+                assert_reply_ok_msg(msg);
+                /* seen: TC mid-frame (a DE pin), or the echo's idle line, which a gap of one
+                 * character on the wire (a 2-character stall, one of them overlapping the byte
+                 * before) may not raise */
+                if (NEW_PORT && ((de != 0u) || (chars > 2u))) {
+                    TEST_ASSERT_EQUAL_UINT32_MESSAGE(1u, j288_stm32_stats(&port1)->tx_stalls, msg);
+                }
+                tearDown();
+            }
         }
     }
 }
