@@ -546,6 +546,23 @@ static void shift_done(fake_uart_t *f)
     }
 }
 
+/* One transfer of a stream: its count down by one, the half and complete flags raised as it
+ * crosses them. Returns whether the count reached 0. */
+static bool stream_count_down(fake_uart_t *f, bool rx)
+{
+    dma_regs_t *s = rx ? &f->rxs : &f->txs;
+    uint32_t size = rx ? f->rx.size : f->tx.size;
+    D_CNT(s)--;
+    if (D_CNT(s) == size / 2u) {
+        stream_flag_set(f, rx, D_HT);
+    }
+    if (D_CNT(s) == 0u) {
+        stream_flag_set(f, rx, D_TC);
+        return true;
+    }
+    return false;
+}
+
 /* The TX stream writes the next byte into the data register. */
 static void tx_fill(fake_uart_t *f)
 {
@@ -572,12 +589,7 @@ static void tx_fill(fake_uart_t *f)
         f->f4_tc_armed = false;
     }
 #endif
-    D_CNT(s)--;
-    if (D_CNT(s) == f->tx.size / 2u) {
-        stream_flag_set(f, false, D_HT);
-    }
-    if (D_CNT(s) == 0u) {
-        stream_flag_set(f, false, D_TC);
+    if (stream_count_down(f, false)) {
 #if !defined(J288_STUB_CHANNELS)
         f->tx.on = false; /* a stream ends its transfer; a channel stays enabled */
 #endif
@@ -602,12 +614,7 @@ static void rx_take(fake_uart_t *f)
     f->st &= ~f->f4_armed; /* the DMA's DR read ends an SR-then-DR sequence */
     f->f4_armed = 0u;
 #endif
-    D_CNT(s)--;
-    if (D_CNT(s) == f->rx.size / 2u) {
-        stream_flag_set(f, true, D_HT);
-    }
-    if (D_CNT(s) == 0u) {
-        stream_flag_set(f, true, D_TC);
+    if (stream_count_down(f, true)) {
         if ((D_CR(s) & D_CIRC) != 0u) {
             D_CNT(s) = f->rx.size;
         } else {

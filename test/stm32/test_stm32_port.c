@@ -1413,6 +1413,45 @@ static void scenario_run(const scenario_t *s)
     tearDown();
 }
 
+/* Every combination of the lists: reply delays (us), DE modes from de_from on, TX stalls
+ * ({before byte, characters}), interrupt latencies (characters); on a line that hears itself,
+ * the echo option on and off in turn. */
+typedef struct {
+    const uint32_t *reply_us, (*stalls)[2], *late;
+    size_t n_reply, n_stalls, n_late;
+} scenario_grid_t;
+
+static void scenario_grid(const scenario_grid_t *g, int de_from, bool deaf)
+{
+    for (size_t r = 0; r < g->n_reply; r++) {
+        for (int de = de_from; de <= DE_HW; de++) {
+            for (size_t st = 0; st < g->n_stalls; st++) {
+                for (size_t l = 0; l < g->n_late; l++) {
+                    scenario_t s;
+                    memset(&s, 0, sizeof s);
+                    if ((de == DE_HW) && !(HAS_HW_DE && NEW_PORT)) {
+                        continue;
+                    }
+#if !defined(J288_STUB_ISR_USART)
+                    /* the F4's limit on a deaf line (test_scenario_deaf_line) */
+                    if (deaf && (g->stalls[st][0] == J288_CMD_LEN - 1u) && (g->late[l] > g->stalls[st][1])) {
+                        continue;
+                    }
+#endif
+                    s.reply_us = g->reply_us[r];
+                    s.de = (de_mode_t)de;
+                    s.deaf = deaf;
+                    s.stall_at = g->stalls[st][0];
+                    s.stall_chars = g->stalls[st][1];
+                    s.late_chars = g->late[l];
+                    s.echo = !deaf && (((r + l) % 2u) == 0u);
+                    scenario_run(&s);
+                }
+            }
+        }
+    }
+}
+
 /* Replies 0-10 us after the stop bit, without DE, with a DE pin and with the hardware DE;
  * TX stalls of 0-5 characters (mid-frame and before the last byte); both interrupts served
  * 0-40 characters late; the echo option on and off. */
@@ -1421,26 +1460,8 @@ static void test_scenario_reply_delay_de_stall_latency(void)
     static const uint32_t reply_us[] = {0u, 1u, 2u, 5u, 10u};
     static const uint32_t stalls[][2] = {{0u, 0u}, {10u, 2u}, {19u, 2u}, {1u, 5u}, {19u, 5u}};
     static const uint32_t late[] = {0u, 1u, 3u, 12u, 40u};
-    for (size_t r = 0; r < sizeof reply_us / sizeof reply_us[0]; r++) {
-        for (int de = DE_NONE; de <= DE_HW; de++) {
-            for (size_t st = 0; st < sizeof stalls / sizeof stalls[0]; st++) {
-                for (size_t l = 0; l < sizeof late / sizeof late[0]; l++) {
-                    scenario_t s;
-                    memset(&s, 0, sizeof s);
-                    if ((de == DE_HW) && !(HAS_HW_DE && NEW_PORT)) {
-                        continue;
-                    }
-                    s.reply_us = reply_us[r];
-                    s.de = (de_mode_t)de;
-                    s.stall_at = stalls[st][0];
-                    s.stall_chars = stalls[st][1];
-                    s.late_chars = late[l];
-                    s.echo = ((r + l) % 2u) == 0u;
-                    scenario_run(&s);
-                }
-            }
-        }
-    }
+    const scenario_grid_t g = {reply_us, stalls, late, 5u, 5u, 5u};
+    scenario_grid(&g, DE_NONE, false);
 }
 
 /* The same with a deaf line (a transceiver's receiver off while DE is on): nothing of ours comes
@@ -1452,31 +1473,8 @@ static void test_scenario_deaf_line(void)
     static const uint32_t reply_us[] = {0u, 2u, 10u};
     static const uint32_t stalls[][2] = {{0u, 0u}, {10u, 2u}, {19u, 3u}};
     static const uint32_t late[] = {0u, 3u, 12u};
-    for (size_t r = 0; r < sizeof reply_us / sizeof reply_us[0]; r++) {
-        for (int de = DE_GPIO; de <= DE_HW; de++) {
-            for (size_t st = 0; st < sizeof stalls / sizeof stalls[0]; st++) {
-                for (size_t l = 0; l < sizeof late / sizeof late[0]; l++) {
-                    scenario_t s;
-                    memset(&s, 0, sizeof s);
-                    if ((de == DE_HW) && !(HAS_HW_DE && NEW_PORT)) {
-                        continue;
-                    }
-#if !defined(J288_STUB_ISR_USART)
-                    if ((stalls[st][0] == J288_CMD_LEN - 1u) && (late[l] > stalls[st][1])) {
-                        continue;
-                    }
-#endif
-                    s.reply_us = reply_us[r];
-                    s.de = (de_mode_t)de;
-                    s.deaf = true;
-                    s.stall_at = stalls[st][0];
-                    s.stall_chars = stalls[st][1];
-                    s.late_chars = late[l];
-                    scenario_run(&s);
-                }
-            }
-        }
-    }
+    const scenario_grid_t g = {reply_us, stalls, late, 3u, 3u, 3u};
+    scenario_grid(&g, DE_GPIO, true);
 }
 
 /* Whether a reply byte with this flag is lost: an overrun always; a framing, parity or start-bit
