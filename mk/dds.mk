@@ -6,8 +6,10 @@
 #   test/dds/*.sh      the namespace guard, golden XCDR1 bytes, the unitree crc and the type
 #                      hashes, the bridge end to end (ROS 2 and both unitree modes), the service
 #                      under a fake systemd, each in a private network namespace (TEST_SCRIPTS)
-#   make test-dds      those tests alone, then a Fast DDS peer against the bridge (CI's test-dds
-#                      step; Debian: libfastrtps-dev fastddsgen, DDS_FASTDDS below)
+#   make test-dds      those tests alone (CI's test-dds step)
+#   make test-dds-fastdds  a Fast DDS peer (ROS 2's default middleware) against the bridge, lo
+#                      with and without multicast (CI's test-fastdds step; Debian:
+#                      libfastrtps-dev fastddsgen g++; not in make test: its build is C++)
 #   make bench-dds     cycles/s with and without DDS, command-to-wire latency, DDS's CPU share,
 #                      and the state rate at 500 Hz idle, under load and under a flood
 # Without Cyclone DDS: a one-line notice and nothing else (CI=true: an error). CMake builds and
@@ -19,7 +21,7 @@
 # (-DJ288_DDS_AS_ROS2: unbounded), twice: without type information ($(DDS_TEST_PEER), as
 # rmw_cyclonedds) and with it ($(DDS_TEST_PEER)_xt, as a peer whose types carry XTypes
 # information), both of which the bridge must match.
-.PHONY: dds dds-missing dds-no-systemd test-dds bench-dds
+.PHONY: dds dds-missing dds-no-systemd test-dds bench-dds test-dds-fastdds
 DDS_FOUND := $(shell pkg-config --exists CycloneDDS 2>/dev/null && command -v idlc >/dev/null 2>&1 && echo yes)
 DDS_SYSTEMD := $(shell pkg-config --exists libsystemd 2>/dev/null && echo yes)
 DDS_BIN := $(BIN)/j288-dds
@@ -119,8 +121,42 @@ test-dds: $(DDS_BIN) $(DDS_PEERS) $(SIM_BIN)
 
 bench-dds: $(DDS_BIN) $(DDS_PEERS) $(SIM_BIN) $(J288_BIN) $(BUILD)/bench/write_stamp.so
 	BUILD=$(BUILD) bash scripts/bench-dds.sh
+
+# The Fast DDS peer (test/dds/fastdds_peer.cpp): fastddsgen's C++ types from the same IDL as
+# ROS 2 declares it (its preprocessor given -DJ288_DDS_AS_ROS2 through a wrapper), built at
+# -O0 (a test program: the build is the cost), the generated code without our warning set.
+DDS_FASTDDS := $(shell command -v fastddsgen >/dev/null 2>&1 && command -v $(CXX) >/dev/null 2>&1 && \
+    [ -f /usr/include/fastdds/dds/domain/DomainParticipant.hpp ] && echo yes)
+FASTDDS_GEN := $(BUILD)/dds/gen-fastdds
+FASTDDS_PEER := $(BUILD)/test/fastdds_peer
+FASTDDS_IDL_NAMES := builtin_interfaces std_msgs sensor_msgs
+FASTDDS_OBJ := $(foreach n,$(FASTDDS_IDL_NAMES),$(OBJ)/dds/gen-fastdds/$(n).o $(OBJ)/dds/gen-fastdds/$(n)PubSubTypes.o)
+ifeq ($(DDS_FASTDDS),yes)
+$(FASTDDS_GEN)/stamp: $(FASTDDS_IDL_NAMES:%=tools/j288-dds/idl/%.idl)
+	@mkdir -p $(@D)
+	printf '#!/bin/sh\nexec cpp -DJ288_DDS_AS_ROS2 "$$@"\n' >$(@D)/cpp-ros2 && chmod +x $(@D)/cpp-ros2
+	fastddsgen -ppPath $(@D)/cpp-ros2 -I tools/j288-dds/idl -d $(@D) -replace $^ >$(@D)/fastddsgen.log
+	touch $@
+$(FASTDDS_GEN)/%.cxx: $(FASTDDS_GEN)/stamp ;
+$(OBJ)/dds/gen-fastdds/%.o: $(FASTDDS_GEN)/%.cxx
+	@mkdir -p $(@D)
+	$(CXX) -std=c++11 -O0 -w -I$(FASTDDS_GEN) -c $< -o $@
+$(OBJ)/test/dds/fastdds_peer.o: test/dds/fastdds_peer.cpp $(FASTDDS_GEN)/stamp
+	@mkdir -p $(@D)
+	$(CXX) -std=c++11 -O0 -Wall -Wextra -Werror -I$(FASTDDS_GEN) -c $< -o $@
+$(FASTDDS_PEER): $(OBJ)/test/dds/fastdds_peer.o $(FASTDDS_OBJ)
+	@mkdir -p $(@D)
+	$(CXX) $^ -o $@ -lfastrtps -lfastcdr
+test-dds-fastdds: $(DDS_BIN) $(DDS_TEST_PEER) $(FASTDDS_PEER) $(SIM_BIN)
+	$(call RUN_TESTS,test/dds/fastdds_e2e.sh)
 else
-dds dds-missing test-dds bench-dds:
+test-dds-fastdds:
+	@if [ "$${CI:-}" = true ]; then \
+	    echo "error: Fast DDS not found (CI=true: a failure); install: libfastrtps-dev fastddsgen g++" >&2; exit 1; fi
+	@echo "notice: skipping the Fast DDS peer test, Fast DDS not found; install with: apt-get install -y --no-install-recommends libfastrtps-dev fastddsgen g++" >&2
+endif
+else
+dds dds-missing test-dds bench-dds test-dds-fastdds:
 	@if [ "$${CI:-}" = true ]; then \
 	    echo "error: Cyclone DDS not found (CI=true: a failure); install: cyclonedds-dev cyclonedds-tools" >&2; exit 1; fi
 	@echo "notice: skipping j288-dds and its tests, Cyclone DDS not found; install with: apt-get install -y --no-install-recommends cyclonedds-dev cyclonedds-tools" >&2

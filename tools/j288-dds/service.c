@@ -34,7 +34,11 @@ void service_ready(const char *status)
 void service_tick(uint64_t now_us, void (*status)(void *ctx, char *buf, unsigned cap), void *ctx)
 {
     char buf[200];
-    if (watchdog_us == 0u || now_us - last_ping_us < watchdog_us / 2u)
+    if (watchdog_us == 0u)
+        return;
+    if (last_ping_us == 0u) /* the first cycle: READY=1 was the sign of life until now */
+        last_ping_us = now_us;
+    if (now_us - last_ping_us < watchdog_us / 2u)
         return;
     last_ping_us = now_us;
     status(ctx, buf, (unsigned)sizeof buf);
