@@ -160,7 +160,8 @@ t_flood_dropped() {
 }
 t_xtypes_peer() {
     # a peer whose types carry XTypes type information (unbounded, as ROS 2 declares them)
-    # matches the bridge's bounded types without it, both ways
+    # matches the bridge's bounded types without it, both ways (had the bridge type information
+    # too, Cyclone 0.10.2 would not match them: docs/dds.md, "Bounded input")
     "${PEER}_xt" states >"$SIM_DIR/states" && grep -q '^leg1_2 ' "$SIM_DIR/states" ||
         { echo "the XTypes peer got no joint_states"; return 1; }
     "${PEER}_xt" command --for 30 --hz 50 leg1_1 -0.2 - - >/dev/null & local p=$!

@@ -18,7 +18,8 @@
  *                             (its writer's, as the bridge names it) once matched
  *   flood [--for S | --count N] [--hz H] [--names K]
  *                             rt/joint_command with K names (default 100000) of 11
- *                             characters: 1.6 MB samples, more names than any robot has
+ *                             characters: 1.6 MB samples, more names than any robot has;
+ *                             at the end 'sent N in S s'
  *   endpoints [--timeout S]   the endpoints of other participants on rt/ topics, once at least
  *                             3 are seen (and 1 s more): 'pub|sub TOPIC TYPE USERDATA' lines
  *   lowstate [--timeout S]    the next rt/lowstate: 'motor I Q DQ TAU TEMP MODE' lines for the
@@ -512,8 +513,9 @@ static dds_entity_t writer_for(const dds_topic_descriptor_t *d, const char *name
     return -1;
 }
 
-/* Publish write() at hz: count times when count > 0, else for seconds (once when 0). */
-static void pace(int count, double seconds, double hz, void (*write)(void *ctx), void *ctx)
+/* Publish write() at hz: count times when count > 0, else for seconds (once when 0). Returns
+ * how many were written. */
+static int pace(int count, double seconds, double hz, void (*write)(void *ctx), void *ctx)
 {
     double end = mono_s() + seconds, next = mono_s();
     int sent = 0;
@@ -524,6 +526,7 @@ static void pace(int count, double seconds, double hz, void (*write)(void *ctx),
         while (mono_s() < next)
             dds_sleepfor(DDS_USECS(200));
     } while (count > 0 ? sent < count : mono_s() < end);
+    return sent;
 }
 
 /* "a,b,c" -> values; "-" -> none. */
@@ -540,117 +543,97 @@ static uint32_t parse_list(char *s, double *out)
 
 typedef struct {
     dds_entity_t w;
-    sensor_msgs_msg_dds__JointState_ m;
-} js_ctx;
+    const void *m;
+} sample_ctx;
 
-static void write_js(void *p)
+static void write_sample(void *p)
 {
-    js_ctx *c = p;
-    dds_write(c->w, &c->m);
+    sample_ctx *c = p;
+    dds_write(c->w, c->m);
+}
+
+/* m on topic name (type d) as pace() says, once a reader matched; prints 'sent N in S s' with
+ * print_sent. 1 when no reader matched. */
+static int publish(const dds_topic_descriptor_t *d, const char *name, const void *m, int count,
+                   double seconds, double hz, int print_sent)
+{
+    sample_ctx c;
+    double t0;
+    int n;
+    c.m = m;
+    c.w = writer_for(d, name);
+    if (c.w < 0)
+        return 1;
+    t0 = mono_s();
+    n = pace(count, seconds, hz, write_sample, &c);
+    if (print_sent)
+        printf("sent %d in %.2f s\n", n, mono_s() - t0);
+    dds_wait_for_acks(c.w, DDS_SECS(2));
+    return 0;
 }
 
 static int cmd_command(int count, double seconds, double hz, char **argv)
 {
     static char *names[MAXN];
     static double pos[MAXN], vel[MAXN], eff[MAXN];
-    static js_ctx c;
+    static sensor_msgs_msg_dds__JointState_ m;
     uint32_t n = 0;
     char *tok;
     for (tok = strtok(argv[0], ","); tok != NULL && n < MAXN; tok = strtok(NULL, ","))
         names[n++] = tok;
-    c.m.header.frame_id = (char *)"";
-    c.m.name._buffer = names;
-    c.m.name._length = c.m.name._maximum = n;
-    c.m.position._buffer = pos;
-    c.m.position._length = c.m.position._maximum = parse_list(argv[1], pos);
-    c.m.velocity._buffer = vel;
-    c.m.velocity._length = c.m.velocity._maximum = parse_list(argv[2], vel);
-    c.m.effort._buffer = eff;
-    c.m.effort._length = c.m.effort._maximum = parse_list(argv[3], eff);
-    c.w = writer_for(&sensor_msgs_msg_dds__JointState__desc, "joint_command");
-    if (c.w < 0)
-        return 1;
-    pace(count, seconds, hz, write_js, &c);
-    dds_wait_for_acks(c.w, DDS_SECS(2));
-    return 0;
+    m.header.frame_id = (char *)"";
+    m.name._buffer = names;
+    m.name._length = m.name._maximum = n;
+    m.position._buffer = pos;
+    m.position._length = m.position._maximum = parse_list(argv[1], pos);
+    m.velocity._buffer = vel;
+    m.velocity._length = m.velocity._maximum = parse_list(argv[2], vel);
+    m.effort._buffer = eff;
+    m.effort._length = m.effort._maximum = parse_list(argv[3], eff);
+    return publish(&sensor_msgs_msg_dds__JointState__desc, "joint_command", &m, count, seconds, hz, 0);
 }
 
-typedef struct {
-    dds_entity_t w;
-    unitree_go_msg_dds__LowCmd_ m;
-} lc_ctx;
-
-static void write_lc(void *p)
-{
-    lc_ctx *c = p;
-    dds_write(c->w, &c->m);
-}
+/* One motor's command (unitree_go's or unitree_hg's MotorCmd_) from MOTOR MODE Q DQ TAU KP KD. */
+#define SET_MOTOR(mc, argv)                        \
+    do {                                           \
+        (mc)->mode = (uint8_t)atoi((argv)[1]);     \
+        (mc)->q = strtof((argv)[2], NULL);         \
+        (mc)->dq = strtof((argv)[3], NULL);        \
+        (mc)->tau = strtof((argv)[4], NULL);       \
+        (mc)->kp = strtof((argv)[5], NULL);        \
+        (mc)->kd = strtof((argv)[6], NULL);        \
+    } while (0)
 
 static int cmd_lowcmd(int count, double seconds, double hz, int bad_crc, char **argv)
 {
-    static lc_ctx c;
-    unitree_go_msg_dds__MotorCmd_ *mc;
+    static unitree_go_msg_dds__LowCmd_ m;
     int motor = atoi(argv[0]);
     if (motor < 0 || motor >= 20)
         return 2;
-    c.m.head[0] = 0xFE;
-    c.m.head[1] = 0xEF;
-    c.m.level_flag = 0xFF;
-    mc = &c.m.motor_cmd[motor];
-    mc->mode = (uint8_t)atoi(argv[1]);
-    mc->q = strtof(argv[2], NULL);
-    mc->dq = strtof(argv[3], NULL);
-    mc->tau = strtof(argv[4], NULL);
-    mc->kp = strtof(argv[5], NULL);
-    mc->kd = strtof(argv[6], NULL);
-    c.m.crc = lowcmd_crc(&c.m) ^ (bad_crc ? 1u : 0u);
-    c.w = writer_for(&unitree_go_msg_dds__LowCmd__desc, "lowcmd");
-    if (c.w < 0)
-        return 1;
-    pace(count, seconds, hz, write_lc, &c);
-    dds_wait_for_acks(c.w, DDS_SECS(2));
-    return 0;
-}
-
-typedef struct {
-    dds_entity_t w;
-    unitree_hg_msg_dds__LowCmd_ m;
-} hg_ctx;
-
-static void write_hg(void *p)
-{
-    hg_ctx *c = p;
-    dds_write(c->w, &c->m);
+    m.head[0] = 0xFE;
+    m.head[1] = 0xEF;
+    m.level_flag = 0xFF;
+    SET_MOTOR(&m.motor_cmd[motor], argv);
+    m.crc = lowcmd_crc(&m) ^ (bad_crc ? 1u : 0u);
+    return publish(&unitree_go_msg_dds__LowCmd__desc, "lowcmd", &m, count, seconds, hz, 0);
 }
 
 static int cmd_hg_lowcmd(int count, double seconds, double hz, int bad_crc, char **argv)
 {
-    static hg_ctx c;
-    unitree_hg_msg_dds__MotorCmd_ *mc;
+    static unitree_hg_msg_dds__LowCmd_ m;
     int motor = atoi(argv[0]);
     if (motor < 0 || motor >= 35)
         return 2;
-    c.m.mode_pr = (uint8_t)(getenv("DDS_PEER_MODE_PR") ? atoi(getenv("DDS_PEER_MODE_PR")) : 0);
-    mc = &c.m.motor_cmd[motor];
-    mc->mode = (uint8_t)atoi(argv[1]);
-    mc->q = strtof(argv[2], NULL);
-    mc->dq = strtof(argv[3], NULL);
-    mc->tau = strtof(argv[4], NULL);
-    mc->kp = strtof(argv[5], NULL);
-    mc->kd = strtof(argv[6], NULL);
-    c.m.crc = hg_lowcmd_crc(&c.m) ^ (bad_crc ? 1u : 0u);
-    c.w = writer_for(&unitree_hg_msg_dds__LowCmd__desc, "lowcmd");
-    if (c.w < 0)
-        return 1;
-    pace(count, seconds, hz, write_hg, &c);
-    dds_wait_for_acks(c.w, DDS_SECS(2));
-    return 0;
+    m.mode_pr = (uint8_t)(getenv("DDS_PEER_MODE_PR") ? atoi(getenv("DDS_PEER_MODE_PR")) : 0);
+    SET_MOTOR(&m.motor_cmd[motor], argv);
+    m.crc = hg_lowcmd_crc(&m) ^ (bad_crc ? 1u : 0u);
+    return publish(&unitree_hg_msg_dds__LowCmd__desc, "lowcmd", &m, count, seconds, hz, 0);
 }
 
 /* JointState commands with k names: far more than the bridge's types allow. */
 static int cmd_flood(int count, double seconds, double hz, long k)
 {
-    static js_ctx c;
+    static sensor_msgs_msg_dds__JointState_ m;
     static char text[16];
     long i;
     char **names = malloc((size_t)k * sizeof *names);
@@ -661,15 +644,10 @@ static int cmd_flood(int count, double seconds, double hz, long k)
         names[i] = pool + 12 * i;
         snprintf(names[i], 12, "flood%06ld", i % 1000000);
     }
-    c.m.header.frame_id = text;
-    c.m.name._buffer = names;
-    c.m.name._length = c.m.name._maximum = (uint32_t)k;
-    c.w = writer_for(&sensor_msgs_msg_dds__JointState__desc, "joint_command");
-    if (c.w < 0)
-        return 1;
-    pace(count, seconds, hz, write_js, &c);
-    dds_wait_for_acks(c.w, DDS_SECS(2));
-    return 0;
+    m.header.frame_id = text;
+    m.name._buffer = names;
+    m.name._length = m.name._maximum = (uint32_t)k;
+    return publish(&sensor_msgs_msg_dds__JointState__desc, "joint_command", &m, count, seconds, hz, 1);
 }
 
 /* The endpoints other participants have on rt/ topics, with their USER_DATA. */
@@ -715,29 +693,30 @@ static int cmd_latency(int count, double hz, char **argv)
 {
     static char *names[1];
     static double pos[1];
-    static js_ctx c;
+    static sensor_msgs_msg_dds__JointState_ m;
+    dds_entity_t w;
     double a = strtod(argv[1], NULL), b = strtod(argv[2], NULL);
     int i;
     names[0] = argv[0];
-    c.m.header.frame_id = (char *)"";
-    c.m.name._buffer = names;
-    c.m.name._length = c.m.name._maximum = 1;
-    c.m.position._buffer = pos;
-    c.m.position._length = c.m.position._maximum = 1;
-    c.w = writer_for(&sensor_msgs_msg_dds__JointState__desc, "joint_command");
-    if (c.w < 0)
+    m.header.frame_id = (char *)"";
+    m.name._buffer = names;
+    m.name._length = m.name._maximum = 1;
+    m.position._buffer = pos;
+    m.position._length = m.position._maximum = 1;
+    w = writer_for(&sensor_msgs_msg_dds__JointState__desc, "joint_command");
+    if (w < 0)
         return 1;
     for (i = 0; i < count; i++) {
         struct timespec ts;
         double next = mono_s() + 1.0 / hz;
         pos[0] = (i % 2) ? b : a;
         clock_gettime(CLOCK_MONOTONIC, &ts);
-        dds_write(c.w, &c.m);
+        dds_write(w, &m);
         printf("sent %lld %.6f\n", (long long)ts.tv_sec * 1000000000LL + ts.tv_nsec, pos[0]);
         while (mono_s() < next)
             dds_sleepfor(DDS_USECS(100));
     }
-    dds_wait_for_acks(c.w, DDS_SECS(2));
+    dds_wait_for_acks(w, DDS_SECS(2));
     return 0;
 }
 

@@ -337,18 +337,25 @@ static bool unitree_plan(bridge_t *b, plan_t *p, const motor_cmd_t *mc, unsigned
     return true;
 }
 
+/* The n motor slots of a LowCmd_ m (unitree_go's or unitree_hg's) into mc[]. */
+#define MOTOR_CMDS(mc, m, n)                                                            \
+    do {                                                                                \
+        unsigned k_;                                                                    \
+        for (k_ = 0; k_ < (n); k_++) {                                                  \
+            motor_cmd_t t_ = {(m)->motor_cmd[k_].mode, (m)->motor_cmd[k_].q,            \
+                              (m)->motor_cmd[k_].dq,   (m)->motor_cmd[k_].tau,          \
+                              (m)->motor_cmd[k_].kp,   (m)->motor_cmd[k_].kd};          \
+            (mc)[k_] = t_;                                                              \
+        }                                                                               \
+    } while (0)
+
 void bridge_take_lowcmd(bridge_t *b, const unitree_go_msg_dds__LowCmd_ *m,
                         const bridge_writer_t *w, uint32_t now_us)
 {
     static plan_t p;
     motor_cmd_t mc[J288_DDS_UNITREE_MOTORS];
     uint32_t want = j288_dds_lowcmd_crc(m);
-    unsigned j;
-    for (j = 0; j < J288_DDS_UNITREE_MOTORS; j++) {
-        const unitree_go_msg_dds__MotorCmd_ *c = &m->motor_cmd[j];
-        motor_cmd_t t = {c->mode, c->q, c->dq, c->tau, c->kp, c->kd};
-        mc[j] = t;
-    }
+    MOTOR_CMDS(mc, m, J288_DDS_UNITREE_MOTORS);
     if (unitree_plan(b, &p, mc, J288_DDS_UNITREE_MOTORS, want == m->crc, m->crc, want))
         run_plan(b, &p, w, now_us);
 }
@@ -359,12 +366,7 @@ void bridge_take_hg_lowcmd(bridge_t *b, const unitree_hg_msg_dds__LowCmd_ *m,
     static plan_t p;
     motor_cmd_t mc[J288_DDS_HG_MOTORS];
     uint32_t want = j288_dds_hg_lowcmd_crc(m);
-    unsigned j;
-    for (j = 0; j < J288_DDS_HG_MOTORS; j++) {
-        const unitree_hg_msg_dds__MotorCmd_ *c = &m->motor_cmd[j];
-        motor_cmd_t t = {c->mode, c->q, c->dq, c->tau, c->kp, c->kd};
-        mc[j] = t;
-    }
+    MOTOR_CMDS(mc, m, J288_DDS_HG_MOTORS);
     if (unitree_plan(b, &p, mc, J288_DDS_HG_MOTORS, want == m->crc, m->crc, want)) {
         unsigned refused_whole = b->refused_whole;
         run_plan(b, &p, w, now_us);
