@@ -275,8 +275,9 @@ t_ctrl_c_locks_every_bus() {
 t_timeout_locks() {
     # in the namespace /robot1 (ROS 2's form: 2af1ea0 refused it)
     PEER_ARGS=(--ns robot1)
-    start_bridge --on-timeout lock --namespace /robot1 || return 1
-    PEER_ARGS=()
+    start_bridge --on-timeout lock --namespace /robot1; local rc=$?
+    PEER_ARGS=() # whatever came of it: the later checks read outside the namespace
+    [ $rc -eq 0 ] || return 1
     "$PEER" --ns robot1 command --for 0.5 --hz 50 leg0_1 - 0.5 - || return 1
     wait_err 'joint leg0_1: no command for 100 ms: locked' || return 1
     : >"$SIM_DIR/log.0"; sleep 0.3

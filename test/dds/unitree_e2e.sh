@@ -83,8 +83,9 @@ type_hashes() {
 t_go_type_hashes() { type_hashes unitree_go/msg/LowState unitree_go/msg/LowCmd; }
 t_hg_lowstate_is_the_truth() {
     PEER_ARGS=(--hg)
-    start_bridge --unitree-hg || return 1
+    start_bridge --unitree-hg; local rc=$?
     PEER_ARGS=()
+    [ $rc -eq 0 ] || return 1
     lowstate_is_the_truth --hg 7 || return 1
     # case and winding temperatures (j288-sim's ambient is 25 deg C; a servo warms as it works),
     # the supply voltage
