@@ -62,6 +62,7 @@ state_rate() {
 }
 if [ "${STATE_ONLY:-0}" = 1 ] || [ -n "${BASE_DDS:-}" ]; then
     : >"$tmp/state"; : >"$tmp/sent"
+    load_before=$(cut -d' ' -f1-3 /proc/loadavg)
     bridges=("$DDS")
     [ -n "${BASE_DDS:-}" ] && bridges=("$BASE_DDS" "$DDS")
     for r in $(seq 1 "$ROUNDS"); do
@@ -72,7 +73,7 @@ if [ "${STATE_ONLY:-0}" = 1 ] || [ -n "${BASE_DDS:-}" ]; then
         done
     done
     echo "j288-dds state rate at --rate 500: joint_states samples/s a subscriber got, ${DURATION} s each,"
-    echo "medians of $ROUNDS rounds (range); 4 buses x 3 servos on j288-sim, $(nproc) cores, load before: $(cut -d' ' -f1-3 /proc/loadavg)"
+    echo "medians of $ROUNDS rounds (range); 4 buses x 3 servos on j288-sim, $(nproc) cores, load average before: $load_before, after: $(cut -d' ' -f1-3 /proc/loadavg)"
     python3 - "$tmp/state" "${BASE_DDS:-}" "$DDS" <<'PY'
 import sys, statistics as st
 rows = {}
