@@ -38,7 +38,8 @@ for p in j288-tools j288-dds; do dpkg-deb -f "$out/${p}_${version}_"*.deb Depend
 [ "$(grep -c libddsc "$out/depends.txt")" = 1 ] && grep -q '^j288-dds: .*libddsc' "$out/depends.txt" ||
     { echo "deb: libddsc must be a dependency of j288-dds alone" >&2; exit 1; }
 # j288-dds ships its systemd unit (debian/j288-dds@.service, docs/dds.md "Running on a robot")
-dpkg-deb -c "$out/j288-dds_${version}_"*.deb | grep -q ' ./lib/systemd/system/j288-dds@.service$' ||
+dpkg-deb -c "$out/j288-dds_${version}_"*.deb >"$out/j288-dds.files" # (grep -q on a pipe: SIGPIPE)
+grep -q ' ./lib/systemd/system/j288-dds@.service$' "$out/j288-dds.files" ||
     { echo "deb: j288-dds lacks lib/systemd/system/j288-dds@.service" >&2; exit 1; }
 [ "$mode" = check ] || exit 0
 
