@@ -52,7 +52,7 @@ state_rate() {
     case $2 in
         load) stress-ng --cpu 2 --timeout $((DURATION + 3)) >/dev/null 2>&1 & l=$! ;;
         flood) "$PEER" flood --hz 50 --for $((DURATION + 3)) >"$tmp/flood" 2>/dev/null & l=$!
-               for _ in $(seq 1 200); do grep -q '^writer ' "$tmp/flood" && break; sleep 0.05; done ;;
+               for _ in $(seq 1 200); do grep -qs '^writer ' "$tmp/flood" && break; sleep 0.05; done ;;
     esac
     sleep 1
     n=$("$PEER" listen --for "$DURATION" | sed -n 's/^samples //p')
