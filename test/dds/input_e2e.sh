@@ -103,12 +103,12 @@ t_two_commanders() {
     g1=$(sed -n 's/^writer //p' "$SIM_DIR/w1")
     for n in $(seq 1 "$(e2e_scaled 100)"); do grep -q '^writer ' "$SIM_DIR/w2" && break; sleep 0.1; done
     g2=$(sed -n 's/^writer //p' "$SIM_DIR/w2")
-    wait_diag "^j288-dds: joint leg1_3|owner=$g1\$" "^j288-dds: joint leg1_3|other_writer=$g2\$" \
-        '^j288-dds: joint leg1_3|refused_other_writer=[1-9]' \
-        "^j288-dds: bridge|joint commanded by another writer=[1-9]" || { kill $p1 $p2; return 1; }
     line=$(wc -l <"$SIM_DIR/log.1"); sleep 0.5
     n=$(targets_on_wire 1 3 "$line" | wc -l)
     [ "$n" -eq 1 ] || { echo "leg1_3 got $n targets on the wire: $(targets_on_wire 1 3 "$line" | tr '\n' ' ')"; kill $p1 $p2; return 1; }
+    wait_diag "^j288-dds: joint leg1_3|owner=$g1\$" "^j288-dds: joint leg1_3|other_writer=$g2\$" \
+        '^j288-dds: joint leg1_3|refused_other_writer=[1-9]' \
+        "^j288-dds: bridge|joint commanded by another writer=[1-9]" || { kill $p1 $p2; return 1; }
     near "$(truth 1 3)" 0.2 0.01 || { echo "leg1_3 left the owner's target"; kill $p1 $p2; return 1; }
     grep -q "command refused: joint commanded by another writer: joint leg1_3: writer $g2" "$SIM_DIR/bridge.err" ||
         { echo "not reported with the writer's GUID"; kill $p1 $p2; return 1; }
