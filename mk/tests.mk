@@ -22,6 +22,12 @@ $(CLI_TEST): $(OBJ)/test/cli/test_cli_helpers.o $(CLI_CAPTURE_OBJ) \
     $(UNITY_OBJ) $(LIB_A)
 	$(LINK)
 
+# The live plot of jog and top (tools/j288/tplot.c) against series worked out by hand.
+CLI_TPLOT_TEST := $(BUILD)/test/test_cli_tplot
+$(CLI_TPLOT_TEST): $(OBJ)/test/cli/test_cli_tplot.o $(OBJ)/tools/j288/tplot.o $(UNITY_OBJ) $(LIB_A)
+	$(LINK)
+HOST_TESTS += $(CLI_TPLOT_TEST)
+
 # The tool's robot config and joint selection (cli_joint.c), with the bus plumbing it calls.
 CLI_JOINT_TEST := $(BUILD)/test/test_cli_joint
 $(OBJ)/test/cli/test_cli_joint.o: $(YAML_ENV)
