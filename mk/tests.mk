@@ -140,8 +140,9 @@ TEST_SCRIPTS += test/e2e/cli_offline.sh test/e2e/cli_bus.sh test/e2e/cli_bus_fau
 # The joint frame end to end against the simulator's truth (the tool, the config, the sim),
 # in three scripts that run side by side (test/e2e/lib_joint.sh).
 TEST_SCRIPTS += test/e2e/joint_seed.sh test/e2e/joint_range.sh test/e2e/joint_refuse.sh
-# j288 top on a terminal (tmux: capture-pane, send-keys) and through a pipe.
-TEST_SCRIPTS += test/e2e/cli_top.sh
+# j288 top on a terminal (tmux: capture-pane, send-keys) and through a pipe; j288 jog's every
+# key and its live plot against the CSV it logged.
+TEST_SCRIPTS += test/e2e/cli_top.sh test/e2e/cli_jog.sh
 # The scripts' own process helpers (whom they signal, what their cleanup removes).
 TEST_SCRIPTS += test/e2e/lib_sim_check.sh
 # The bash completion (tools/completion/j288.bash) against the tools' --help.

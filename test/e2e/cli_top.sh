@@ -17,7 +17,7 @@ SIM_DIR=$E2E_TMP
 # last one's server was still exiting met "server exited unexpectedly" on a loaded machine.
 TOP_N=0
 TMUX_SOCK=j288-top-$$-$TOP_N
-tmux_do() { tmux -L "$TMUX_SOCK" -f /dev/null "$@"; }
+tmux_do() { tmux -u -L "$TMUX_SOCK" -f /dev/null "$@"; }
 cleanup() {
     local n
     [ "$BASHPID" = "$$" ] || return 0
@@ -68,9 +68,16 @@ t_port_form() {
     [ "$(grep -Ec '^id[0-9]+ ' "$E2E_TMP/out")" -eq 2 ] && grep -Eq '^id1 +bus +1 \* ' "$E2E_TMP/out" &&
         grep -Eq '^id2 +bus +2 \* ' "$E2E_TMP/out" || { cat "$E2E_TMP/out"; return 1; }
 }
+t_port_from_env() {
+    # $J288_PORT, as its own error says (2af1ea0 said "no bus" with it set)
+    J288_PORT=$DEV "$J288" top --ids 1,2 --once --margin-us 1000000 >"$E2E_TMP/out" 2>"$E2E_TMP/err" ||
+        { cat "$E2E_TMP/err"; return 1; }
+    grep -Eq '^id1 +bus +1 \* ' "$E2E_TMP/out" || { cat "$E2E_TMP/out"; return 1; }
+}
 run_t() { if "$2" >"$E2E_TMP/t.out" 2>&1; then e2e_pass "$1"; else e2e_fail "$1" "$(head -c 1500 "$E2E_TMP/t.out")"; fi; }
 run_t pipe_one_frame t_pipe_one_frame
 run_t port_form t_port_form
+run_t port_from_env t_port_from_env
 expect_bad no_bus 2 '^j288 top: no bus: give --config FILE or --port DEV' env -u J288_PORT "$J288" top
 expect_bad json_refused 2 '^j288 top: --json: top draws a screen' "$J288" top --config "$CFG" --json
 expect_bad bad_rate 2 '^j288 top: --rate: 0 is out of range' "$J288" top --config "$CFG" --rate 0
@@ -87,13 +94,14 @@ if ! command -v tmux >/dev/null; then
     exit $?
 fi
 
-# start_top: j288 top in a fresh tmux session; its exit status goes to top.rc.
+# start_top [COLS [ARGS]]: j288 top in a fresh tmux session (150 columns, or COLS), with ARGS;
+# its exit status goes to top.rc.
 start_top() {
     rm -f "$E2E_TMP/top.rc"
     TOP_N=$((TOP_N + 1))
     TMUX_SOCK=j288-top-$$-$TOP_N
-    tmux_do new-session -d -s top -x 150 -y 30 \
-        "env -u J288_QUIET '$J288' top --config '$CFG' --interval 0.1 --rate 50; echo \$? >'$E2E_TMP/top.rc'"
+    tmux_do new-session -d -s top -x "${1:-150}" -y 30 \
+        "env -u J288_QUIET '$J288' top --config '$CFG' --interval 0.1 --rate 50 ${2:-}; echo \$? >'$E2E_TMP/top.rc'"
 }
 screen() { tmux_do capture-pane -p -t top 2>/dev/null; }
 # wait_screen REGEX: up to 30 s for the screen to show a line matching REGEX.
@@ -134,6 +142,33 @@ t_ctrl_c() {
     tmux_do send-keys -t top C-c
     wait_rc 130 && wait_broadcast "$before"
 }
+t_narrow_terminal() {
+    # 40 columns: every line cut there, never wrapped (2af1ea0 wrapped each row over three
+    # lines, pushing the header off the screen)
+    start_top 40
+    wait_screen '^hip +left +1 \* ' || return 1
+    screen | head -n1 | grep -q '^j288 top ' || { echo "header not on top"; screen; return 1; }
+    screen | awk '{ if (length($0) > 40) { print "longer than 40: " $0; bad = 1 } } END { exit bad }' || return 1
+    screen | grep -A1 '^hip ' | tail -n1 | grep -q '^knee ' || { echo "the hip row wrapped"; screen; return 1; }
+    tmux_do send-keys -t top q
+    wait_rc 0
+}
+t_live_plot() {
+    # --plot: the joints' angles in braille below the table; v: speed, torque, angle
+    start_top 150 "--plot hip,knee"
+    wait_screen '^plot: angle, rad of hip knee' || return 1
+    # (a braille cell, U+2801-U+28FF, is e2 a0-a3 xx in UTF-8: matched as bytes)
+    LC_ALL=C wait_screen $'^ +-?[0-9]+\\.[0-9]{4} \\|.*\xe2[\xa0-\xa3]' || return 1
+    tmux_do send-keys -t top v
+    wait_screen '^plot: speed, rad/s of hip knee' || return 1
+    tmux_do send-keys -t top v
+    wait_screen '^plot: torque, N\*m of hip knee' || return 1
+    tmux_do send-keys -t top q
+    wait_rc 0
+}
 run_t live_screen_and_q t_live_screen_and_q
 run_t ctrl_c t_ctrl_c
+run_t narrow_terminal t_narrow_terminal
+run_t live_plot t_live_plot
+expect_bad plot_unknown_joint 2 "^j288 top: --plot: no joint 'elbow'" "$J288" top --config "$CFG" --once --plot elbow
 e2e_summary
