@@ -143,6 +143,9 @@ TEST_SCRIPTS += test/e2e/joint_seed.sh test/e2e/joint_range.sh test/e2e/joint_re
 # j288 top on a terminal (tmux: capture-pane, send-keys) and through a pipe; j288 jog's every
 # key and its live plot against the CSV it logged.
 TEST_SCRIPTS += test/e2e/cli_top.sh test/e2e/cli_jog.sh
+# What a new user tripped on: options before the command, one range per quantity named by
+# its source, $J288_BAUD for config buses, stop naming its bus, duplicate ids, the man page.
+TEST_SCRIPTS += test/e2e/cli_usability.sh
 # The scripts' own process helpers (whom they signal, what their cleanup removes).
 TEST_SCRIPTS += test/e2e/lib_sim_check.sh
 # The bash completion (tools/completion/j288.bash) against the tools' --help.
