@@ -4,7 +4,8 @@
 # named by where it came from (a kp in the config is the config's error, not "--kp"); $J288_BAUD
 # for the buses of a config; `--config F stop` naming the bus that is busy; scan saying
 # "possible duplicate ids" when two servos answer one id; scripts/bench-robot.sh running on its
-# own; the man page listing every command apart, with every command's options. Run from the
+# own; the man page listing every command apart, with every command's options; the docs' claims
+# about the log's columns, the packages to purge and the python to use. Run from the
 # repo root with BIN set (make test does). Waits poll, bounded.
 set -u
 cd "$(dirname "$0")/../.."
@@ -100,6 +101,36 @@ t_bench_robot_runs() {
         grep -Eq '^4 buses x 3 servos \(robot\) +[0-9]+$' "$E2E_TMP/out" || { cat "$E2E_TMP/out" "$E2E_TMP/err"; return 1; }
 }
 e2e_check bench_robot_runs t_bench_robot_runs
+
+# ---- what the docs say about the programs and packages -----------------------------------------
+# (test/e2e/docs_run.sh runs the commands the docs show; these are the claims it cannot run)
+t_readme_csv_columns() {
+    # the robot form's log columns as tools/j288/README.md lists them (2af1ea0 listed
+    # "time_s, cycle, joint, bus, id, fresh, known, ..." for a header that is not that)
+    local doc
+    "$J288" --config "$E2E_TMP/robot.yaml" log --duration 0.05 --csv "$E2E_TMP/r.csv" >/dev/null || return 1
+    doc=$(grep '^| `log \[--rate HZ\]' tools/j288/README.md | sed -n 's/.*(`\([a-z_,]*\)`), then `\([a-z_,]*\)`.*/\1,\2/p')
+    [ "$doc" = "$(head -n1 "$E2E_TMP/r.csv")" ] || { echo "README: '$doc'"; echo "header: '$(head -n1 "$E2E_TMP/r.csv")'"; return 1; }
+}
+e2e_check readme_csv_columns t_readme_csv_columns
+t_readme_purge_names_every_package() {
+    # "sudo apt purge ..." must name every package debian/control builds (2af1ea0: libj288-0
+    # alone, which leaves j288-tools and j288-dds installed)
+    local line p
+    line=$(tr '\n' ' ' <README.md | grep -o 'sudo apt purge [a-z0-9 .-]*' | head -n1)
+    for p in $(sed -n 's/^Package: //p' debian/control); do
+        [[ " $line " == *" $p "* ]] || { echo "README's '$line' leaves $p installed"; return 1; }
+    done
+}
+e2e_check readme_purge_names_every_package t_readme_purge_names_every_package
+t_readme_pip_uses_debian_python() {
+    # the offline pip line needs Debian's python3-setuptools and python3-wheel: the system's
+    # /usr/bin/python3, as pip-check.sh uses (2af1ea0: "python3", which under pyenv failed with
+    # "invalid command 'bdist_wheel'")
+    grep -q '^/usr/bin/python3 -m venv --system-site-packages v && v/bin/pip install --no-build-isolation \.$' README.md &&
+        grep -q '^/usr/bin/python3 -m venv --system-site-packages ' scripts/pip-check.sh
+}
+e2e_check readme_pip_uses_debian_python t_readme_pip_uses_debian_python
 
 # ---- the man page: every command apart, with its options -------------------------------------
 t_man_page() {
