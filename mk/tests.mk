@@ -146,14 +146,20 @@ TEST_SCRIPTS += test/e2e/cli_top.sh test/e2e/cli_jog.sh
 # What a new user tripped on: options before the command, one range per quantity named by
 # its source, $J288_BAUD for config buses, stop naming its bus, duplicate ids, the man page.
 TEST_SCRIPTS += test/e2e/cli_usability.sh
-# Every j288 and j288-sim command the docs show, run against the simulator (docs/architecture.md,
-# "Commands in the docs"), and the READMEs' make demo output against make demo.
-TEST_SCRIPTS += test/e2e/docs_run.sh
+
 # The scripts' own process helpers (whom they signal, what their cleanup removes).
 TEST_SCRIPTS += test/e2e/lib_sim_check.sh
 # The bash completion (tools/completion/j288.bash) against the tools' --help.
 TEST_SCRIPTS += test/e2e/completion.sh
 TEST_DEPS += $(J288_BIN) $(SIM_BIN) $(EXAMPLE_LINUX) $(LIB_A)
+
+# make docs-check: every j288 and j288-sim command the docs show, run against the simulator
+# (docs/architecture.md, "Commands in the docs"), and the READMEs' make demo output against
+# make demo. A CI step of its own (once, about 20 s), not in `make test`, which CI runs five
+# times over (compilers, sanitizers, valgrind) for what is a check of the docs.
+.PHONY: docs-check
+docs-check: $(J288_BIN) $(SIM_BIN)
+	$(call RUN_TESTS,test/e2e/docs_run.sh)
 
 .PHONY: check-abi vectors-check
 check-abi: $(LIB_A)
