@@ -4,7 +4,7 @@
 # the keys. Every key is checked: up/down step the target (the angle follows; a step beyond the
 # joint's limit is refused on screen and nothing changes), left/right halve and double the
 # step, p/P and d/D change kp and kd (the simulator receives the new gains), space locks and
-# holds again, tab selects the next joint (held), v switches the plot, q quits (exit 0, the
+# holds again, tab selects the next joint (held), v switches the plot, z zooms it, q quits (exit 0, the
 # broadcast lock after the key, the gains printed), Ctrl-C (exit 130, the lock). The live plot
 # is checked cell by cell against the CSV jog logged (test/e2e/plot_check.py draws it again
 # from tplot.h's rules). Also the --port form, a 40-column terminal (lines cut, never
@@ -170,6 +170,11 @@ t_keys() {
     wait_screen '^plot: torque, N\*m of hip' || return 1
     press v
     wait_screen '^plot: angle \(green\) and target \(yellow\), rad of hip' || return 1
+    # z: the plot zoomed in (a column a cycle, started again), and out
+    press z
+    wait_screen '^plot: one column a cycle$' && wait_screen ' [0-9]+ samples, 1 a column$' || return 1
+    press z
+    wait_screen '^plot: 20 columns a second$' && wait_screen ' [0-9]+ samples, 5 a column$' || return 1
     # tab: knee selected and held with its own gains; hip still holds
     mark
     press Tab

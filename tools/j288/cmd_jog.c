@@ -35,6 +35,8 @@ static const char jog_help[] =
     "  tab              next joint of the config (held from where it is; the others keep\n"
     "                   what they had)\n"
     "  v                plot: angle and target, speed, torque\n"
+    "  z                plot: one column a cycle (zoomed in on a step's response), or 20\n"
+    "                   columns a second (the default: some 10 s on a screen)\n"
     "  q                quit\n"
     "The target moves to a new value at --speed (or the joint's max_speed when lower), with\n"
     "that speed as feed-forward; the plot and --csv show that ramped target.\n"
@@ -91,6 +93,7 @@ typedef struct {
     unsigned sel;     /* the selected joint */
     double step;
     unsigned view;    /* plot: 0 angle and target, 1 speed, 2 torque */
+    bool fine;        /* plot: every cycle a column (z), else 20 columns a second */
     jog_joint_t j[J288_ROBOT_MAX_JOINTS];
     bool live;        /* the screen runs: cycles are plotted and logged */
     cli_tplot_t tp;   /* the selected joint: angle, target, speed, torque */
@@ -205,11 +208,18 @@ static void lock_joint(jog_t *g, unsigned j)
     (void)j288_robot_lock(g->r, j);
 }
 
+/* The plot starts again: 20 columns a second (a screen spans some 10 s), or with fine one column
+ * a cycle (a step's response spread out). */
+static void restart_plot(jog_t *g)
+{
+    cli_tplot_init(&g->tp, 4, g->fine ? 1u : (unsigned)(g->a->rate_hz / 20.0 + 0.5));
+}
+
 /* Select joint j: the plot starts again, and the joint is held unless it already is. */
 static void select_joint(jog_t *g, unsigned j)
 {
     g->sel = j;
-    cli_tplot_init(&g->tp, 4, (unsigned)(g->a->rate_hz / 20.0 + 0.5));
+    restart_plot(g);
     if (!g->j[j].held && hold_here(g, j))
         say(g, "%s holds at %.4f rad", j288_robot_joint_name(g->r, j), g->j[j].target);
 }
@@ -394,6 +404,11 @@ static bool key(jog_t *g, int k)
     case 'v':
         g->view = (g->view + 1u) % 3u;
         break;
+    case 'z':
+        g->fine = !g->fine;
+        restart_plot(g);
+        say(g, "plot: %s", g->fine ? "one column a cycle" : "20 columns a second");
+        break;
     case 'q':
     case 'Q':
         return false;
@@ -457,7 +472,7 @@ static void draw(const jog_t *g, const char *source)
     fprintf(fr.f, "\nstep %.4f rad   ramp %.2f rad/s   limits [%.4f, %.4f] rad%s\n", g->step,
             ramp_speed(g, g->sel), lo, hi, clamp ? " (clamp)" : "");
     fputs("up/down: target +/- step   left/right: step /2 *2   p/P: kp -/+   d/D: kd -/+\n"
-          "space: hold/lock   tab: next joint   v: plot view   q: quit (servos go limp)\n",
+          "space: hold/lock   tab: next joint   v: plot view   z: zoom   q: quit (servos go limp)\n",
           fr.f);
     fprintf(fr.f, "%s\n", g->msg);
     fprintf(fr.f, "plot: %s of %s   %lu samples, %u a column\n", views[g->view],
