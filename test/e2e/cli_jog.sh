@@ -4,8 +4,9 @@
 # the keys. Every key is checked: up/down step the target (the angle follows; a step beyond the
 # joint's limit is refused on screen and nothing changes), left/right halve and double the
 # step, p/P and d/D change kp and kd (the simulator receives the new gains), space locks and
-# holds again, tab selects the next joint (held), v switches the plot, z zooms it, q quits (exit 0, the
-# broadcast lock after the key, the gains printed), Ctrl-C (exit 130, the lock). The live plot
+# holds again, tab selects the next joint (held), v switches the plot, z zooms it, q quits
+# (exit 0, the broadcast lock after the key, the gains printed), Ctrl-C (exit 130, the lock).
+# The live plot
 # is checked cell by cell against the CSV jog logged (test/e2e/plot_check.py draws it again
 # from tplot.h's rules). Also the --port form, a 40-column terminal (lines cut, never
 # wrapped), and the refusals without a terminal. Waits poll the screen or the simulator's
