@@ -6,10 +6,9 @@
 # step, p/P and d/D change kp and kd (the simulator receives the new gains), space locks and
 # holds again, tab selects the next joint (held), v switches the plot, z zooms it, q quits
 # (exit 0, the broadcast lock after the key, the gains printed), Ctrl-C (exit 130, the lock).
-# The live plot
-# is checked cell by cell against the CSV jog logged (test/e2e/plot_check.py draws it again
-# from tplot.h's rules). Also the --port form, a 40-column terminal (lines cut, never
-# wrapped), and the refusals without a terminal. Waits poll the screen or the simulator's
+# The live plot is checked cell by cell against the CSV jog logged (test/e2e/plot_check.py
+# draws it again from tplot.h's rules). Also the --port form, a 40-column terminal (lines cut,
+# never wrapped), and the refusals without a terminal. Waits poll the screen or the simulator's
 # log, bounded; nothing depends on the machine's speed. tmux missing: skipped with a notice,
 # unless CI=true (then failed: scripts/ci-install.sh installs tmux).
 set -u
