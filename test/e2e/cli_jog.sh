@@ -74,6 +74,7 @@ wait_screen() {
     echo "never on screen: /$1/"; screen; return 1
 }
 press() { tmux_do send-keys -t jog "$@"; }
+cycle_now() { screen | sed -n 's/^j288 jog .* cycle \([0-9]*\) .*/\1/p'; }
 # field JOINT N: field N of the joint's row (1 name, 2 state, 3 target, 4 angle, ... 7 kp, 8 kd).
 field() { screen | sed -n "s/^[> ] \($1 .*\)/\1/p" | awk -v n="$2" '{ print $n }'; }
 # wait_rc WANT: up to 30 s for jog to exit with WANT.
@@ -172,7 +173,14 @@ t_keys() {
     wait_screen '^plot: angle \(green\) and target \(yellow\), rad of hip' || return 1
     # z: the plot zoomed in (a column a cycle, started again), and out
     press z
-    wait_screen '^plot: one column a cycle$' && wait_screen ' [0-9]+ samples, 1 a column$' || return 1
+    wait_screen '^plot: one column a cycle from each step or gain change, then held$' || return 1
+    # ... held once the screen is full: later cycles leave it as it is
+    local full=$((2 * (COLS - 11))) c1
+    wait_screen " $full samples, 1 a column$" || return 1
+    c1=$(cycle_now)
+    for _ in $(seq 1 "$(e2e_scaled 600)"); do [ "$(cycle_now)" -gt $((c1 + 20)) ] && break; sleep 0.05; done
+    [ "$(cycle_now)" -gt $((c1 + 20)) ] && screen | grep -q " $full samples, 1 a column$" ||
+        { echo "the zoomed plot went on"; screen; return 1; }
     press z
     wait_screen '^plot: 20 columns a second$' && wait_screen ' [0-9]+ samples, 5 a column$' || return 1
     # tab: knee selected and held with its own gains; hip still holds

@@ -35,8 +35,9 @@ static const char jog_help[] =
     "  tab              next joint of the config (held from where it is; the others keep\n"
     "                   what they had)\n"
     "  v                plot: angle and target, speed, torque\n"
-    "  z                plot: one column a cycle (zoomed in on a step's response), or 20\n"
-    "                   columns a second (the default: some 10 s on a screen)\n"
+    "  z                plot: one column a cycle from each step or gain change until the\n"
+    "                   screen is full, then held (a step's response, spread out and kept\n"
+    "                   in view), or 20 columns a second (the default: some 10 s a screen)\n"
     "  q                quit\n"
     "The target moves to a new value at --speed (or the joint's max_speed when lower), with\n"
     "that speed as feed-forward; the plot and --csv show that ramped target.\n"
@@ -93,7 +94,9 @@ typedef struct {
     unsigned sel;     /* the selected joint */
     double step;
     unsigned view;    /* plot: 0 angle and target, 1 speed, 2 torque */
-    bool fine;        /* plot: every cycle a column (z), else 20 columns a second */
+    bool fine;        /* plot: every cycle a column from the latest step on (z), else 20
+                         columns a second */
+    unsigned plot_cols; /* dot columns the plot showed last (fine: it stops when full) */
     jog_joint_t j[J288_ROBOT_MAX_JOINTS];
     bool live;        /* the screen runs: cycles are plotted and logged */
     cli_tplot_t tp;   /* the selected joint: angle, target, speed, torque */
@@ -209,7 +212,8 @@ static void lock_joint(jog_t *g, unsigned j)
 }
 
 /* The plot starts again: 20 columns a second (a screen spans some 10 s), or with fine one column
- * a cycle (a step's response spread out). */
+ * a cycle from now until the screen is full, where it stays (a step's response spread out and
+ * kept in view, as an oscilloscope's single trigger): every step and gain change starts it. */
 static void restart_plot(jog_t *g)
 {
     cli_tplot_init(&g->tp, 4, g->fine ? 1u : (unsigned)(g->a->rate_hz / 20.0 + 0.5));
@@ -243,7 +247,8 @@ static void record(jog_t *g, const j288_robot_cycle_t *c)
     }
     if (jj->held)
         v[1] = jj->setpoint;
-    cli_tplot_add(&g->tp, v);
+    if (!g->fine || g->plot_cols == 0u || g->tp.ncols < g->plot_cols)
+        cli_tplot_add(&g->tp, v);
     if (g->csv == NULL)
         return;
     (void)j288_robot_joint_stats(g->r, g->sel, &js);
@@ -341,6 +346,8 @@ static void step_target(jog_t *g, double sign)
         say(g, "target %.4f rad", want);
     }
     jj->target = want;
+    if (g->fine)
+        restart_plot(g);
 }
 
 static void change_gain(jog_t *g, j288_quantity_t q, bool up)
@@ -361,6 +368,8 @@ static void change_gain(jog_t *g, j288_quantity_t q, bool up)
     }
     *gain = want;
     say(g, "%s %.6g %s", name, want, j288_range(q)->unit);
+    if (g->fine)
+        restart_plot(g);
 }
 
 /* One key; false for q. */
@@ -407,7 +416,8 @@ static bool key(jog_t *g, int k)
     case 'z':
         g->fine = !g->fine;
         restart_plot(g);
-        say(g, "plot: %s", g->fine ? "one column a cycle" : "20 columns a second");
+        say(g, "plot: %s", g->fine ? "one column a cycle from each step or gain change, then held"
+                                   : "20 columns a second");
         break;
     case 'q':
     case 'Q':
@@ -450,7 +460,7 @@ static void print_joint_rows(FILE *f, const jog_t *g)
     }
 }
 
-static void draw(const jog_t *g, const char *source)
+static void draw(jog_t *g, const char *source)
 {
     static const char *const views[] = {"angle (green) and target (yellow), rad",
                                         "speed, rad/s", "torque, N*m"};
@@ -478,6 +488,7 @@ static void draw(const jog_t *g, const char *source)
     fprintf(fr.f, "plot: %s of %s   %lu samples, %u a column\n", views[g->view],
             j288_robot_joint_name(g->r, g->sel), (unsigned long)g->tp.samples, g->tp.per_column);
     used = 10u + j288_robot_njoints(g->r);
+    g->plot_cols = cols > 20u ? 2u * (cols - 11u) : 0u;
     if (rows > used + 2u && cols > 20u)
         cli_live_plot(fr.f, &g->tp, masks[g->view], cols,
                       rows - used - 2u > 24u ? 24u : rows - used - 2u, min_span[g->view],
