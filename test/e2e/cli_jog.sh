@@ -16,21 +16,9 @@ cd "$(dirname "$0")/../.."
 . test/e2e/lib_e2e.sh
 SIM_DIR=$E2E_TMP
 . test/e2e/lib_sim.sh
-JOG_N=0
-JOG_SOCK=j288-jog-$$-0
-tmux_do() { tmux -u -L "$JOG_SOCK" -f /dev/null "$@"; }
-cleanup() {
-    local n
-    [ "$BASHPID" = "$$" ] || return 0
-    if command -v tmux >/dev/null; then
-        for n in $(seq 0 "$JOG_N"); do
-            tmux -L "j288-jog-$$-$n" kill-server 2>/dev/null
-            rm -f "${TMUX_TMPDIR:-/tmp}/tmux-$(id -u)/j288-jog-$$-$n"
-        done
-    fi
-    sim_cleanup TERM
-}
-trap cleanup EXIT
+TMUX_NAME=jog
+. test/e2e/lib_tmux.sh
+trap 'tmux_cleanup; sim_cleanup TERM' EXIT
 need_built "$J288" "$SIM"
 e2e_need_python
 
@@ -44,12 +32,6 @@ printf 'buses:\n  - {name: left, port: %s, margin_us: 250000}\njoints:\n  - {nam
 CSV=$E2E_TMP/jog.csv
 COLS=110
 
-# broadcasts: the simulator's broadcast locks so far; wait_broadcast N: more than N, 20 s.
-broadcasts() { grep -c ' id=15 status=0 ' "$LOG"; }
-wait_broadcast() {
-    for _ in $(seq 1 "$(e2e_scaled 400)"); do [ "$(broadcasts)" -gt "$1" ] && return 0; sleep 0.05; done
-    echo "no broadcast lock after the key"; return 1
-}
 # wait_log REGEX: up to 20 s for the simulator to log a command matching REGEX after line $MARK.
 wait_log() {
     for _ in $(seq 1 "$(e2e_scaled 400)"); do tail -n +"$MARK" "$LOG" | grep -Eq -- "$1" && return 0; sleep 0.05; done
@@ -57,31 +39,11 @@ wait_log() {
 }
 mark() { MARK=$(($(wc -l <"$LOG") + 1)); }
 
-# start_jog COLS ARGS...: j288 jog ARGS in a fresh tmux session COLS wide; its exit status goes
-# to jog.rc, and the pane stays (a read) so that what it printed last can be read.
-start_jog() {
-    local cols=$1; shift
-    rm -f "$E2E_TMP/jog.rc"
-    JOG_N=$((JOG_N + 1))
-    JOG_SOCK=j288-jog-$$-$JOG_N
-    tmux_do new-session -d -s jog -x "$cols" -y 40 \
-        "env -u J288_QUIET '$J288' jog $* ; echo \$? >'$E2E_TMP/jog.rc'; read -r _"
-}
-screen() { tmux_do capture-pane -p -t jog 2>/dev/null; }
-# wait_screen REGEX: up to 30 s for a screen line matching REGEX.
-wait_screen() {
-    for _ in $(seq 1 "$(e2e_scaled 600)"); do screen | grep -Eq -- "$1" && return 0; sleep 0.05; done
-    echo "never on screen: /$1/"; screen; return 1
-}
-press() { tmux_do send-keys -t jog "$@"; }
+# start_jog COLS ARGS: j288 jog ARGS (a shell line's words) in a fresh tmux session COLS wide.
+start_jog() { tmux_start "$1" 40 "env -u J288_QUIET '$J288' jog $2"; }
 cycle_now() { screen | sed -n 's/^j288 jog .* cycle \([0-9]*\) .*/\1/p'; }
 # field JOINT N: field N of the joint's row (1 name, 2 state, 3 target, 4 angle, ... 7 kp, 8 kd).
 field() { screen | sed -n "s/^[> ] \($1 .*\)/\1/p" | awk -v n="$2" '{ print $n }'; }
-# wait_rc WANT: up to 30 s for jog to exit with WANT.
-wait_rc() {
-    for _ in $(seq 1 "$(e2e_scaled 600)"); do [ -s "$E2E_TMP/jog.rc" ] && break; sleep 0.05; done
-    [ "$(cat "$E2E_TMP/jog.rc" 2>/dev/null)" = "$1" ] || { echo "exit '$(cat "$E2E_TMP/jog.rc" 2>/dev/null)', want $1"; return 1; }
-}
 # wait_settled JOINT: up to 30 s for its angle to come within 0.01 rad of its target.
 wait_settled() {
     local t a
@@ -95,6 +57,13 @@ wait_settled() {
 # kp_raw / kd_raw SI: the wire's fields for a joint-side gain (x 1280000 and 128000000 / N^2).
 kp_raw() { awk -v k="$1" 'BEGIN { printf "%d", k * 1280000 / (288.35 * 288.35) + 0.5 }'; }
 kd_raw() { awk -v k="$1" 'BEGIN { printf "%d", k * 128000000 / (288.35 * 288.35) + 0.5 }'; }
+# gain_key KEY kp|kd VALUE SCREEN: press KEY; the screen says SCREEN and the simulator gets
+# VALUE (rad units on the joint side) in that field of servo 1's commands.
+gain_key() {
+    mark
+    press "$1"
+    wait_screen "$4" && wait_log " id=1 status=1 wd=1 .* $2=$("${2}_raw" "$3")( |$)"
+}
 run_t() { if "$2" >"$E2E_TMP/t.out" 2>&1; then e2e_pass "$1"; else e2e_fail "$1" "$(head -c 2500 "$E2E_TMP/t.out")"; fi; }
 
 # ---- without a terminal -----------------------------------------------------------------------
@@ -104,15 +73,7 @@ expect_bad id_with_config 2 '^j288 jog: --id: with --config, name the joint' "$J
 expect_bad bad_step 2 '^j288 jog: --step: 2 is out of range' "$J288" jog --config "$CFG" --step 2
 expect_bad bad_kp 2 '^j288 jog: --kp: 3000 is out of range 0..2128.4' "$J288" jog --config "$CFG" --kp 3000
 
-if ! command -v tmux >/dev/null; then
-    if [ "${CI:-}" = true ]; then
-        e2e_fail tmux "tmux is not installed (scripts/ci-install.sh installs it)"
-    else
-        echo "cli_jog: tmux not installed: the terminal checks are skipped (apt-get install tmux)"
-    fi
-    e2e_summary
-    exit $?
-fi
+tmux_need
 
 # ---- every key, one session -------------------------------------------------------------------
 t_keys() {
@@ -143,20 +104,9 @@ t_keys() {
     # down: back to where it began
     press Down
     wait_screen "^> hip +hold +$t0 " && wait_settled hip || return 1
-    # P, p: kp up by 1.25 and down again, each on the wire
-    mark
-    press P
-    wait_screen '^kp 25 N\*m/rad$' && wait_log " id=1 status=1 wd=1 .* kp=$(kp_raw 25) " || return 1
-    mark
-    press p
-    wait_screen '^kp 20 N\*m/rad$' && wait_log " id=1 status=1 wd=1 .* kp=$(kp_raw 20) " || return 1
-    # D, d: kd
-    mark
-    press D
-    wait_screen '^kd 3\.125 N\*m\*s/rad$' && wait_log " id=1 status=1 wd=1 .* kd=$(kd_raw 3.125)$" || return 1
-    mark
-    press d
-    wait_screen '^kd 2\.5 N\*m\*s/rad$' && wait_log " id=1 status=1 wd=1 .* kd=$(kd_raw 2.5)$" || return 1
+    # P, p, D, d: kp up by 1.25 and down again, kd too, each on the wire
+    gain_key P kp 25 '^kp 25 N\*m/rad$' && gain_key p kp 20 '^kp 20 N\*m/rad$' &&
+        gain_key D kd 3.125 '^kd 3\.125 N\*m\*s/rad$' && gain_key d kd 2.5 '^kd 2\.5 N\*m\*s/rad$' || return 1
     # space: locked (lock on the wire), then held again
     mark
     press Space
@@ -189,9 +139,9 @@ t_keys() {
     wait_screen '^> knee +hold +-0\.[23][0-9]{3} ' && wait_screen '^  hip +hold ' || return 1
     wait_log " id=2 status=1 wd=1 .* kp=$(kp_raw 10) kd=$(kd_raw 1)$" || return 1
     # q: exit 0, every servo locked after the key, the gains to keep printed
-    before=$(broadcasts)
+    before=$(broadcasts "$LOG")
     press q
-    wait_rc 0 && wait_broadcast "$before" || return 1
+    wait_rc 0 && wait_broadcast "$LOG" "$before" || return 1
     wait_screen '^hip: kp: 20  kd: 2\.5$' && wait_screen '^knee: kp: 10  kd: 1$'
 }
 # check_plot: the screen's plot against the CSV, a few captures (a frame may be caught while
@@ -209,9 +159,9 @@ t_ctrl_c() {
     local before
     start_jog "$COLS" "--config '$CFG' --joint knee"
     wait_screen '^> knee +hold ' || return 1
-    before=$(broadcasts)
+    before=$(broadcasts "$LOG")
     press C-c
-    wait_rc 130 && wait_broadcast "$before"
+    wait_rc 130 && wait_broadcast "$LOG" "$before"
 }
 t_port_form() {
     start_jog "$COLS" "--port '$DEV' --id 1 --margin-us 250000"
@@ -223,11 +173,7 @@ t_narrow_terminal() {
     # 40 columns: every line cut there, the header still the first line, one line per joint
     start_jog 40 "--config '$CFG'"
     wait_screen '^> hip +hold ' || return 1
-    screen | head -n1 | grep -q '^j288 jog ' || { echo "header not on top"; screen; return 1; }
-    screen | python3 -c 'import sys
-long = [l for l in sys.stdin.read().split("\n") if len(l) > 40]
-print("\n".join("longer than 40: " + l for l in long)); sys.exit(1 if long else 0)' || return 1
-    screen | grep -A1 '^> hip ' | tail -n1 | grep -q '^  knee ' || { echo "the hip row wrapped"; screen; return 1; }
+    narrow_screen_ok 40 'j288 jog ' '> hip ' '  knee ' || return 1
     press q
     wait_rc 0
 }

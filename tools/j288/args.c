@@ -132,6 +132,15 @@ int cli_parse_qty(j288_quantity_t q, const char *from, const char *text, double 
     return 0;
 }
 
+int cli_parse_gain(j288_quantity_t q, const char *text, bool *given, double *out)
+{
+    if (cli_parse_qty(q, j288_range(q)->option, text, out) != 0) {
+        return -1;
+    }
+    *given = true;
+    return 0;
+}
+
 int cli_parse_choice(const char *opt, const char *text, const char *const *choices, int *out)
 {
     int i;

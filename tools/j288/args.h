@@ -62,6 +62,10 @@ int cli_parse_real_in(const char *opt, const char *text, double lo, double hi, d
  * LO..HI" otherwise). */
 int cli_parse_qty(j288_quantity_t q, const char *from, const char *text, double *out);
 
+/* A gain option (q J288_QTY_KP or _KD, named as the table names it): cli_parse_qty(), and
+ * *given set when it parsed. */
+int cli_parse_gain(j288_quantity_t q, const char *text, bool *given, double *out);
+
 /* One of choices (NULL-terminated); *out is its index. */
 int cli_parse_choice(const char *opt, const char *text, const char *const *choices, int *out);
 

@@ -121,11 +121,9 @@ static int parse_jog_opt(void *ctx, int key, const char *v)
     case OPT_SPEED:
         return cli_parse_real_in("--speed", v, 0.01, 100.0, &a->speed);
     case OPT_KP:
-        a->have_kp = true;
-        return cli_parse_qty(J288_QTY_KP, "--kp", v, &a->kp);
+        return cli_parse_gain(J288_QTY_KP, v, &a->have_kp, &a->kp);
     case OPT_KD:
-        a->have_kd = true;
-        return cli_parse_qty(J288_QTY_KD, "--kd", v, &a->kd);
+        return cli_parse_gain(J288_QTY_KD, v, &a->have_kd, &a->kd);
     case OPT_RATE:
         return cli_parse_real_in("--rate", v, 10.0, 2000.0, &a->rate_hz);
     case OPT_CSV:
