@@ -190,7 +190,7 @@ static bool hold_here(jog_t *g, unsigned j)
     }
     limits_of(g->r, j, &lo, &hi, &clamp);
     q = st.pos < lo ? lo : (st.pos > hi ? hi : st.pos);
-    if (fabs(q - st.pos) > J288_ROBOT_HOLD_BEYOND_MAX && !clamp) {
+    if (fabs(q - st.pos) > J288_ROBOT_HOLD_BEYOND_MAX) { /* (clamping or not: no jump at the start) */
         say(g, "%s is at %.4f rad, beyond its limits [%.4f, %.4f] by more than %g rad: "
                "nothing held; move it inside by hand",
             j288_robot_joint_name(g->r, j), st.pos, lo, hi, J288_ROBOT_HOLD_BEYOND_MAX);
