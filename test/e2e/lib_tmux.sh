@@ -51,11 +51,12 @@ wait_screen() {
     for _ in $(seq 1 "$(e2e_scaled 600)"); do screen | grep -Eq -- "$1" && return 0; sleep 0.05; done
     echo "never on screen: /$1/"; screen; return 1
 }
-# wait_rc WANT: up to 30 s for the program to exit, with status WANT.
+# wait_rc WANT: up to 30 s for the program to exit, with status WANT (else the screen shows
+# what it said last).
 wait_rc() {
     local rc=$E2E_TMP/$TMUX_NAME.rc
     for _ in $(seq 1 "$(e2e_scaled 600)"); do [ -s "$rc" ] && break; sleep 0.05; done
-    [ "$(cat "$rc" 2>/dev/null)" = "$1" ] || { echo "exit '$(cat "$rc" 2>/dev/null)', want $1"; return 1; }
+    [ "$(cat "$rc" 2>/dev/null)" = "$1" ] || { echo "exit '$(cat "$rc" 2>/dev/null)', want $1"; screen; return 1; }
 }
 # broadcasts LOG: the broadcast locks the simulator logged so far; wait_broadcast LOG N: up to
 # 20 s for more than N.

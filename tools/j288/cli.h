@@ -33,10 +33,12 @@ typedef struct {
     const char *port; /* NULL: $J288_PORT, else an error for bus commands */
     uint32_t baud;    /* 0: J288_DEFAULT_BAUD */
     const char *config; /* --config FILE before the command, or NULL */
-    /* The bus commands' other common options, accepted before the command too. */
+    /* The bus commands' other common options, accepted before the command too. All-zero:
+     * none given. */
     uint32_t margin_us; /* 0: by device kind */
     bool echo;
-    int retries; /* -1: the command's default */
+    bool has_retries;
+    uint8_t retries;
 } cli_global_t;
 
 /* Watchdog trips the host layer found and cleared in this process (cli_bus.c): main() turns

@@ -31,7 +31,7 @@ void cli_bus_opts_init(cli_bus_opts_t *o, const cli_global_t *g)
     o->config = g->config; /* `j288 --config F status --joint hip` as well */
     o->margin_us = g->margin_us;
     o->echo = g->echo;
-    o->retries = g->retries;
+    o->retries = g->has_retries ? (int)g->retries : -1;
 }
 
 int cli_bus_common_opt(cli_bus_opts_t *o, int key, const char *value)

@@ -116,7 +116,7 @@ static int parse_robot_args(int argc, char **argv, const cli_global_t *g, robot_
     a->margin_us = g->margin_us;
     a->baud = g->baud;
     a->echo = g->echo;
-    a->retries = g->retries;
+    a->retries = g->has_retries ? (int)g->retries : -1;
     a->rate_hz = 500.0;
     a->duration_s = 1.0;
     cli_args_init(&p, argc, argv);

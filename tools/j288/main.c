@@ -85,7 +85,8 @@ static int global_value(cli_global_t *g, int key, const char *v)
     } else if (key == OPT_MARGIN && cli_parse_qty(J288_QTY_MARGIN_US, "--margin-us", v, &x) == 0) {
         g->margin_us = (uint32_t)x;
     } else if (key == OPT_RETRIES && cli_parse_qty(J288_QTY_RETRIES, "--retries", v, &x) == 0) {
-        g->retries = (int)x;
+        g->retries = (uint8_t)x;
+        g->has_retries = true;
     } else {
         return -1;
     }
@@ -100,12 +101,13 @@ static int watchdog_exit(int code)
 
 int main(int argc, char **argv)
 {
-    cli_global_t g = {NULL, 0, NULL, 0, false, -1};
+    cli_global_t g;
     cli_args_t a;
     const char *v;
     const command_t *c;
     int key;
 
+    memset(&g, 0, sizeof g);
     cli_set_command(NULL);
     cli_args_init(&a, argc, argv);
     /* Global options stop at the first positional argument: the command. */
