@@ -85,11 +85,12 @@ $(OBJ)/test/linux/%.o $(OBJ)/test/desktop/%.o: CPPFLAGS_OBJ = $(TEST_CPPFLAGS) -
 # j288-sim as a child process, for the tests that drive it (test/linux/sim_process.c).
 SIM_PROCESS_OBJ := $(OBJ)/test/linux/sim_process.o
 
-# The bus loop the port tests (and benchmarks, the soak) drive a port with: test/desktop/.
+# test/desktop/: the bus loop the port tests (and benchmarks, the soak) drive a port with, and
+# the checks every OS's port test runs alike.
 SERIAL_LOOP_OBJ := $(OBJ)/test/desktop/serial_loop.o
 
-$(LINUX_PORT_TEST): $(OBJ)/test/linux/test_linux_port.o $(SIM_PROCESS_OBJ) $(SERIAL_LOOP_OBJ) $(UNITY_OBJ) \
-    $(LINUX_A) $(LIB_A)
+$(LINUX_PORT_TEST): $(OBJ)/test/linux/test_linux_port.o $(SIM_PROCESS_OBJ) $(SERIAL_LOOP_OBJ) \
+    $(OBJ)/test/desktop/serial_checks.o $(UNITY_OBJ) $(LINUX_A) $(LIB_A)
 	$(LINK)
 
 CONFIG_TEST := $(BUILD)/test/test_robot_config

@@ -101,8 +101,8 @@ $(WIN)/test/%.exe: $(WIN_OBJ)/test/unit/%.o $(WIN_TEST_SUPPORT_OBJ) $(WIN_UNITY_
 
 # The port's test goes through the DLL (its import library): that checks the DLL too.
 WIN_SERIAL_LOOP_OBJ := $(WIN_OBJ)/test/desktop/serial_loop.o
-$(WIN_PORT_TEST): $(WIN_OBJ)/test/windows/test_windows_port.o $(WIN_SERIAL_LOOP_OBJ) $(WIN_UNITY_OBJ) \
-    $(WIN_IMPLIB)
+$(WIN_PORT_TEST): $(WIN_OBJ)/test/windows/test_windows_port.o $(WIN_SERIAL_LOOP_OBJ) \
+    $(WIN_OBJ)/test/desktop/serial_checks.o $(WIN_UNITY_OBJ) $(WIN_IMPLIB)
 	$(LINK)
 
 $(WIN_BENCH): $(WIN_OBJ)/test/windows/bench_windows_port.o $(WIN_SERIAL_LOOP_OBJ) $(WIN_PORT_A) $(WIN_LIB_A)

@@ -23,6 +23,7 @@
 
 #include "j288/j288.h"
 #include "j288_serial.h"
+#include "serial_checks.h"
 #include "serial_loop.h"
 
 #define WINE_MAX_BAUD            4000000u
@@ -424,50 +425,12 @@ static void test_two_ports_one_wait(void)
     TEST_ASSERT_EQUAL_UINT(0u, j288_serial_wait_any(ports, 0, 1000u, ready));
 }
 
-/* The done callback's copy of the transaction. */
-static j288_txn_t g_done_txn;
-static bool g_done;
-static void on_done(void *user, const j288_txn_t *txn)
-{
-    (void)user;
-    g_done_txn = *txn;
-    g_done = true;
-}
-
-/* A whole reply in the driver's queue (no read is in flight before the port first waits). */
-static bool reply_waiting(void)
-{
-    COMSTAT st;
-    DWORD errs;
-    memset(&st, 0, sizeof st);
-    return ClearCommError(g_sp.os.h, &errs, &st) && st.cbInQue >= J288_REPLY_LEN;
-}
-
-/* As test_linux_port's: a host that wakes past the reply deadline with the reply already
- * waiting gets it, on the first attempt (the core reads before it judges a due deadline). */
+/* The core's late-host rule under Windows (serial_checks.h): bytes that came while no read
+ * was in flight are read at once, not by a read that Wine completes after the deadline. */
 static void test_reply_waiting_when_the_host_wakes_late(void)
 {
-    j288_cmd_raw_t c = lock_cmd(1);
-    uint32_t at;
-    int i;
     open_port(g_clean, 20000u, false);
-    g_done = false;
-    TEST_ASSERT_EQUAL_INT(J288_OK, j288_bus_submit(&g_bus, &c, j288_serial_now_us(), on_done, NULL));
-    /* The host "asleep": the reply arrives and the deadline passes (each bounded: 30 s). */
-    for (i = 0; i < 30000 && !reply_waiting(); i++)
-        Sleep(1);
-    TEST_ASSERT_TRUE_MESSAGE(reply_waiting(), "no reply from the simulator");
-    TEST_ASSERT_TRUE(j288_serial_next_deadline(&g_sp, &at));
-    for (i = 0; i < 30000 && (int32_t)(j288_serial_now_us() - at) <= 0; i++)
-        Sleep(1);
-    TEST_ASSERT_EQUAL_INT(J288_OK, j288_serial_service(&g_sp));
-    j288_bus_poll(&g_bus, j288_serial_now_us());
-    TEST_ASSERT_TRUE(g_done);
-    TEST_ASSERT_EQUAL_INT(J288_OK, g_done_txn.result);
-    TEST_ASSERT_EQUAL_UINT(1, g_done_txn.attempts);
-    TEST_ASSERT_EQUAL_UINT(1, g_done_txn.reply.id);
-    TEST_ASSERT_EQUAL_UINT32(0, j288_bus_stats(&g_bus)->timeouts);
-    TEST_ASSERT_EQUAL_UINT32(0, j288_bus_stats(&g_bus)->stale_bytes);
+    serial_check_late_host_takes_waiting_reply(&g_sp, &g_bus);
 }
 
 /* The simulator goes away: the port says the device vanished, once, and then fails fast. */
