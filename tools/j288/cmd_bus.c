@@ -913,10 +913,10 @@ static drive_end_t drive_loop_run(cli_bus_t *b, drive_args_t *d, const drive_pla
                               drive_result_t *res)
 {
     uint32_t period_us = (uint32_t)lround(1e6 / d->rate_hz);
-    uint32_t t0 = j288_linux_now_us(), next = t0, now;
+    uint32_t t0 = j288_robot_now_us(), next = t0, now;
     int fails = 0, rc;
     for (;;) {
-        double t = (double)(uint32_t)(j288_linux_now_us() - t0) / 1e6;
+        double t = (double)(uint32_t)(j288_robot_now_us() - t0) / 1e6;
         if (cli_stop_signal != 0) {
             return DRIVE_END_SIGNAL;
         }
@@ -947,7 +947,7 @@ static drive_end_t drive_loop_run(cli_bus_t *b, drive_args_t *d, const drive_pla
             return DRIVE_END_SILENT;
         }
         next += period_us;
-        now = j288_linux_now_us();
+        now = j288_robot_now_us();
         if ((int32_t)(next - now) < 0) {
             res->overruns++;
             next = now;
