@@ -60,7 +60,7 @@ static bool answered_twice(cli_bus_t *b, uint32_t extra_before)
 {
     const j288_bus_t *bus = j288_robot_bus_engine(b->robot, 0);
     if (bus != NULL)
-        (void)cli_bus_sleep_until(b, j288_linux_now_us() + j288_bus_reply_budget_us(bus));
+        (void)cli_bus_sleep_until(b, j288_robot_now_us() + j288_bus_reply_budget_us(bus));
     return extra_bytes(b) != extra_before;
 }
 

@@ -650,7 +650,7 @@ int cli_cmd_jog(int argc, char **argv, const cli_global_t *gl)
         g.j[k].kd = a.have_kd ? a.kd : (double)jc.kd;
     }
     g.sel = (unsigned)sel;
-    g.t0_us = j288_linux_now_us();
+    g.t0_us = j288_robot_now_us();
     rc = acquire(&g);
     if (rc == J288_OK) {
         select_joint(&g, g.sel);
