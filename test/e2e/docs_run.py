@@ -18,8 +18,11 @@ and listed: syntax with placeholders (an all-capitals word such as FILE, DEV or 
 
 How. Each runs in DIR (a scratch folder, with build/bin there linking to BIN), the program
 being the build's. Every serial device the docs use (/dev/ttyUSB0, /dev/ttyUSB1, /dev/j288,
-build/demo/bus, /tmp/j288bus, /tmp/bus) is LINK, the simulator (servos 1, 2, 3; hip and knee in
-DIR/robot.yaml are 1 and 2); a j288-sim command gets a link of its own. A command that runs
+build/demo/bus, /tmp/j288bus, /tmp/bus) is LINK, the simulator (servos 0-14; hip and knee in
+DIR/robot.yaml are 1 and 2), and so is $J288_PORT; a j288-sim command gets a link of its own.
+A j288 bus command that gives no --margin-us gets --margin-us 1000000 before it: on a loaded
+machine the pseudo-terminal's default 5 ms misses replies (make demo, whose output is checked
+as it prints it, is run once more when it failed). A command that runs
 until Ctrl-C (hold, move, torque without --duration or --arrive; the robot form's hold; a
 j288-sim) is interrupted once it is driving (the simulator logs its first FOC command; a
 j288-sim: its link exists), and must then exit 130 (0 for j288-sim). Any other must exit 0
@@ -173,6 +176,21 @@ def mapped(argv, dev, own_link):
     return out
 
 
+OFFLINE = {"encode", "decode", "plot", "help"}
+LOADED_MARGIN = "1000000"
+
+
+def with_margin(argv):
+    """A j288 bus command with --margin-us 1000000 before it (unless it gives one): the reply
+    margin of a loaded machine, where the pseudo-terminal's default (5 ms) misses replies."""
+    k = next(i for i, a in enumerate(argv) if not re.match(r"^[A-Za-z_]\w*=", a))
+    rest = argv[k + 1:]
+    if os.path.basename(argv[k]) != "j288" or any(a.startswith("--margin-us") for a in rest) or \
+            any(a in OFFLINE or a in ("--help", "-h", "--version") for a in rest):
+        return argv
+    return argv[:k + 1] + ["--margin-us", LOADED_MARGIN] + rest
+
+
 def long_running(argv):
     """A command that runs until Ctrl-C: how to tell it is running ('foc' or 'sim')."""
     prog = os.path.basename(next(a for a in argv if not re.match(r"^[A-Za-z_]\w*=", a)))
@@ -305,7 +323,7 @@ def main():
             tests += 1
             own = os.path.join(args.work, f"sim{tests}.link") if "j288-sim" in os.path.basename(
                 next(a for a in argv if not re.match(r"^[A-Za-z_]\w*=", a))) else None
-            argv = mapped(argv, args.dev, own)
+            argv = with_margin(mapped(argv, args.dev, own))
             if own and "--link" not in argv:
                 argv += ["--link", own]  # to tell when it serves
             if argv[0].startswith("./"):
@@ -339,6 +357,8 @@ def main():
             tests += 1
             if demo_out is None:
                 demo_out = run_demo(args)
+                if demo_out[0] != 0:  # (its 5 ms pty margin can miss a reply on a loaded
+                    demo_out = run_demo(args)  # machine: once more; a drift fails both)
             rc, out = demo_out
             bad = f"make demo: exit {rc}" if rc != 0 else check_output(d.outputs, out)
             if bad:

@@ -15,16 +15,17 @@ trap 'sim_cleanup TERM' EXIT
 need_built "$J288" "$SIM"
 e2e_need_python
 
-# group N FILE...: a simulator (servos 1, 2, 3; hip and knee where the docs' example output
-# has them, inside the limits the docs give hip), a robot config over it, and docs_run.py
-# over FILE... in the background, its lines in $E2E_TMP/out.N.
+# group N FILE...: a simulator (servos 0-14: no id the docs probe is absent, so that a long
+# reply margin costs nothing; hip and knee where the docs' example output has them, inside the
+# limits the docs give hip), a robot config over it, and docs_run.py over FILE... in the
+# background, its lines in $E2E_TMP/out.N.
 group() {
     local n=$1 work=$E2E_TMP/work.$1; shift
-    sim_start_linked "docs$n" --ids 1,2,3 --quiet --exit-after "$(e2e_scaled 300)" \
+    sim_start_linked "docs$n" --ids 0,1,2,3,4,5,6,7,8,9,10,11,12,13,14 --quiet --exit-after "$(e2e_scaled 300)" \
         --start-angle 1:0.3 --start-angle 2:1.0 --start-angle 3:-0.5 || return 1
     mkdir -p "$work/build"
     ln -s "$(cd "$BIN" && pwd)" "$work/build/bin"
-    printf 'buses:\n  - name: left\n    port: %s\n    margin_us: 250000\njoints:\n  - name: hip\n    bus: left\n    id: 1\n    limits: [-1.5, 1.5]\n    kp: 20.0\n    kd: 2.5\n  - name: knee\n    bus: left\n    id: 2\n' \
+    printf 'buses:\n  - name: left\n    port: %s\n    margin_us: 1000000\njoints:\n  - name: hip\n    bus: left\n    id: 1\n    limits: [-1.5, 1.5]\n    kp: 20.0\n    kd: 2.5\n  - name: knee\n    bus: left\n    id: 2\n' \
         "$DEV" >"$work/robot.yaml"
     python3 test/e2e/docs_run.py ${DOCS_RUN_VERBOSE:+-v} --dev "$DEV" --log "$SIM_DIR/docs$n.log" \
         --bin "$BIN" --work "$work" "$@" >"$E2E_TMP/out.$n" 2>&1 &
