@@ -32,7 +32,7 @@ static const char scan_help[] =
     "  --ids LIST       the ids to address, e.g. 1,2,3 (default 0-14): each absent id costs\n"
     "                   a reply margin and its retries, so a scan with a long --margin-us\n"
     "                   stays short\n"
-    "More bytes after a servo's reply (two servos answering one id) are reported as\n"
+    "More bytes within 10 ms of a servo's reply (two servos answering one id) are reported as\n"
     "\"possible duplicate ids\" (JSON: possible_duplicate). The protocol has no command that\n"
     "sets a servo's id: give each servo its own id with the vendor's tool, one servo on the\n"
     "bus at a time (docs/troubleshooting.md).\n"
@@ -54,13 +54,20 @@ static uint32_t extra_bytes(const cli_bus_t *b)
     return s == NULL ? 0u : s->stale_bytes + s->wrong_id + s->crc_errors;
 }
 
-/* After id's good reply, one more reply budget: anything that comes is a second answer (on a
- * real wire, two replies at once garble each other). */
+/* How long scan listens after a good reply for a second one: a second servo on the id answers
+ * the same command at once, so its bytes follow the first reply's at the wire's pace (two
+ * replies at the same moment garble each other: a CRC error, noted as such). */
+#define SCAN_SECOND_REPLY_US 10000u
+
+/* After id's good reply, up to SCAN_SECOND_REPLY_US more (or the reply budget, when shorter):
+ * any byte that comes then is a second answer. */
 static bool answered_twice(cli_bus_t *b, uint32_t extra_before)
 {
     const j288_bus_t *bus = j288_robot_bus_engine(b->robot, 0);
-    if (bus != NULL)
-        (void)cli_bus_sleep_until(b, j288_robot_now_us() + j288_bus_reply_budget_us(bus));
+    uint32_t wait_us = bus != NULL ? j288_bus_reply_budget_us(bus) : 0u;
+    if (wait_us > SCAN_SECOND_REPLY_US)
+        wait_us = SCAN_SECOND_REPLY_US;
+    (void)cli_bus_sleep_until(b, j288_robot_now_us() + wait_us);
     return extra_bytes(b) != extra_before;
 }
 
