@@ -17,7 +17,6 @@
 #include <dds/dds.h>
 
 #include "bridge.h"
-#include "j288_linux.h"
 #include "service.h"
 #include "typehash.h"
 
@@ -436,7 +435,7 @@ static void take_commands(bridge_t *b, const dds_io_t *io)
     void *samples[TAKE_MAX] = {NULL};
     dds_sample_info_t info[TAKE_MAX];
     dds_return_t n = dds_take(io->cmd_r, samples, info, TAKE_MAX, TAKE_MAX);
-    uint32_t now = j288_linux_now_us();
+    uint32_t now = j288_robot_now_us();
     dds_return_t i;
     for (i = 0; i < n; i++) {
         bridge_writer_t w;
@@ -665,14 +664,14 @@ static int run(const options_t *o)
     sc.bridge = &b;
     sc.cycles = 0;
     sc.at_s = start_s;
-    last_diag = j288_linux_now_us();
+    last_diag = j288_robot_now_us();
     (void)clock_gettime(CLOCK_MONOTONIC, &next);
     publish_diagnostics(&b, &io);
     service_ready(line);
     while (stop_signal == 0) {
         take_commands(&b, &io);
         collect_drops(&b);
-        bridge_check_timeouts(&b, j288_linux_now_us());
+        bridge_check_timeouts(&b, j288_robot_now_us());
         rc = j288_robot_cycle(&robot, 0, NULL);
         handle_events(&b, &pending);
         if (rc == J288_ERR_ABORTED)
@@ -685,8 +684,8 @@ static int run(const options_t *o)
         if (rc == J288_ERR_OFFLINE) /* stop on bus loss: the runner locked every bus */
             bridge_stopped(&b, j288_robot_error(&robot));
         publish_state(&b, &io, start_s);
-        if ((uint32_t)(j288_linux_now_us() - last_diag) >= DIAG_PERIOD_US) {
-            last_diag = j288_linux_now_us();
+        if ((uint32_t)(j288_robot_now_us() - last_diag) >= DIAG_PERIOD_US) {
+            last_diag = j288_robot_now_us();
             publish_diagnostics(&b, &io);
         }
         service_tick((uint64_t)(mono_s() * 1e6), service_status, &sc);
