@@ -19,7 +19,8 @@
  *    waited past). The echo's end is where it started plus its length when the line hears us
  *    and no flag says a byte of it was lost; otherwise every byte from its start goes to the
  *    bus after the transmit's end, whose parser finds the reply among them: a lost echo byte
- *    costs nothing, and a broadcast ends.
+ *    costs nothing, and a broadcast ends (with the echo option, the echo the bus checks is then
+ *    a byte short: J288_ERR_COLLISION).
  *  - The receive position is read from the stream's counter (NDTR/CNDTR) at every event: idle
  *    line, half and whole buffer. The events may come in any order, late or twice: every byte
  *    is handed to the bus once, in order, as long as each event is served within the timing
