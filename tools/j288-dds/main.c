@@ -613,7 +613,7 @@ static int run(const options_t *o)
     static j288_robot_t robot;
     static bridge_t b;
     static pending_t pending;
-    char err[J288_ROBOT_CONFIG_ERROR_MAX], line[300];
+    char err[J288_ROBOT_CONFIG_ERROR_MAX], line[NS_MAX + 256u]; /* the longest namespace fits */
     j288_robot_options_t ro;
     dds_io_t io;
     status_ctx_t sc;

@@ -188,7 +188,7 @@ static void print_plot(FILE *f, const j288_robot_t *r, const top_plot_t *pl, con
     unsigned k;
     fprintf(f, "\nplot: %s of", views[pl->view]);
     for (k = 0; k < pl->n; k++) {
-        mask |= 1ul << (3u * k + pl->view);
+        mask |= (uint32_t)1u << (3u * k + pl->view);
         fprintf(f, " %s", j288_robot_joint_name(r, pl->joint[k]));
     }
     fputs("  (v: angle, speed, torque)\n", f);
