@@ -869,23 +869,20 @@ static const j288_q24_t *jq_limit_hit(const j288_jointq_t *j, const j288_jointq_
     return NULL;
 }
 
-/* The limit law of limit x: hold at x, speed 0, no feed-forward, kp_L = kd_L * rate. */
+/* The limit law of limit x: hold at x, speed 0, no feed-forward, kp_L = kd_L * rate (both
+ * within the wire's gains: kd_l <= LIMIT_KD_MAX). */
 static int jq_limit_command(const j288_jointq_t *j, j288_q24_t x, int32_t kd_l, j288_cmd_raw_t *raw)
 {
-    j288_cmd_q_t q;
-    int err;
-
-    (void)memset(&q, 0, sizeof q);
-    q.id = j->cfg.id;
-    q.status = J288_MODE_FOC;
-    q.watchdog = true;
-    q.kp = kd_l * J288_JOINTQ_LIMIT_RATE;
-    q.kd = kd_l;
-    err = jq_cmd_from_q(&q, raw, false, NULL); /* gains within the wire: cannot fail */
-    if ((err == J288_OK) && !jq_rotor_target(x - j->ref_q, jq_reversed(j), j->ref_pos, &raw->pos)) {
-        err = J288_ERR_RANGE_POS;
+    uint32_t kd = (uint32_t)kd_l;
+    uint32_t kp = kd * (uint32_t)J288_JOINTQ_LIMIT_RATE;
+    if (!jq_rotor_target(x - j->ref_q, jq_reversed(j), j->ref_pos, &raw->pos)) {
+        return J288_ERR_RANGE_POS;
     }
-    return err;
+    raw->tau = 0;
+    raw->speed = 0;
+    raw->kp = (int16_t)jq_scale_field(kp, KP_F, KP_K, KP_NUM, KP_DEN);
+    raw->kd = (int16_t)jq_scale_field(kd, KD_F, KD_K, KD_NUM, KD_DEN);
+    return J288_OK;
 }
 
 /* A target whose law can push the joint through a limit: its command depends on the state. */
@@ -915,6 +912,7 @@ static int jq_make_command(const j288_jointq_t *j, const j288_jointq_target_t *t
     v.torque = t->torque;
     v.kp = t->kp;
     v.kd = t->kd;
+    raw.kd = 0; /* (set below on every path that uses it: quiets gcc) */
     err = jq_apply_limits(&j->cfg, &v, &mask);
     if (err != J288_OK) {
         return err;
