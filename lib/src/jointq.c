@@ -80,6 +80,18 @@ static int32_t jq_signed_of(bool neg, uint32_t m)
     return neg ? jq_as_i32(0u - m) : (int32_t)m;
 }
 
+/* a - b, saturated at int64's ends (a target's position may be any int64). */
+static int64_t jq_diff64(int64_t a, int64_t b)
+{
+    if ((b < 0) && (a > (INT64_MAX + b))) {
+        return INT64_MAX;
+    }
+    if ((b > 0) && (a < (INT64_MIN + b))) {
+        return INT64_MIN;
+    }
+    return a - b;
+}
+
 /* x saturated to +-(2^31 - 1). */
 static int32_t jq_sat32(int64_t x)
 {
@@ -829,7 +841,7 @@ static int64_t jq_spring(int32_t k, j288_q24_t dx)
 /* The target's law's push toward hi (or lo) from rest there: T + kp (P - x) + kd V. */
 static int64_t jq_push_at(const j288_jointq_target_t *t, int32_t kp, int32_t kd, j288_q24_t x)
 {
-    return ((int64_t)t->torque * 65536) + jq_spring(kp, t->pos - x) +
+    return ((int64_t)t->torque * 65536) + jq_spring(kp, jq_diff64(t->pos, x)) +
            jq_gain_times(kd, t->speed);
 }
 
@@ -858,7 +870,7 @@ static const j288_q24_t *jq_limit_hit(const j288_jointq_t *j, const j288_jointq_
     if (!up && !down) {
         return NULL;
     }
-    u = ((int64_t)t->torque * 65536) + jq_spring(kp, t->pos - s->pos) +
+    u = ((int64_t)t->torque * 65536) + jq_spring(kp, jq_diff64(t->pos, s->pos)) +
         jq_gain_times(kd, jq_sat32((int64_t)t->speed - s->speed)) + jq_gain_times(kd_l, s->speed);
     if (up && (u > jq_spring(kp_l, j->cfg.pos_max - s->pos))) {
         return &j->cfg.pos_max;
@@ -923,7 +935,7 @@ static int jq_make_command(const j288_jointq_t *j, const j288_jointq_target_t *t
                            v.kd, j->cfg.clamp, &raw, &mask);
     raw.pos = j->last_pos; /* kp <= 0: the position has no effect */
     if (!jq_before_pos(err) && (v.kp > 0) &&
-        !jq_rotor_target(v.pos - j->ref_q, rev, j->ref_pos, &raw.pos)) {
+        !jq_rotor_target(jq_diff64(v.pos, j->ref_q), rev, j->ref_pos, &raw.pos)) {
         err = J288_ERR_RANGE_POS;
     }
     *keep = (err == J288_OK) && jq_drives_out(j, &v);

@@ -8,7 +8,8 @@
  * max_torque, kp, kd as uint16 (Q16 / 16); then operations until the input runs dry: an
  * op byte (low 2 bits: 0-1 reply, 2 target, 3 reset or zero_here) and its fields (reply: int32
  * pos, uint16 out_pos, int16 speed, int16 torque, the op's bit 2 fault 12; target: int32 pos
- * and a shift 0-31 (pos * 2^shift, Q24), int32 speed, torque, kp, kd).
+ * and a shift 0-31 (pos * 2^shift, Q24; shift bit 6: near INT64_MAX, bit 7 too: INT64_MIN),
+ * int32 speed, torque, kp, kd).
  *
  * Invariants:
  * - core and facade agree on everything: init result, events, errors, clamp masks, command
@@ -135,7 +136,14 @@ static void target(fuzz_in_t *in, j288_jointq_t *q, j288_joint_t *f)
     j288_cmd_raw_t a, b, before;
     unsigned ma = 77u, mb = 77u;
     int ra, rb;
-    tq.pos = (j288_q24_t)s32(in) * ((j288_q24_t)1 << (fuzz_u8(in) & 31u));
+    {
+        int32_t p = s32(in);
+        uint8_t shift = fuzz_u8(in);
+        /* bit 6: an extreme (near int64's ends, where differences overflow) */
+        tq.pos = ((shift & 0x40u) != 0u)
+                     ? (((shift & 0x80u) != 0u) ? (INT64_MIN + (p & 0xFFFF)) : (INT64_MAX - (p & 0xFFFF)))
+                     : (j288_q24_t)p * ((j288_q24_t)1 << (shift & 31u));
+    }
     tq.speed = s32(in);
     tq.torque = s32(in);
     tq.kp = s32(in);
