@@ -363,9 +363,13 @@ int j288_joint_bus_init(j288_joint_bus_t *jb, j288_sched_t *sched, j288_joint_ev
 
 int j288_joint_bus_add(j288_joint_bus_t *jb, j288_joint_t *j)
 {
-    int err = j288_jointq_bus_add((jb == NULL) ? NULL : &jb->core, (j == NULL) ? NULL : &j->core);
+    int err;
+    if ((jb == NULL) || (j == NULL)) {
+        return J288_ERR_NULL;
+    }
+    err = j288_jointq_bus_add(&jb->core, &j->core);
     if (err == J288_OK) {
-        jb->joint[j->core.cfg.id] = j;
+        jb->joint[j->core.cfg.id] = j; /* 0-14: the core checked it */
     }
     return err;
 }

@@ -81,13 +81,14 @@ static int32_t jq_signed_of(bool neg, uint32_t m)
 }
 
 /* a - b, saturated at int64's ends (a target's position may be any int64). */
+#define I64_TOP 0x7FFFFFFFFFFFFFFF /* INT64_MAX, spelled as a signed constant */
 static int64_t jq_diff64(int64_t a, int64_t b)
 {
-    if ((b < 0) && (a > (INT64_MAX + b))) {
-        return INT64_MAX;
+    if ((b < 0) && (a > (I64_TOP + b))) {
+        return I64_TOP;
     }
-    if ((b > 0) && (a < (INT64_MIN + b))) {
-        return INT64_MIN;
+    if ((b > 0) && (a < ((-I64_TOP - 1) + b))) {
+        return -I64_TOP - 1;
     }
     return a - b;
 }
