@@ -12,6 +12,7 @@
  * vectors and every reply field's input against double. */
 #define PI_Q J288_JOINTQ_PI          /* pi * 2^24 */
 #define TWO_PI_Q J288_JOINTQ_TWO_PI  /* 2 pi * 2^24, odd */
+#define POS_FAR 0x4000000000000000   /* 2^62: a continuous joint's targets are bounded to it */
 #define HALF_TURN_Q 52707178         /* (TWO_PI_Q - 1) / 2: the wrap's bound, below pi */
 #define FORTY_PI_Q 2108287141        /* 40 pi * 2^24: N * 40 pi is 5767 turns of the rotor */
 #define FORTY_PI_FRAC 1424062817u    /* its fraction, * 2^32 */
@@ -78,19 +79,6 @@ static uint64_t jq_mag64(int64_t x)
 static int32_t jq_signed_of(bool neg, uint32_t m)
 {
     return neg ? jq_as_i32(0u - m) : (int32_t)m;
-}
-
-/* a - b, saturated at int64's ends (a target's position may be any int64). */
-#define I64_TOP 0x7FFFFFFFFFFFFFFF /* INT64_MAX, spelled as a signed constant */
-static int64_t jq_diff64(int64_t a, int64_t b)
-{
-    if ((b < 0) && (a > (I64_TOP + b))) {
-        return I64_TOP;
-    }
-    if ((b > 0) && (a < ((-I64_TOP - 1) + b))) {
-        return -I64_TOP - 1;
-    }
-    return a - b;
 }
 
 /* x saturated to +-(2^31 - 1). */
@@ -807,11 +795,17 @@ static int jq_limit_one(int32_t *x, int32_t lo, int32_t hi, bool clamp, unsigned
 }
 
 /* The target's position within the limits (checked only when kp > 0: with kp = 0 it has no
- * effect), then its speed and torque. */
+ * effect, and is 0 from here on), then its speed and torque. A position may be any int64: a
+ * continuous joint's is bounded to +-2^62 (far beyond the wire's reach), so that differences
+ * to the anchor and the state never overflow. */
 static int jq_apply_limits(const j288_jointq_config_t *c, j288_jointq_target_t *t, unsigned *mask)
 {
     int err = J288_OK;
-    if ((t->kp > 0) && !c->continuous && !jq_within(t->pos, c->pos_min, c->pos_max)) {
+    if (t->kp <= 0) {
+        t->pos = 0;
+    } else if (c->continuous) {
+        t->pos = (t->pos > POS_FAR) ? POS_FAR : ((t->pos < -POS_FAR) ? -POS_FAR : t->pos);
+    } else if (!jq_within(t->pos, c->pos_min, c->pos_max)) {
         if (!c->clamp) {
             return J288_ERR_LIMIT_POS;
         }
@@ -842,7 +836,7 @@ static int64_t jq_spring(int32_t k, j288_q24_t dx)
 /* The target's law's push toward hi (or lo) from rest there: T + kp (P - x) + kd V. */
 static int64_t jq_push_at(const j288_jointq_target_t *t, int32_t kp, int32_t kd, j288_q24_t x)
 {
-    return ((int64_t)t->torque * 65536) + jq_spring(kp, jq_diff64(t->pos, x)) +
+    return ((int64_t)t->torque * 65536) + jq_spring(kp, t->pos - x) +
            jq_gain_times(kd, t->speed);
 }
 
@@ -871,7 +865,7 @@ static const j288_q24_t *jq_limit_hit(const j288_jointq_t *j, const j288_jointq_
     if (!up && !down) {
         return NULL;
     }
-    u = ((int64_t)t->torque * 65536) + jq_spring(kp, jq_diff64(t->pos, s->pos)) +
+    u = ((int64_t)t->torque * 65536) + jq_spring(kp, t->pos - s->pos) +
         jq_gain_times(kd, jq_sat32((int64_t)t->speed - s->speed)) + jq_gain_times(kd_l, s->speed);
     if (up && (u > jq_spring(kp_l, j->cfg.pos_max - s->pos))) {
         return &j->cfg.pos_max;
@@ -936,7 +930,7 @@ static int jq_make_command(const j288_jointq_t *j, const j288_jointq_target_t *t
                            v.kd, j->cfg.clamp, &raw, &mask);
     raw.pos = j->last_pos; /* kp <= 0: the position has no effect */
     if (!jq_before_pos(err) && (v.kp > 0) &&
-        !jq_rotor_target(jq_diff64(v.pos, j->ref_q), rev, j->ref_pos, &raw.pos)) {
+        !jq_rotor_target(v.pos - j->ref_q, rev, j->ref_pos, &raw.pos)) {
         err = J288_ERR_RANGE_POS;
     }
     *keep = (err == J288_OK) && jq_drives_out(j, &v);
@@ -1139,7 +1133,7 @@ void j288_jointq_after_reply(j288_jointq_bus_t *jb, j288_jointq_t *j, const j288
     if (!j->st.known) {
         j->live = false;
         if (slot->cmd.status != J288_MODE_LOCK) {
-            (void)jq_set_lock(jb->sched, id, slot->cmd.watchdog); /* a valid lock is never refused */
+            (void)jq_set_lock(jb->sched, id, slot->cmd.watchdog); /* valid: never refused */
         }
     } else if (j->live && jq_same_cmd(&slot->cmd, &j->live_cmd)) {
         bool keep;

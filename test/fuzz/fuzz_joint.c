@@ -140,9 +140,9 @@ static void target(fuzz_in_t *in, j288_jointq_t *q, j288_joint_t *f)
         int32_t p = s32(in);
         uint8_t shift = fuzz_u8(in);
         /* bit 6: an extreme (near int64's ends, where differences overflow) */
-        tq.pos = ((shift & 0x40u) != 0u)
-                     ? (((shift & 0x80u) != 0u) ? (INT64_MIN + (p & 0xFFFF)) : (INT64_MAX - (p & 0xFFFF)))
-                     : (j288_q24_t)p * ((j288_q24_t)1 << (shift & 31u));
+        tq.pos = ((shift & 0x40u) != 0u) ? (((shift & 0x80u) != 0u) ? (INT64_MIN + (p & 0xFFFF))
+                                                                    : (INT64_MAX - (p & 0xFFFF)))
+                                         : (j288_q24_t)p * ((j288_q24_t)1 << (shift & 31u));
     }
     tq.speed = s32(in);
     tq.torque = s32(in);
@@ -164,7 +164,8 @@ static void target(fuzz_in_t *in, j288_jointq_t *q, j288_joint_t *f)
     if ((tq.pos > -(1LL << 53)) && (tq.pos < (1LL << 53)) &&
         (tq.speed > -1073741824 && tq.speed < 1073741824) &&
         (tq.torque > -1073741824 && tq.torque < 1073741824) &&
-        (tq.kp > -1073741824 && tq.kp < 1073741824) && (tq.kd > -1073741824 && tq.kd < 1073741824)) {
+        (tq.kp > -1073741824 && tq.kp < 1073741824) &&
+        (tq.kd > -1073741824 && tq.kd < 1073741824)) {
         FUZZ_CHECK(ra == rb);
         FUZZ_CHECK(ma == mb);
         FUZZ_CHECK(same_cmd(&a, &b));

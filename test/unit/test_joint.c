@@ -1261,7 +1261,8 @@ static void test_command_frames(void)
         TEST_ASSERT_EQUAL_UINT8(J288_MODE_FOC, cmd.status);
         TEST_ASSERT_TRUE(cmd.watchdog);
         /* The position: the start's error (uncalibrated) plus rounding, in rotor LSB. */
-        pos_tol = (calibrated ? 1.0 : 0.5 * COUNT * NR / ROTOR_LSB + 1.0) + EPS * NR / ROTOR_LSB * 4.0;
+        pos_tol =
+            (calibrated ? 1.0 : 0.5 * COUNT * NR / ROTOR_LSB + 1.0) + EPS * NR / ROTOR_LSB * 4.0;
         TEST_ASSERT_DOUBLE_WITHIN(pos_tol, rotor_lsb_for(&c, &m, as_real(t.pos)), (double)cmd.pos);
         TEST_ASSERT_INT_WITHIN(1, (int)lround(d * as_real(t.speed) * NR * 2.56 / TAU), cmd.speed);
         TEST_ASSERT_INT_WITHIN(1, (int)lround(d * as_real(t.torque) / NR * 256000.0), cmd.tau);
@@ -1542,12 +1543,14 @@ static void test_zero_here(void)
         (void)start_joint(&m);
         r = reply_of(&m, 2u);
         r.faults = FAULT12;
-        r.pos = (int32_t)((uint32_t)r.pos + (uint32_t)(d * (int32_t)llround(1.999 * NR / ROTOR_LSB)));
+        r.pos =
+            (int32_t)((uint32_t)r.pos + (uint32_t)(d * (int32_t)llround(1.999 * NR / ROTOR_LSB)));
         TEST_ASSERT_EQUAL_INT(J288_OK, j_take(&r, NULL)); /* 63.999 rad from zero 0 */
         zero = 99.0;
         TEST_ASSERT_EQUAL_INT(J288_OK, j_zero_here(&zero));
         TEST_ASSERT_DOUBLE_WITHIN(UNCAL_TOL, 63.999 * d, zero);
-        r.pos = (int32_t)((uint32_t)r.pos + (uint32_t)(d * (int32_t)llround(0.01 * NR / ROTOR_LSB)));
+        r.pos =
+            (int32_t)((uint32_t)r.pos + (uint32_t)(d * (int32_t)llround(0.01 * NR / ROTOR_LSB)));
         TEST_ASSERT_EQUAL_INT(J288_OK, j_take(&r, NULL));
         zero = 99.0;
         TEST_ASSERT_EQUAL_INT(J288_ERR_RANGE, j_zero_here(&zero));
@@ -2340,10 +2343,12 @@ static void test_core_constants_and_macros(void)
     j288_jointq_reset(NULL);
     j288_jointq_target_init(NULL, NULL);
     j288_jointq_target_init(&qj, NULL);
-    TEST_ASSERT_EQUAL_INT(J288_ERR_NULL, j288_jointq_take_reply(NULL, &(j288_reply_raw_t){0}, NULL));
+    TEST_ASSERT_EQUAL_INT(J288_ERR_NULL,
+                          j288_jointq_take_reply(NULL, &(j288_reply_raw_t){0}, NULL));
     TEST_ASSERT_EQUAL_INT(J288_ERR_NULL, j288_jointq_command(NULL, &(j288_jointq_target_t){0},
                                                              &(j288_cmd_raw_t){0}, NULL));
-    TEST_ASSERT_EQUAL_INT(J288_ERR_NULL, j288_jointq_command(&qj, NULL, &(j288_cmd_raw_t){0}, NULL));
+    TEST_ASSERT_EQUAL_INT(J288_ERR_NULL,
+                          j288_jointq_command(&qj, NULL, &(j288_cmd_raw_t){0}, NULL));
     TEST_ASSERT_EQUAL_INT(J288_ERR_NULL,
                           j288_jointq_command(&qj, &(j288_jointq_target_t){0}, NULL, NULL));
     TEST_ASSERT_EQUAL_INT(J288_ERR_NULL, j288_jointq_lock_command(NULL, &(j288_cmd_raw_t){0}));

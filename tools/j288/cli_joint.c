@@ -155,7 +155,8 @@ int cli_joint_acquire(cli_bus_t *b, j288_joint_t *j, const char *name, j288_txn_
                       unsigned *replies, bool report_unknown)
 {
     const j288_joint_state_t *st = j288_joint_state(j);
-    unsigned samples = j288_joint_config(j)->init_samples != 0u ? j288_joint_config(j)->init_samples : 8u;
+    unsigned given = j288_joint_config(j)->init_samples;
+    unsigned samples = given != 0u ? given : 8u;
     unsigned tries = samples * ACQUIRE_TRIES_PER_SAMPLE, n;
     j288_cmd_raw_t cmd;
     j288_txn_t txn;

@@ -214,7 +214,8 @@ typedef struct {
 static int cal_window(const joint_args_t *a, const j288_joint_t *j, double q, cal_path_t *p,
                       const char *name)
 {
-    double lmin = (double)j288_joint_config(j)->pos_min, lmax = (double)j288_joint_config(j)->pos_max, q0;
+    const j288_joint_config_t *cfg = j288_joint_config(j);
+    double lmin = (double)cfg->pos_min, lmax = (double)cfg->pos_max, q0;
     if (lmin == 0.0 && lmax == 0.0) {
         lmin = -J288_PI;
         lmax = J288_PI;
@@ -238,7 +239,7 @@ static int cal_window(const joint_args_t *a, const j288_joint_t *j, double q, ca
     if (p->lo < lmin) {
         cli_error("%s: no room for a %g rad motion inside the limits [%g, %g] (give a smaller "
                   "--range)",
-                  name, a->range, lmin, lmax);
+                  name, a->range, (double)cfg->pos_min, (double)cfg->pos_max);
         return -1;
     }
     return 0;

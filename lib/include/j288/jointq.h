@@ -11,13 +11,15 @@
  * divisions. Always compiled (J288_CONFIG_SI=0 or 1); --gc-sections drops what is not called.
  *
  * Numbers. Angles are j288_q24_t: rad * 2^24 in an int64 (step 60 nrad, range +-2^39 rad,
- * 5.5e11 rad: a wheel at 30 rad/s for 580 years). Speeds, torques and gains are j288_q16_t:
- * the SI value * 2^16 in an int32 (rad/s, N*m, N*m/rad, N*m*s/rad; step 1.5e-5, range
- * +-32768). J288_Q24() and J288_Q16() make constants of them. The gear ratio is the exact
- * fraction N = 5767 / 20 (20 output turns are exactly 5767 rotor turns); constants with pi
- * are the exact values rounded. pi itself is J288_JOINTQ_PI = round(pi 2^24), 28 nrad above
- * pi: a limit or tolerance of pi, configured here or converted from the float API, is that
- * value, and the default range [-pi, pi] is [-J288_JOINTQ_PI, J288_JOINTQ_PI].
+ * 5.5e11 rad; a joint's angle is followed to 2.7e11 rad, a wheel at 30 rad/s for 285 years,
+ * and a continuous joint's position targets are taken within +-2^38 rad). Speeds, torques
+ * and gains are j288_q16_t: the SI value * 2^16 in an int32 (rad/s, N*m, N*m/rad, N*m*s/rad;
+ * step 1.5e-5, range +-32768). J288_Q24() and J288_Q16() make constants of them. The gear
+ * ratio is the exact fraction N = 5767 / 20 (20 output turns are exactly 5767 rotor turns);
+ * constants with pi are the exact values rounded. pi itself is J288_JOINTQ_PI =
+ * round(pi 2^24), 28 nrad above pi: a limit or tolerance of pi, configured here or converted
+ * from the float API, is that value, and the default range [-pi, pi] is [-J288_JOINTQ_PI,
+ * J288_JOINTQ_PI].
  *
  * The model. The rotor turns N times per output turn: r = N theta + c (theta the output angle,
  * c a phase fixed at assembly); a reply's rotor position is p = r - 2 pi k, k lost at every
