@@ -9,14 +9,16 @@ if(NOT CMAKE_SYSTEM_NAME STREQUAL "Linux")
 endif()
 find_library(J288_LIBM m)
 
-add_library(j288_linux STATIC "${PROJECT_SOURCE_DIR}/port/linux/j288_linux.c")
-target_include_directories(j288_linux PUBLIC "${PROJECT_SOURCE_DIR}/port/linux")
+set(_j288_port_sources "${PROJECT_SOURCE_DIR}/port/desktop/j288_serial.c"
+                       "${PROJECT_SOURCE_DIR}/port/linux/j288_linux.c")
+add_library(j288_linux STATIC ${_j288_port_sources})
+target_include_directories(j288_linux PUBLIC "${PROJECT_SOURCE_DIR}/port/desktop"
+                                             "${PROJECT_SOURCE_DIR}/port/linux")
 target_link_libraries(j288_linux PUBLIC j288::j288)
 
 find_library(J288_YAML_LIB yaml)
 find_path(J288_YAML_INCLUDE yaml.h)
 set(_j288_robot_sources "${PROJECT_SOURCE_DIR}/host/j288_robot.c"
-                        "${PROJECT_SOURCE_DIR}/host/j288_host_wait.c"
                         "${PROJECT_SOURCE_DIR}/host/j288_robot_config.c"
                         "${PROJECT_SOURCE_DIR}/host/j288_number.c")
 add_library(j288_robot STATIC ${_j288_robot_sources})
@@ -26,10 +28,9 @@ target_link_libraries(j288_robot PUBLIC j288_linux)
 add_library(j288::robot ALIAS j288_robot)
 
 file(GLOB _j288_shared_sources CONFIGURE_DEPENDS "${PROJECT_SOURCE_DIR}/lib/src/*.c")
-add_library(j288_shared SHARED ${_j288_shared_sources} "${PROJECT_SOURCE_DIR}/port/linux/j288_linux.c"
-            ${_j288_robot_sources})
+add_library(j288_shared SHARED ${_j288_shared_sources} ${_j288_port_sources} ${_j288_robot_sources})
 target_include_directories(j288_shared PUBLIC
-    "$<BUILD_INTERFACE:${PROJECT_SOURCE_DIR}/lib/include;${PROJECT_SOURCE_DIR}/port/linux;${PROJECT_SOURCE_DIR}/host>"
+    "$<BUILD_INTERFACE:${PROJECT_SOURCE_DIR}/lib/include;${PROJECT_SOURCE_DIR}/port/desktop;${PROJECT_SOURCE_DIR}/port/linux;${PROJECT_SOURCE_DIR}/host>"
     "$<INSTALL_INTERFACE:include;include/j288>")
 get_target_property(_j288_defs j288 INTERFACE_COMPILE_DEFINITIONS)
 target_compile_definitions(j288_shared PUBLIC ${_j288_defs})
@@ -93,14 +94,26 @@ foreach(t j288_linux j288_robot j288_shared ${_j288_tools})
 endforeach()
 
 # Man pages from the tools' --help and --version (Debian's help2man), when it is there.
+# j288's page also has every command's own --help (scripts/man-include.sh, help2man --include).
 find_program(J288_HELP2MAN help2man)
 function(j288_man target name what)
+    set(_include "")
+    set(_deps ${target})
+    if(ARGC GREATER 3)
+        set(_h2m "${PROJECT_BINARY_DIR}/${name}.h2m")
+        add_custom_command(OUTPUT "${name}.h2m" COMMAND bash "${ARGV3}" "$<TARGET_FILE:${target}>"
+            "${_h2m}" DEPENDS ${target} "${ARGV3}" VERBATIM)
+        set(_include --include "${_h2m}")
+        list(APPEND _deps "${name}.h2m")
+    endif()
     add_custom_command(OUTPUT "${name}.1" COMMAND "${J288_HELP2MAN}" --no-info --name "${what}"
-        --output "${PROJECT_BINARY_DIR}/${name}.1" "$<TARGET_FILE:${target}>" DEPENDS ${target} VERBATIM)
+        ${_include} --output "${PROJECT_BINARY_DIR}/${name}.1" "$<TARGET_FILE:${target}>"
+        DEPENDS ${_deps} VERBATIM)
     add_custom_target(${target}_man ALL DEPENDS "${name}.1")
 endfunction()
 if(J288_HELP2MAN)
-    j288_man(j288_cli j288 "Unitree J288/S288 servo bus tool")
+    j288_man(j288_cli j288 "Unitree J288/S288 servo bus tool"
+             "${PROJECT_SOURCE_DIR}/scripts/man-include.sh")
     j288_man(j288_sim j288-sim "simulated J288 servo bus")
     set(J288_MAN_PAGES "${PROJECT_BINARY_DIR}/j288.1" "${PROJECT_BINARY_DIR}/j288-sim.1")
     if(TARGET j288_dds)

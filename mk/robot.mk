@@ -3,8 +3,8 @@
 #   test/linux/test_robot.c   several j288-sim buses from one loop (HOST_TESTS)
 #   test/e2e/cli_robot.sh     j288 --config FILE log|status|hold|stop (TEST_SCRIPTS)
 #   test/e2e/host_stack.sh    a second session after a stop, every front end (TEST_SCRIPTS)
-# (the runner, and its one OS-specific call, the wait over every bus: host/j288_host_wait.c)
-ROBOT_OBJ := $(OBJ)/host/j288_robot.o $(OBJ)/host/j288_host_wait.o
+# (the runner; its wait over every bus is the port's, j288_serial_wait_any())
+ROBOT_OBJ := $(OBJ)/host/j288_robot.o
 
 ROBOT_TEST := $(BUILD)/test/test_robot
 $(ROBOT_TEST): $(OBJ)/test/linux/test_robot.o $(SIM_PROCESS_OBJ) $(ROBOT_OBJ) $(CONFIG_OBJ) $(UNITY_OBJ) $(LINUX_A) $(LIB_A) \

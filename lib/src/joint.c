@@ -7,7 +7,7 @@
 
 #include <string.h>
 
-#include "internal.h"
+#include "hints.h"
 #include "jointq_priv.h"
 
 #define HALF ((j288_real_t)0.5)

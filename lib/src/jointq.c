@@ -4,7 +4,7 @@
 
 #include <string.h>
 
-#include "internal.h"
+#include "frame_priv.h"
 #include "jointq_priv.h"
 
 /* ---- constants. Each is the exact value rounded to an integer (pi taken to 60 digits, the

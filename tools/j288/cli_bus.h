@@ -21,7 +21,6 @@
 
 #include "args.h"
 #include "cli.h"
-#include "j288_host_port.h"
 #include "j288_robot.h"
 #include "j288_robot_config.h"
 #include "json.h"
@@ -106,6 +105,11 @@ void cli_signals_install(void);
 /* Exit code for a command stopped by a signal (130 or 143). */
 int cli_signal_exit_code(void);
 
+/* The line rate: given (a --baud, or 0), else $J288_BAUD when set, else 0 (the default). 0, or
+ * -1 after one error line ($J288_BAUD out of range or not a number). For every bus a command
+ * opens whose config entry gives no baud. */
+int cli_bus_baud(uint32_t given, uint32_t *baud);
+
 /* Open the device through the runner (j288_robot_open_port()). Prints the port's notices
  * once (cli_print_notices()), and one error line on failure. Returns CLI_EXIT_OK or
  * CLI_EXIT_FAIL / CLI_EXIT_USAGE. */
@@ -140,7 +144,7 @@ int cli_bus_lock_driven(cli_bus_t *b);
  * or the port's own message when the device is gone. */
 void cli_report_txn_failure(cli_bus_t *b, uint8_t id, int rc);
 
-/* Sleep until until_us (j288_linux_now_us() time) while the runner keeps the port serviced
+/* Sleep until until_us (j288_robot_now_us() time) while the runner keeps the port serviced
  * (j288_robot_idle()). Returns J288_OK, J288_ERR_ABORTED (stop signal) or J288_ERR_OFFLINE. */
 int cli_bus_sleep_until(cli_bus_t *b, uint32_t until_us);
 

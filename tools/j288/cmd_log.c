@@ -791,7 +791,7 @@ static int wait_tick(log_run_t *r, uint32_t *next, uint32_t period_us)
 {
     uint32_t now;
     *next += period_us;
-    now = j288_linux_now_us();
+    now = j288_robot_now_us();
     if ((int32_t)(*next - now) < 0) {
         r->rs.missed++;
         while ((int32_t)(*next + period_us - now) <= 0) {
@@ -823,10 +823,10 @@ static log_end_t log_cycles(log_run_t *r)
     uint32_t period_us = (uint32_t)lround(1e6 / r->a.rate_hz);
     uint32_t next;
     log_end_t end = LOG_DONE;
-    r->t0 = j288_linux_now_us();
+    r->t0 = j288_robot_now_us();
     next = r->t0;
     for (;;) {
-        double t = (double)(uint32_t)(j288_linux_now_us() - r->t0) / 1e6;
+        double t = (double)(uint32_t)(j288_robot_now_us() - r->t0) / 1e6;
         if (t >= r->a.duration_s) {
             break;
         }
@@ -840,7 +840,7 @@ static log_end_t log_cycles(log_run_t *r)
             break;
         }
     }
-    r->rs.elapsed_s = (double)(uint32_t)(j288_linux_now_us() - r->t0) / 1e6;
+    r->rs.elapsed_s = (double)(uint32_t)(j288_robot_now_us() - r->t0) / 1e6;
     return end;
 }
 
