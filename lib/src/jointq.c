@@ -811,6 +811,8 @@ static int jq_apply_limits(const j288_jointq_config_t *c, j288_jointq_target_t *
         }
         t->pos = (t->pos < c->pos_min) ? c->pos_min : c->pos_max;
         *mask |= J288_FIELD_POS;
+    } else {
+        /* within the limits: as given */
     }
     if (c->max_speed > 0) {
         err = jq_limit_one(&t->speed, -c->max_speed, c->max_speed, c->clamp, J288_FIELD_SPEED,
