@@ -798,7 +798,7 @@ int j288_robot_joint_bus(const j288_robot_t *r, unsigned joint)
 
 int j288_robot_joint_id(const j288_robot_t *r, unsigned joint)
 {
-    return (r == NULL || joint >= r->njoints) ? -1 : (int)r->joint[joint].cfg.id;
+    return (r == NULL || joint >= r->njoints) ? -1 : (int)j288_joint_config(&r->joint[joint])->id;
 }
 
 int j288_robot_joint_config(const j288_robot_t *r, unsigned joint, j288_joint_config_t *out)
@@ -807,7 +807,7 @@ int j288_robot_joint_config(const j288_robot_t *r, unsigned joint, j288_joint_co
         return J288_ERR_NULL;
     if (joint >= r->njoints)
         return J288_ERR_BAD_ARG;
-    *out = r->joint[joint].cfg;
+    *out = *j288_joint_config(&r->joint[joint]);
     return J288_OK;
 }
 
@@ -822,7 +822,7 @@ int j288_robot_read(const j288_robot_t *r, unsigned joint, j288_robot_state_t *s
         return J288_ERR_BAD_ARG;
     b = &r->bus[r->joint_bus[joint]];
     js = j288_joint_state(&r->joint[joint]);
-    slot = j288_sched_slot(&b->sched, r->joint[joint].cfg.id);
+    slot = j288_sched_slot(&b->sched, j288_joint_config(&r->joint[joint])->id);
     memset(st, 0, sizeof *st);
     st->known = js->known;
     st->online = slot->online && bus_live(b);
@@ -910,6 +910,21 @@ int j288_robot_check_target(const j288_robot_t *r, unsigned joint, const j288_ro
     return j288_joint_command(&r->joint[joint], &jt, &cmd, NULL);
 }
 
+/* Joint j's target from the arrays of j288_robot_set_targets() (gains NULL: the joint's). */
+static void target_of_arrays(const j288_robot_t *r, unsigned j, const double *pos,
+                             const double *speed, const double *torque, const double *kp,
+                             const double *kd, j288_joint_target_t *jt)
+{
+    j288_joint_target_init(&r->joint[j], jt);
+    jt->pos = (j288_real_t)pos[j];
+    jt->speed = (speed != NULL) ? (j288_real_t)speed[j] : (j288_real_t)0;
+    jt->torque = (torque != NULL) ? (j288_real_t)torque[j] : (j288_real_t)0;
+    if (kp != NULL)
+        jt->kp = (j288_real_t)kp[j];
+    if (kd != NULL)
+        jt->kd = (j288_real_t)kd[j];
+}
+
 int j288_robot_set_targets(j288_robot_t *r, size_t n, const double *pos, const double *speed,
                            const double *torque, const double *kp, const double *kd,
                            unsigned *bad)
@@ -924,14 +939,7 @@ int j288_robot_set_targets(j288_robot_t *r, size_t n, const double *pos, const d
     /* Every command is built (and so checked) before any slot changes. */
     for (j = 0; j < r->njoints; j++) {
         j288_joint_target_t jt;
-        j288_joint_target_init(&r->joint[j], &jt);
-        jt.pos = (j288_real_t)pos[j];
-        jt.speed = (speed != NULL) ? (j288_real_t)speed[j] : (j288_real_t)0;
-        jt.torque = (torque != NULL) ? (j288_real_t)torque[j] : (j288_real_t)0;
-        if (kp != NULL)
-            jt.kp = (j288_real_t)kp[j];
-        if (kd != NULL)
-            jt.kd = (j288_real_t)kd[j];
+        target_of_arrays(r, j, pos, speed, torque, kp, kd, &jt);
         rc = target_check(r, j);
         if (rc == J288_OK)
             rc = j288_joint_command(&r->joint[j], &jt, &cmd[j], NULL);
@@ -941,28 +949,15 @@ int j288_robot_set_targets(j288_robot_t *r, size_t n, const double *pos, const d
             return rc;
         }
     }
-    for (j = 0; j < r->njoints; j++)
-        (void)j288_sched_set_cmd(&r->bus[r->joint_bus[j]].sched, &cmd[j]);
+    /* Through the binding, which makes again on every reply the command of a target that
+     * drives toward a limit (the same command now: it was just made). */
+    for (j = 0; j < r->njoints; j++) {
+        j288_joint_target_t jt;
+        target_of_arrays(r, j, pos, speed, torque, kp, kd, &jt);
+        (void)j288_joint_bus_set_target(&r->bus[r->joint_bus[j]].jb, &r->joint[j], &jt, NULL);
+    }
     r->driven = true;
     return J288_OK;
-}
-
-/* The pose to hold a joint at pos: pos itself, or the nearest limit when pos is beyond it
- * by at most J288_ROBOT_HOLD_BEYOND_MAX (farther, pos: the joint layer refuses it). */
-static j288_real_t hold_pose(const j288_joint_config_t *jc, j288_real_t pos)
-{
-    double lo = -J288_PI, hi = J288_PI, q = (double)pos;
-    if (jc->clamp)
-        return pos;
-    if (jc->pos_min != 0 || jc->pos_max != 0) {
-        lo = (double)jc->pos_min;
-        hi = (double)jc->pos_max;
-    }
-    if (q < lo && lo - q <= J288_ROBOT_HOLD_BEYOND_MAX)
-        return (j288_real_t)lo;
-    if (q > hi && q - hi <= J288_ROBOT_HOLD_BEYOND_MAX)
-        return (j288_real_t)hi;
-    return pos;
 }
 
 int j288_robot_hold(j288_robot_t *r, unsigned joint)
@@ -976,8 +971,7 @@ int j288_robot_hold(j288_robot_t *r, unsigned joint)
         return rc;
     if (!j288_joint_state(&r->joint[joint])->known)
         return J288_ERR_ANGLE_UNKNOWN;
-    j288_joint_target_init(&r->joint[joint], &jt);
-    jt.pos = hold_pose(&r->joint[joint].cfg, jt.pos);
+    j288_joint_target_init(&r->joint[joint], &jt); /* at the nearest limit, if just beyond */
     rc = j288_joint_bus_set_target(&r->bus[r->joint_bus[joint]].jb, &r->joint[joint], &jt, NULL);
     if (rc == J288_OK)
         r->driven = true;
@@ -991,7 +985,7 @@ int j288_robot_lock(j288_robot_t *r, unsigned joint)
         return J288_ERR_NULL;
     if (joint >= r->njoints)
         return J288_ERR_BAD_ARG;
-    lock_cmd(r->joint[joint].cfg.id, &lock);
+    lock_cmd(j288_joint_config(&r->joint[joint])->id, &lock);
     return j288_sched_set_cmd(&r->bus[r->joint_bus[joint]].sched, &lock);
 }
 
@@ -1030,7 +1024,8 @@ int j288_robot_joint_stats(const j288_robot_t *r, unsigned joint, j288_robot_joi
     if (joint >= r->njoints)
         return J288_ERR_BAD_ARG;
     *out = r->jstats[joint];
-    slot = j288_sched_slot(&r->bus[r->joint_bus[joint]].sched, r->joint[joint].cfg.id);
+    slot = j288_sched_slot(&r->bus[r->joint_bus[joint]].sched,
+                           j288_joint_config(&r->joint[joint])->id);
     out->servo = slot->stats;
     return J288_OK;
 }

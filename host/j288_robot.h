@@ -367,8 +367,9 @@ int j288_robot_set_targets(j288_robot_t *r, size_t n, const double *pos, const d
 
 /* How far beyond its soft limits a joint may be for j288_robot_hold() to hold it at the
  * nearest limit (rad, joint frame): a joint zeroed against a hard stop reads a hair outside
- * its range, and must still be holdable; the first command pulls it in by at most this. */
-#define J288_ROBOT_HOLD_BEYOND_MAX 0.05
+ * its range, and must still be holdable; the first command pulls it in by at most this. The
+ * joint layer's rule (j288_joint_target_init(), J288_JOINT_HOLD_BEYOND). */
+#define J288_ROBOT_HOLD_BEYOND_MAX J288_JOINT_HOLD_BEYOND
 
 /* Hold the joint where it is (its configured gains, else J288_ROBOT_DEFAULT_KP/_KD), or put
  * it at lock (watchdog bit 0). A joint beyond its limits by at most J288_ROBOT_HOLD_BEYOND_MAX

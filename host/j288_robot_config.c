@@ -69,6 +69,7 @@ void j288_robot_config_joint_config(const j288_robot_config_joint_t *rj, j288_jo
     jc->id = rj->id;
     jc->direction = (int8_t)(rj->direction < 0 ? -1 : 1);
     jc->clamp = rj->clamp;
+    jc->continuous = rj->continuous;
     jc->zero = (j288_real_t)rj->zero;
     /* Without limits the file means the library's default range: both 0 say so. */
     if (rj->has_limits) {
@@ -470,11 +471,13 @@ static void set_label(ctx_t *x, const char *kind, const char *name, size_t index
 }
 
 static const char *const bus_keys[] = {"name", "port", "baud", "margin_us", "echo"};
-static const char *const joint_keys[] = {"name", "bus",    "id",        "direction",
-                                         "zero", "limits", "max_speed", "max_torque",
-                                         "kp",   "kd",     "phase",     "clamp"};
+static const char *const joint_keys[] = {"name",  "bus",       "id",        "direction",
+                                         "zero",  "limits",    "max_speed", "max_torque",
+                                         "kp",    "kd",        "phase",     "clamp",
+                                         "continuous"};
 #define JOINT_KEYS_TEXT                                                                            \
-    "name, bus, id, direction, zero, limits, max_speed, max_torque, kp, kd, phase, clamp"
+    "name, bus, id, direction, zero, limits, max_speed, max_torque, kp, kd, phase, clamp, "      \
+    "continuous"
 
 /* What a bus and a joint entry have in common. */
 typedef struct {
@@ -690,6 +693,11 @@ static int parse_joint(ctx_t *x, yaml_node_t *m, size_t i)
     x->joint_bus[i] = value_of(x, m, "bus");
     if ((v = value_of(x, m, "clamp")) != NULL && get_bool(x, v, "clamp", &jt->clamp) != 0)
         return -1;
+    if ((v = value_of(x, m, "continuous")) != NULL &&
+        get_bool(x, v, "continuous", &jt->continuous) != 0)
+        return -1;
+    if (jt->continuous && (v = value_of(x, m, "limits")) != NULL)
+        return fail(x, line_of(v), "limits: a continuous joint has none (continuous: true)");
     return parse_joint_numbers(x, m, jt);
 }
 
@@ -1075,7 +1083,7 @@ static bool same_joint(const j288_robot_config_joint_t *a, const j288_robot_conf
            a->has_max_torque == b->has_max_torque && a->max_torque == b->max_torque &&
            a->has_kp == b->has_kp && a->kp == b->kp && a->has_kd == b->has_kd && a->kd == b->kd &&
            (skip_phase || (a->has_phase == b->has_phase && a->phase == b->phase)) &&
-           a->clamp == b->clamp;
+           a->clamp == b->clamp && a->continuous == b->continuous;
 }
 
 /* The edited text must read as the old one with only the new values changed. */

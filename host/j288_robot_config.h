@@ -6,9 +6,9 @@
  * default and range (a test loads it, so it stays a file this reader takes). In short:
  * 'buses:' (each a name, a port, and optionally baud, margin_us, echo) and 'joints:' (each a
  * name and an id, and optionally bus, direction, zero, limits, max_speed, max_torque, kp, kd,
- * phase, clamp). A relative port (sim/bus0) is taken from the config file's folder, not from
- * where the program runs (j288_robot_config_load(); j288_robot_config_parse() has no folder
- * and keeps it as written).
+ * phase, clamp, continuous). A relative port (sim/bus0) is taken from the config file's
+ * folder, not from where the program runs (j288_robot_config_load();
+ * j288_robot_config_parse() has no folder and keeps it as written).
  *
  * Reading is strict, so that a typo never silently becomes a default: unknown or repeated
  * keys, values of the wrong type (numbers must be plain, e.g. 1.5, not "1.5", in the syntax the
@@ -97,7 +97,8 @@ typedef struct {
     bool has_phase;
     double phase; /* rotor rad */
     bool clamp;
-    unsigned line; /* where the entry starts in the file */
+    bool continuous; /* a wheel: no limits (pos_min / pos_max unused), the angle unbounded */
+    unsigned line;   /* where the entry starts in the file */
 } j288_robot_config_joint_t;
 
 typedef struct {
@@ -145,11 +146,11 @@ int j288_robot_config_write_joint(const char *path, const char *joint, const j28
 int j288_robot_config_check_writable(const char *path, char *err, size_t errlen);
 
 /* The library's configuration of a joint read from the file (j288/joint.h): id, direction,
- * zero, clamp and phase as given; limits, max_speed, max_torque, kp and kd as given, else 0
- * (the library's defaults: [-pi, pi], no speed or torque limit beyond the wire's, no default
- * gains); the start's sample count and tolerances at the library's defaults (0). Checks
- * nothing: j288_joint_init() does, and the file's own checks keep its values in the ranges
- * the library takes. Works without libyaml. NULL arguments are ignored. */
+ * zero, clamp, continuous and phase as given; limits, max_speed, max_torque, kp and kd as
+ * given, else 0 (the library's defaults: [-pi, pi], no speed or torque limit beyond the
+ * wire's, no default gains); the start's sample count and tolerances at the library's
+ * defaults (0). Checks nothing: j288_joint_init() does, and the file's own checks keep its
+ * values in the ranges the library takes. Works without libyaml. NULL arguments are ignored. */
 void j288_robot_config_joint_config(const j288_robot_config_joint_t *rj, j288_joint_config_t *jc);
 
 /* The text-level edit behind j288_robot_config_write_joint(): the len bytes of text in, the edited

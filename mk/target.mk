@@ -179,7 +179,7 @@ SIZE_hw_DEFS := -DJ288_CONFIG_CRC_BACKEND=J288_CRC_BACKEND_HW \
                 -DJ288_CONFIG_CRC_HW_FUNCTION=j288_stm32_crc32_default
 # The smallest Cortex-M0 build: CRC unit, raw integers only (no SI API, no soft float).
 SIZE_hw-nosi_DEFS := $(SIZE_hw_DEFS) -DJ288_CONFIG_SI=0
-# The FPU-less robot: the same, with the fixed-point joint layer for 15 joints on the
+# The FPU-less robot: the same, with the joint core (integers) for 15 joints on the
 # scheduler (j288/jointq.h); size_report.py fails if soft float shows up in its map.
 SIZE_hw-jointq_DEFS := $(SIZE_hw-nosi_DEFS) -DSIZE_PROBE_JOINTQ=1
 SIZE_SRC := $(LIB_SRC) port/stm32_hal/j288_stm32.c test/stm32/stub/stm32_hal_stub.c \

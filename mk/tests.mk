@@ -111,6 +111,14 @@ $(OBJ)/test/sim/%.o: CPPFLAGS_OBJ = $(TEST_CPPFLAGS) -Itools/j288-sim
 $(SIM_MODEL_TEST): $(OBJ)/test/sim/test_sim_model.o $(SIM_MODEL_OBJ) $(UNITY_OBJ) $(LIB_A)
 	$(LINK)
 
+# The joint against the simulator's physics in simulated time: soft limits in every mode, a
+# wheel (the simulator's truth, not the library's view).
+JOINT_SIM_TEST := $(BUILD)/test/test_joint_sim
+$(JOINT_SIM_TEST): $(OBJ)/test/sim/test_joint_sim.o $(SIM_MODEL_OBJ) $(TEST_SUPPORT_OBJ) $(UNITY_OBJ) \
+    $(LIB_A)
+	$(LINK)
+
+
 # The port against the fake HAL (test/stm32/fake_hal.c, every register access watched:
 # J288_STUB_FAKE), with a 64-byte receive buffer (a transaction's echo and reply then cross the
 # half, complete and wrap points) and the bytes handed to the bus watched (test_rx_sink); the
@@ -143,7 +151,7 @@ TEST_SCRIPTS += test/stm32/stub_matches_st.sh
 
 # ---- the lists -------------------------------------------------------------------------------
 HOST_TESTS += $(CLI_TEST) $(foreach v,$(CODEC_CRC_VARIANTS),$(CODEC_CRC_TEST_NAMES:%=$(BUILD)/crc-$(v)/test/%)) \
-    $(FUZZ_REPLAY_TESTS) $(LINUX_PORT_TEST) $(CONFIG_TEST) $(SIM_MODEL_TEST) $(STM32_FAMILY_TESTS)
+    $(FUZZ_REPLAY_TESTS) $(LINUX_PORT_TEST) $(CONFIG_TEST) $(SIM_MODEL_TEST) $(JOINT_SIM_TEST) $(STM32_FAMILY_TESTS)
 TEST_SCRIPTS += test/e2e/cli_offline.sh test/e2e/cli_bus.sh test/e2e/cli_bus_faults.sh tools/vectors/check-drift.sh \
     test/e2e/sim_cli.sh test/e2e/example_linux.sh test/abi/check-abi.sh
 # The joint frame end to end against the simulator's truth (the tool, the config, the sim),

@@ -1,95 +1,178 @@
-/* The joint layer: absolute joint angles, soft limits, the binding to a scheduler and the
- * phase fit. The contract is in j288/joint.h, the model in docs/joint.md. */
+/* The joint frame in SI units: the float facade over the joint core (jointq.c). It converts
+ * at its edge and runs the core; the contract is in j288/joint.h, the model in j288/jointq.h
+ * and docs/joint.md. The calibration fit is in joint_cal.c. */
 #include "j288/joint.h"
 
 #if J288_CONFIG_SI
 
 #include <string.h>
 
-#define N_RATIO ((j288_real_t)J288_GEAR_RATIO)
-#define TWO_PI ((j288_real_t)(2.0 * J288_PI))
-#define INV_TWO_PI ((j288_real_t)(1.0 / (2.0 * J288_PI)))
+#include "hints.h"
+#include "jointq_priv.h"
+
 #define HALF ((j288_real_t)0.5)
 #define ZERO ((j288_real_t)0)
-/* Output rad per OutPos count; rotor rad per position LSB; output rad per position LSB. */
-#define OUT_RAD_PER_COUNT ((j288_real_t)(2.0 * J288_PI / (double)J288_OUT_POS_COUNTS))
-#define ROTOR_RAD_PER_LSB ((j288_real_t)(2.0 * J288_PI / 32768.0))
-#define OUT_RAD_PER_LSB ((j288_real_t)(2.0 * J288_PI / 32768.0 / J288_GEAR_RATIO))
-#define ROTOR_LSB_MASK 0x7FFFu /* position LSB within one rotor turn */
-#define COUNT_MASK (J288_OUT_POS_COUNTS - 1u)
-#define HALF_TURN_COUNTS 4096
-#define TURN_COUNTS 8192
-/* The fit's continued count stays within this (65536 output turns), far from int32's end. */
-#define CONT_LIMIT 0x20000000
-/* Finite bound for speed, torque and gain limits (a float holds it). */
-#define BIG ((j288_real_t)1e30)
+#define Q24_SCALE ((j288_real_t)16777216.0)
+#define Q16_SCALE ((j288_real_t)65536.0)
+#define Q24_STEP ((j288_real_t)(1.0 / 16777216.0))
+#define Q16_STEP ((j288_real_t)(1.0 / 65536.0))
+#define TWO_POW_32 ((j288_real_t)4294967296.0)
+#define TWO_POW_M32 ((j288_real_t)(1.0 / 4294967296.0))
+#define TWO_POW_63 ((j288_real_t)9223372036854775808.0)
+#define Q24_SATURATED 0x7FFFFFFFFFFFFFFFu /* 2^63 - 1: beyond every range */
 
-/* ---- small maths, without libm */
+/* ---- the edge: reals to the core's integers and back, without an int64 <-> real conversion
+ * (a soft-float helper on a single-precision FPU). Halves away from zero throughout. */
 
-/* x - 2 pi n for the nearest integer n: [-pi, pi]. Every caller's |x| is far below 2^31 turns
- * (configuration angles are bounded, rotor differences are int32). */
-static j288_real_t wrap_pi(j288_real_t x)
+/* |x|: a single instruction on an FPU where the compiler has it built in (the conditional
+ * form must keep -0's sign, so it is not one). */
+#if defined(__GNUC__) && J288_CONFIG_SI_FLOAT
+#define ABS_REAL(x) __builtin_fabsf(x)
+#elif defined(__GNUC__)
+#define ABS_REAL(x) __builtin_fabs(x)
+#else
+#define ABS_REAL(x) (((x) < ZERO) ? -(x) : (x))
+#endif
+
+/* 2v, |2v| < TWICE_EDGE: the truncation t of |2v| (exact: 2 floor|v| + 1 when |v|'s fraction
+ * is a half or more) gives |v| rounded, halves up, as (t + 1) / 2; then v's sign. */
+#define TWICE_EDGE ((j288_real_t)2147483646.0) /* float rounds it to 2^31: still within */
+#define Q24_TWICE ((j288_real_t)33554432.0)    /* 2^25 */
+#define Q16_TWICE ((j288_real_t)131072.0)      /* 2^17 */
+
+static int32_t round_twice(j288_real_t v2, j288_real_t a2)
 {
-    j288_real_t t = x * INV_TWO_PI;
-    int32_t n = (int32_t)((t >= ZERO) ? (t + HALF) : (t - HALF));
-    return x - ((j288_real_t)n * TWO_PI);
+    int32_t m = (int32_t)(((uint32_t)a2 + 1u) >> 1);
+    return (v2 < ZERO) ? -m : m;
 }
 
-static j288_real_t abs_real(j288_real_t x)
-{
-    return (x < ZERO) ? -x : x;
-}
 
-static bool in_range(j288_real_t x, j288_real_t lo, j288_real_t hi)
+/* x beyond 16384 saturated at int32's ends (beyond every range); NaN: 0 and *ok false. */
+static j288_q16_t q16_slow(j288_real_t x, bool *ok)
 {
-    return (x >= lo) && (x <= hi); /* false for NaN */
-}
-
-/* a - b in rotor LSB, modulo 2^32 (the wire's int32 may wrap), as an int32. */
-static int32_t lsb_diff(int32_t a, int32_t b)
-{
-    uint32_t u = (uint32_t)a - (uint32_t)b;
-    uint32_t below;
-    if (u <= (uint32_t)INT32_MAX) {
-        return (int32_t)u;
+    if (x != x) {
+        *ok = false;
+        return 0;
     }
-    below = u - 0x80000000u; /* u - 2^32 = below - 2^31, computed without overflow */
-    return (int32_t)below - INT32_MAX - 1;
+    return (x < ZERO) ? INT32_MIN : INT32_MAX;
 }
 
-/* The rotor position within its turn, [0, 2 pi): exact from the integer. */
-static j288_real_t rotor_frac(int32_t pos)
+/* a >= 2^31 (not NaN), below 2^63, rounded: the high word and the rest, each exact. */
+static uint64_t round_big(j288_real_t a)
 {
-    uint32_t lsb = (uint32_t)pos & ROTOR_LSB_MASK;
-    return (j288_real_t)lsb * ROTOR_RAD_PER_LSB;
+    uint32_t hi = (uint32_t)(a * TWO_POW_M32);
+    j288_real_t rest = a - ((j288_real_t)hi * TWO_POW_32); /* in [0, 2^32): exact */
+    uint32_t lo = (uint32_t)rest;
+    uint64_t q = ((uint64_t)hi << 32) + (uint64_t)lo;
+    if ((rest - (j288_real_t)lo) >= HALF) {
+        q++;
+    }
+    return q;
 }
 
-/* OutPos as an output angle: the centre of its count, (0, 2 pi). */
-static j288_real_t encoder_angle(uint16_t out_pos)
+/* x * 2^24 rounded, saturated at int64's ends: beyond 64 rad; NaN: 0 and *ok false. */
+static j288_q24_t q24_slow(j288_real_t x, bool *ok)
 {
-    unsigned count = (unsigned)out_pos & COUNT_MASK;
-    return ((j288_real_t)count + HALF) * OUT_RAD_PER_COUNT;
+    j288_real_t a = ((x < ZERO) ? -x : x) * Q24_SCALE;
+    uint64_t m;
+    if (x != x) {
+        *ok = false;
+        return 0;
+    }
+    m = (a >= TWO_POW_63) ? Q24_SATURATED : round_big(a);
+    return (x < ZERO) ? -(j288_q24_t)m : (j288_q24_t)m; /* (-(2^63 - 1) at the low end) */
 }
 
-/* The turn choice: the joint angle of output angle theta (any turn) within pi of centre. */
-static j288_real_t label_q(j288_real_t dir, j288_real_t zero, j288_real_t centre,
-                           j288_real_t theta)
+/* x * 2^24 rounded (NaN: *ok false). The fast path inline in every caller. */
+static J288_INLINE_HOT j288_q24_t q24_of(j288_real_t x, bool *ok)
 {
-    j288_real_t q = dir * (theta - zero);
-    return centre + wrap_pi(q - centre);
+    j288_real_t v2 = x * Q24_TWICE;
+    j288_real_t a2 = ABS_REAL(v2);
+    return (a2 < TWICE_EDGE) ? round_twice(v2, a2) : q24_slow(x, ok); /* NaN: slow */
+}
+
+/* x * 2^16 rounded (NaN: *ok false). */
+static J288_INLINE_HOT j288_q16_t q16_of(j288_real_t x, bool *ok)
+{
+    j288_real_t v2 = x * Q16_TWICE;
+    j288_real_t a2 = ABS_REAL(v2);
+    return (a2 < TWICE_EDGE) ? round_twice(v2, a2) : q16_slow(x, ok); /* NaN: slow */
+}
+
+static j288_real_t real_of_q16(j288_q16_t q)
+{
+    return (j288_real_t)q * Q16_STEP;
+}
+
+/* An angle the core keeps within +-2 pi (encoder, residuals). */
+static j288_real_t real_of_small(j288_q24_t q)
+{
+    return (j288_real_t)(int32_t)q * Q24_STEP;
+}
+
+j288_real_t j288_joint_real_of_q24(j288_q24_t q)
+{
+    uint64_t m;
+    j288_real_t r;
+    if ((q > -(j288_q24_t)INT32_MAX) && (q < (j288_q24_t)INT32_MAX)) {
+        return real_of_small(q); /* within 128 rad */
+    }
+    m = (q < 0) ? ((uint64_t)0 - (uint64_t)q) : (uint64_t)q;
+    r = ((j288_real_t)(uint32_t)(m >> 32) * (TWO_POW_32 * Q24_STEP)) +
+        ((j288_real_t)(uint32_t)m * Q24_STEP);
+    return (q < 0) ? -r : r;
+}
+
+static bool finite_real(j288_real_t x)
+{
+    return (x - x) == ZERO; /* NaN and infinities are not */
 }
 
 /* ---- configuration */
 
-static void fill_defaults(j288_joint_config_t *c)
+static bool config_finite(const j288_joint_config_t *c)
 {
-    if (c->direction == 0) {
-        c->direction = 1;
+    return finite_real(c->zero) && finite_real(c->pos_min) && finite_real(c->pos_max) &&
+           finite_real(c->max_speed) && finite_real(c->max_torque) && finite_real(c->kp) &&
+           finite_real(c->kd) && finite_real(c->phase) && finite_real(c->track_tol) &&
+           finite_real(c->cal_tol);
+}
+
+/* c (finite: config_finite()) in the core's units. */
+static void config_to_q(const j288_joint_config_t *c, j288_jointq_config_t *q)
+{
+    bool ok = true; /* (finite) */
+    (void)memset(q, 0, sizeof *q);
+    q->id = c->id;
+    q->direction = c->direction;
+    q->clamp = c->clamp;
+    q->has_phase = c->has_phase;
+    q->continuous = c->continuous;
+    q->init_samples = c->init_samples;
+    q->zero = q24_of(c->zero, &ok);
+    q->pos_min = q24_of(c->pos_min, &ok);
+    q->pos_max = q24_of(c->pos_max, &ok);
+    if ((c->pos_min == ZERO) && (c->pos_max == ZERO) && !c->continuous) {
+        /* the default range: [-pi, pi] with pi as j288_real_t holds it (a float's pi rounds
+         * to J288_JOINTQ_PI + 1, a double's to J288_JOINTQ_PI: a target of pi is inside) */
+        q->pos_min = q24_of((j288_real_t)-J288_PI, &ok);
+        q->pos_max = q24_of((j288_real_t)J288_PI, &ok);
     }
-    if (c->init_samples == 0u) {
-        c->init_samples = (uint8_t)J288_JOINT_DEFAULT_INIT_SAMPLES;
-    }
-    if ((c->pos_min == ZERO) && (c->pos_max == ZERO)) {
+    q->max_speed = q16_of(c->max_speed, &ok);
+    q->max_torque = q16_of(c->max_torque, &ok);
+    q->kp = q16_of(c->kp, &ok);
+    q->kd = q16_of(c->kd, &ok);
+    q->phase = q24_of(c->phase, &ok);
+    q->track_tol = q24_of(c->track_tol, &ok);
+    q->cal_tol = q24_of(c->cal_tol, &ok);
+}
+
+/* The defaults the core filled in, in the given configuration's terms. */
+static void fill_defaults(j288_joint_config_t *c, const j288_jointq_config_t *q)
+{
+    c->direction = q->direction;
+    c->init_samples = q->init_samples;
+    if ((c->pos_min == ZERO) && (c->pos_max == ZERO) && !c->continuous) {
         c->pos_min = (j288_real_t)-J288_PI;
         c->pos_max = (j288_real_t)J288_PI;
     }
@@ -101,63 +184,68 @@ static void fill_defaults(j288_joint_config_t *c)
     }
 }
 
-static bool config_ok(const j288_joint_config_t *c)
+/* The state after the core's latest reply. */
+static void state_from_core(j288_joint_t *j)
 {
-    const j288_real_t a = (j288_real_t)J288_JOINT_MAX_ANGLE;
-    const j288_real_t pi = (j288_real_t)J288_PI;
-    bool ok = (c->direction == 1) || (c->direction == -1);
-    ok = ok && in_range(c->zero, -a, a) && in_range(c->pos_min, -a, a);
-    ok = ok && in_range(c->pos_max, -a, a) && (c->pos_min < c->pos_max);
-    ok = ok && in_range(c->max_speed, ZERO, BIG) && in_range(c->max_torque, ZERO, BIG);
-    ok = ok && in_range(c->kp, ZERO, BIG) && in_range(c->kd, ZERO, BIG);
-    ok = ok && in_range(c->phase, -TWO_PI, TWO_PI);
-    return ok && in_range(c->track_tol, ZERO, pi) && in_range(c->cal_tol, ZERO, pi);
-}
-
-/* cfg checked, with its defaults, into *out. */
-static int joint_check_config(const j288_joint_config_t *cfg, j288_joint_config_t *out)
-{
-    j288_joint_config_t c = *cfg;
-    if (c.id > J288_MAX_ID) {
-        return J288_ERR_BAD_ID;
-    }
-    fill_defaults(&c);
-    if (!config_ok(&c)) {
-        return J288_ERR_BAD_CONFIG;
-    }
-    *out = c;
-    return J288_OK;
+    const j288_jointq_state_t *s = &j->core.st;
+    j->st.known = s->known;
+    j->st.calibrated = s->calibrated;
+    j->st.cal_mismatch = s->cal_mismatch;
+    j->st.encoder_fault = s->encoder_fault;
+    j->st.beyond_limit = s->beyond_limit;
+    j->st.pos = j288_joint_real_of_q24(s->pos);
+    j->st.speed = real_of_q16(s->speed);
+    j->st.torque = real_of_q16(s->torque);
+    j->st.encoder = real_of_small(s->encoder);
+    j->st.residual = real_of_small(s->residual);
+    j->st.cal_residual = real_of_small(s->cal_residual);
 }
 
 int j288_joint_init(j288_joint_t *j, const j288_joint_config_t *cfg)
 {
-    j288_joint_config_t c;
+    j288_jointq_config_t q;
+    j288_jointq_config_t filled;
+    j288_q24_t centre;
     int err;
 
     if ((j == NULL) || (cfg == NULL)) {
         return J288_ERR_NULL;
     }
-    err = joint_check_config(cfg, &c);
+    if (cfg->id > J288_MAX_ID) {
+        return J288_ERR_BAD_ID;
+    }
+    if (!config_finite(cfg)) {
+        return J288_ERR_BAD_CONFIG;
+    }
+    config_to_q(cfg, &q);
+    err = j288_jointq_check_config(&q, &filled, &centre);
     if (err != J288_OK) {
         return err;
     }
     (void)memset(j, 0, sizeof *j);
-    j->cfg = c;
-    j->dir = (c.direction < 0) ? (j288_real_t)-1 : (j288_real_t)1;
-    j->centre = (c.pos_min + c.pos_max) * HALF;
-    j->k_q = j->dir * OUT_RAD_PER_LSB;
-    j->k_speed = j->dir * (j288_real_t)(1.0 / (J288_SCALE_SPEED * J288_GEAR_RATIO));
-    j->k_torque = j->dir * (j288_real_t)(J288_GEAR_RATIO / J288_SCALE_TORQUE);
+    (void)j288_jointq_init(&j->core, &q); /* checked above */
+    j->cfg = *cfg;
+    fill_defaults(&j->cfg, &filled);
+    state_from_core(j);
     return J288_OK;
 }
 
 void j288_joint_reset(j288_joint_t *j)
 {
     if (j != NULL) {
-        j->seen = false;
-        j->init_n = 0u;
-        (void)memset(&j->st, 0, sizeof j->st);
+        j288_jointq_reset(&j->core);
+        state_from_core(j);
     }
+}
+
+const j288_joint_config_t *j288_joint_config(const j288_joint_t *j)
+{
+    return (j == NULL) ? NULL : &j->cfg;
+}
+
+const j288_jointq_t *j288_joint_core(const j288_joint_t *j)
+{
+    return (j == NULL) ? NULL : &j->core;
 }
 
 const j288_joint_state_t *j288_joint_state(const j288_joint_t *j)
@@ -165,163 +253,17 @@ const j288_joint_state_t *j288_joint_state(const j288_joint_t *j)
     return (j == NULL) ? NULL : &j->st;
 }
 
-/* ---- replies */
-
-/* The output angle minus the rotor's motion since the start's first sample. */
-static j288_real_t start_sample(const j288_joint_t *j, int32_t pos)
-{
-    return j->st.encoder - ((j288_real_t)lsb_diff(pos, j->init_pos) * OUT_RAD_PER_LSB);
-}
-
-static void first_sample(j288_joint_t *j, int32_t pos)
-{
-    j->init_pos = pos;
-    j->init_e0 = j->st.encoder;
-    j->init_sum = ZERO;
-    j->init_n = 1u;
-}
-
-/* The joint angle of the current reply, and its residual against the encoder. */
-static void follow(j288_joint_t *j, int32_t pos)
-{
-    j->st.pos = j->ref_q + (j->k_q * (j288_real_t)lsb_diff(pos, j->ref_pos));
-    j->st.residual =
-        j->st.encoder_fault ? ZERO : wrap_pi((j->cfg.zero + (j->dir * j->st.pos)) - j->st.encoder);
-}
-
-/* Calibrated start: correct the angle q at the anchor by the residual eps. false: eps beyond
- * cal_tol (a mismatch, reported once until a start succeeds). */
-static bool apply_phase(j288_joint_t *j, j288_real_t *q, unsigned *ev)
-{
-    j288_real_t theta = j->cfg.zero + (j->dir * *q);
-    j288_real_t eps = wrap_pi(((N_RATIO * theta) + j->cfg.phase) - rotor_frac(j->init_pos));
-
-    j->st.cal_residual = eps;
-    if (abs_real(eps) > j->cfg.cal_tol) {
-        if (!j->st.cal_mismatch) {
-            *ev |= J288_JOINT_EV_BIT(J288_JOINT_EV_CAL_MISMATCH);
-        }
-        j->st.cal_mismatch = true;
-        return false;
-    }
-    *q -= (j->dir * eps) / N_RATIO;
-    j->st.calibrated = true;
-    return true;
-}
-
-/* Enough samples: label the turn, apply the phase, anchor. */
-static void finish_start(j288_joint_t *j, int32_t pos, unsigned *ev)
-{
-    j288_real_t theta = j->init_e0 + (j->init_sum / (j288_real_t)j->init_n);
-    j288_real_t q = label_q(j->dir, j->cfg.zero, j->centre, theta);
-
-    j->init_n = 0u; /* a later start collects afresh */
-    if (j->cfg.has_phase && !apply_phase(j, &q, ev)) {
-        return;
-    }
-    j->st.cal_mismatch = false;
-    j->ref_pos = j->init_pos;
-    j->ref_q = q;
-    j->st.known = true;
-    *ev |= J288_JOINT_EV_BIT(J288_JOINT_EV_ANGLE_KNOWN);
-    follow(j, pos);
-}
-
-static void start(j288_joint_t *j, int32_t pos, unsigned *ev)
-{
-    j->st.residual = ZERO;
-    if (j->st.encoder_fault) {
-        j->init_n = 0u; /* the encoder is not trusted: no start from it */
-        return;
-    }
-    if (j->init_n == 0u) {
-        first_sample(j, pos);
-    } else {
-        j288_real_t d = wrap_pi(start_sample(j, pos) - j->init_e0);
-        if (abs_real(d) > j->cfg.track_tol) {
-            first_sample(j, pos); /* the samples disagree: begin again from this one */
-        } else {
-            j->init_sum += d;
-            j->init_n++;
-        }
-    }
-    if (j->init_n >= j->cfg.init_samples) {
-        finish_start(j, pos, ev);
-    }
-}
-
-static void track(j288_joint_t *j, int32_t pos, unsigned *ev)
-{
-    follow(j, pos);
-    if (abs_real(j->st.residual) > j->cfg.track_tol) {
-        j->st.known = false;
-        j->st.calibrated = false;
-        j->st.beyond_limit = false;
-        j->init_n = 0u;
-        *ev |= J288_JOINT_EV_BIT(J288_JOINT_EV_ANGLE_LOST);
-    }
-}
-
-static void check_limits(j288_joint_t *j, unsigned *ev)
-{
-    j288_real_t q = j->st.pos;
-    j288_real_t h = (j288_real_t)J288_JOINT_LIMIT_HYST;
-
-    if (!j->st.beyond_limit) {
-        if ((q < j->cfg.pos_min) || (q > j->cfg.pos_max)) {
-            j->st.beyond_limit = true;
-            *ev |= J288_JOINT_EV_BIT(J288_JOINT_EV_LIMIT_REACHED);
-        }
-    } else if ((q >= (j->cfg.pos_min + h)) && (q <= (j->cfg.pos_max - h))) {
-        j->st.beyond_limit = false;
-        *ev |= J288_JOINT_EV_BIT(J288_JOINT_EV_LIMIT_LEFT);
-    } else {
-        /* still beyond */
-    }
-}
-
-/* k * raw, and +0 for raw 0: a reversed joint at rest is not -0 (tools print "-0"). A test
- * is cheaper than adding 0 in soft float. */
-static j288_real_t scale_raw(j288_real_t k, int16_t raw)
-{
-    return (raw == 0) ? ZERO : (k * (j288_real_t)raw);
-}
-
 int j288_joint_take_reply(j288_joint_t *j, const j288_reply_raw_t *reply, unsigned *events)
 {
-    unsigned ev = 0u;
-    bool fault;
-
-    if ((j == NULL) || (reply == NULL)) {
+    int err;
+    if (j == NULL) {
         return J288_ERR_NULL;
     }
-    if (reply->id != j->cfg.id) {
-        return J288_ERR_WRONG_ID;
+    err = j288_jointq_take_reply(&j->core, reply, events);
+    if (err == J288_OK) {
+        state_from_core(j);
     }
-    fault = (reply->faults & J288_FAULT_OUTPUT_ENCODER) != 0u;
-    if (fault != j->st.encoder_fault) {
-        ev |= J288_JOINT_EV_BIT(fault ? J288_JOINT_EV_ENCODER_FAULT : J288_JOINT_EV_ENCODER_OK);
-    }
-    j->st.encoder_fault = fault;
-    j->st.speed = scale_raw(j->k_speed, reply->speed);
-    j->st.torque = scale_raw(j->k_torque, reply->torque);
-    j->st.encoder = encoder_angle(reply->out_pos);
-    if (!j->seen) {
-        j->seen = true;
-        ev |= J288_JOINT_EV_BIT(J288_JOINT_EV_ANGLE_UNKNOWN);
-    }
-    if (j->st.known) {
-        track(j, reply->pos, &ev);
-    } else {
-        start(j, reply->pos, &ev);
-    }
-    if (j->st.known) {
-        check_limits(j, &ev);
-    }
-    if (events != NULL) {
-        *events = ev;
-    }
-    return J288_OK;
+    return err;
 }
 
 /* ---- targets and commands */
@@ -329,7 +271,9 @@ int j288_joint_take_reply(j288_joint_t *j, const j288_reply_raw_t *reply, unsign
 void j288_joint_target_init(const j288_joint_t *j, j288_joint_target_t *t)
 {
     if ((j != NULL) && (t != NULL)) {
-        t->pos = j->st.known ? j->st.pos : ZERO;
+        j288_jointq_target_t q;
+        j288_jointq_target_init(&j->core, &q);
+        t->pos = j288_joint_real_of_q24(q.pos);
         t->speed = ZERO;
         t->torque = ZERO;
         t->kp = j->cfg.kp;
@@ -337,262 +281,97 @@ void j288_joint_target_init(const j288_joint_t *j, j288_joint_target_t *t)
     }
 }
 
-static bool target_has_nan(const j288_joint_target_t *t)
+/* The target in the core's units: false for a NaN in it (refused at the edge, before
+ * anything else; a NaN takes the conversions' slow path, so a good target pays no test). */
+static bool target_to_q(const j288_joint_target_t *t, j288_jointq_target_t *q)
 {
-    return (t->pos != t->pos) || (t->speed != t->speed) || (t->torque != t->torque) ||
-           (t->kp != t->kp) || (t->kd != t->kd);
-}
-
-/* *x within [lo, hi], or saturated there (bit into *clamped) in clamp mode, or err. A NaN
- * anywhere in the target (t) fails first: NaN is never clamped, and its error comes before
- * any other. */
-static int limit_one(const j288_joint_target_t *t, j288_real_t *x, j288_real_t lo,
-                     j288_real_t hi, bool clamp, unsigned bit, int err, unsigned *clamped)
-{
-    if (in_range(*x, lo, hi)) { /* false for NaN */
-        return J288_OK;
-    }
-    if (target_has_nan(t)) {
-        return J288_ERR_NOT_FINITE;
-    }
-    if (!clamp) {
-        return err;
-    }
-    *x = (*x < lo) ? lo : hi;
-    *clamped |= bit;
-    return J288_OK;
-}
-
-static int apply_limits(const j288_joint_config_t *c, j288_joint_target_t *t, unsigned *clamped)
-{
-    int err = limit_one(t, &t->pos, c->pos_min, c->pos_max, c->clamp, J288_FIELD_POS,
-                        J288_ERR_LIMIT_POS, clamped);
-    if ((err == J288_OK) && (c->max_speed > ZERO)) {
-        err = limit_one(t, &t->speed, -c->max_speed, c->max_speed, c->clamp, J288_FIELD_SPEED,
-                        J288_ERR_LIMIT_SPEED, clamped);
-    }
-    if ((err == J288_OK) && (c->max_torque > ZERO)) {
-        err = limit_one(t, &t->torque, -c->max_torque, c->max_torque, c->clamp, J288_FIELD_TAU,
-                        J288_ERR_LIMIT_TORQUE, clamped);
-    }
-    return err;
-}
-
-/* a + b when it fits int32 (false otherwise), wrap-free: in unsigned arithmetic, the sum
- * overflowed when both operands have the same sign and the sum has the other. */
-static bool add_i32(int32_t a, int32_t b, int32_t *sum)
-{
-    uint32_t ua = (uint32_t)a;
-    uint32_t ub = (uint32_t)b;
-    uint32_t us = ua + ub;
-    if ((((ua ^ us) & (ub ^ us)) & 0x80000000u) != 0u) {
-        return false;
-    }
-    if (us <= (uint32_t)INT32_MAX) {
-        *sum = (int32_t)us;
-    } else {
-        uint32_t below = us - 0x80000000u; /* us - 2^32 = below - 2^31, without overflow */
-        *sum = (int32_t)below - INT32_MAX - 1;
-    }
-    return true;
-}
-
-/* The limited target in the rotor frame, its position relative to the anchor. */
-static int target_to_raw(const j288_joint_t *j, const j288_joint_target_t *t,
-                         j288_cmd_raw_t *raw, unsigned *clamped)
-{
-    j288_cmd_si_t si;
-    unsigned wire = 0u;
-    int err;
-
-    si.id = j->cfg.id;
-    si.status = J288_MODE_FOC;
-    si.watchdog = true;
-    si.tau = j->dir * t->torque;
-    si.speed = j->dir * t->speed;
-    si.pos = j->dir * (t->pos - j->ref_q);
-    si.kp = t->kp;
-    si.kd = t->kd;
-    err = j->cfg.clamp ? j288_cmd_from_si_clamped(&si, J288_SIDE_OUTPUT, raw, &wire)
-                       : j288_cmd_from_si(&si, J288_SIDE_OUTPUT, raw);
-    if (err != J288_OK) {
-        return err;
-    }
-    if (!add_i32(j->ref_pos, raw->pos, &raw->pos)) {
-        return J288_ERR_RANGE_POS;
-    }
-    *clamped |= wire;
-    return J288_OK;
+    bool ok = true;
+    q->pos = q24_of(t->pos, &ok);
+    q->speed = q16_of(t->speed, &ok);
+    q->torque = q16_of(t->torque, &ok);
+    q->kp = q16_of(t->kp, &ok);
+    q->kd = q16_of(t->kd, &ok);
+    return ok;
 }
 
 int j288_joint_command(const j288_joint_t *j, const j288_joint_target_t *t, j288_cmd_raw_t *cmd,
                        unsigned *clamped)
 {
-    j288_joint_target_t v;
-    j288_cmd_raw_t raw;
-    unsigned mask = 0u;
-    int err;
+    j288_jointq_target_t q;
 
     if ((j == NULL) || (t == NULL) || (cmd == NULL)) {
         return J288_ERR_NULL;
     }
-    if (!j->st.known) {
-        return j->st.cal_mismatch ? J288_ERR_CAL_MISMATCH : J288_ERR_ANGLE_UNKNOWN;
+    if (!target_to_q(t, &q)) {
+        return J288_ERR_NOT_FINITE;
     }
-    /* NaN is refused before anything else, but tested only where a step fails (a NaN fails
-     * every limit and every conversion): a good target pays no test of its own. */
-    v = *t;
-    err = apply_limits(&j->cfg, &v, &mask);
-    if (err == J288_OK) {
-        err = target_to_raw(j, &v, &raw, &mask);
-    }
-    if (err != J288_OK) {
-        return target_has_nan(t) ? J288_ERR_NOT_FINITE : err;
-    }
-    *cmd = raw;
-    if (clamped != NULL) {
-        *clamped = mask;
-    }
-    return J288_OK;
-}
-
-static void joint_lock_cmd(uint8_t id, bool watchdog, j288_cmd_raw_t *cmd)
-{
-    (void)memset(cmd, 0, sizeof *cmd);
-    cmd->id = id;
-    cmd->status = J288_MODE_LOCK;
-    cmd->watchdog = watchdog;
+    return j288_jointq_command(&j->core, &q, cmd, clamped);
 }
 
 int j288_joint_lock_command(const j288_joint_t *j, j288_cmd_raw_t *cmd)
 {
-    if ((j == NULL) || (cmd == NULL)) {
-        return J288_ERR_NULL;
-    }
-    joint_lock_cmd(j->cfg.id, true, cmd);
-    return J288_OK;
+    return j288_jointq_lock_command((j == NULL) ? NULL : &j->core, cmd);
 }
 
 int j288_joint_zero_here(const j288_joint_t *j, j288_real_t *zero)
 {
+    j288_q24_t z;
+    int err;
+
     if ((j == NULL) || (zero == NULL)) {
         return J288_ERR_NULL;
     }
-    if (!j->st.known) {
-        return J288_ERR_ANGLE_UNKNOWN;
+    err = j288_jointq_zero_here(&j->core, &z);
+    if (err == J288_OK) {
+        *zero = j288_joint_real_of_q24(z);
     }
-    *zero = j->cfg.zero + (j->dir * j->st.pos);
-    return J288_OK;
+    return err;
 }
 
-/* ---- binding */
+/* ---- binding: the core's, its events converted (the user's callback in the facade). */
 
-int j288_joint_bus_init(j288_joint_bus_t *jb, j288_sched_t *sched, j288_joint_event_fn on_event,
-                        void *user)
+static void event_to_real(void *user, const j288_jointq_event_t *ev)
 {
-    if ((jb == NULL) || (sched == NULL)) {
-        return J288_ERR_NULL;
-    }
-    (void)memset(jb, 0, sizeof *jb);
-    jb->sched = sched;
-    jb->on_event = on_event;
-    jb->user = user;
-    return J288_OK;
-}
-
-int j288_joint_bus_add(j288_joint_bus_t *jb, j288_joint_t *j)
-{
-    j288_cmd_raw_t lock;
-    uint8_t id;
-
-    if ((jb == NULL) || (j == NULL)) {
-        return J288_ERR_NULL;
-    }
-    id = j->cfg.id; /* 0-14: j288_joint_init() checked it */
-    if ((jb->joint[id] != NULL) && (jb->joint[id] != j)) {
-        return J288_ERR_BAD_CONFIG;
-    }
-    jb->joint[id] = j;
-    joint_lock_cmd(id, true, &lock);
-    return j288_sched_set_cmd(jb->sched, &lock);
-}
-
-/* The joint bound under j's id is j itself. */
-static bool bound_here(const j288_joint_bus_t *jb, const j288_joint_t *j)
-{
-    return (j->cfg.id <= J288_MAX_ID) && (jb->joint[j->cfg.id] == j);
-}
-
-int j288_joint_bus_set_target(j288_joint_bus_t *jb, const j288_joint_t *j,
-                              const j288_joint_target_t *t, unsigned *clamped)
-{
-    j288_cmd_raw_t cmd;
-    int err;
-
-    if ((jb == NULL) || (j == NULL)) {
-        return J288_ERR_NULL;
-    }
-    if (!bound_here(jb, j)) {
-        return J288_ERR_BAD_ARG;
-    }
-    err = j288_joint_command(j, t, &cmd, clamped);
-    if (err != J288_OK) {
-        return err;
-    }
-    return j288_sched_set_cmd(jb->sched, &cmd);
-}
-
-int j288_joint_bus_lock(j288_joint_bus_t *jb, const j288_joint_t *j)
-{
-    j288_cmd_raw_t lock;
-
-    if ((jb == NULL) || (j == NULL)) {
-        return J288_ERR_NULL;
-    }
-    if (!bound_here(jb, j)) {
-        return J288_ERR_BAD_ARG;
-    }
-    joint_lock_cmd(j->cfg.id, true, &lock);
-    return j288_sched_set_cmd(jb->sched, &lock);
-}
-
-static j288_real_t event_value(const j288_joint_t *j, j288_joint_event_kind_t kind)
-{
-    switch (kind) {
-    case J288_JOINT_EV_ANGLE_LOST:
-        return j->st.residual;
-    case J288_JOINT_EV_CAL_MISMATCH:
-        return j->st.cal_residual;
-    case J288_JOINT_EV_ANGLE_KNOWN:
-    case J288_JOINT_EV_LIMIT_REACHED:
-    case J288_JOINT_EV_LIMIT_LEFT:
-        return j->st.pos;
-    default:
-        return ZERO;
-    }
-}
-
-static void report(const j288_joint_bus_t *jb, const j288_joint_t *j, unsigned events)
-{
-    static const j288_joint_event_kind_t order[J288_JOINT_EV_COUNT] = {
-        J288_JOINT_EV_ENCODER_FAULT, J288_JOINT_EV_ENCODER_OK,   J288_JOINT_EV_ANGLE_UNKNOWN,
-        J288_JOINT_EV_ANGLE_LOST,    J288_JOINT_EV_CAL_MISMATCH, J288_JOINT_EV_ANGLE_KNOWN,
-        J288_JOINT_EV_LIMIT_REACHED, J288_JOINT_EV_LIMIT_LEFT};
-    j288_joint_event_t ev;
-    unsigned i;
+    const j288_joint_bus_t *jb = (const j288_joint_bus_t *)user; /* ours, set at init */
+    j288_joint_event_t e;
 
     if (jb->on_event == NULL) {
         return;
     }
-    ev.id = j->cfg.id;
-    ev.joint = j;
-    for (i = 0u; i < J288_JOINT_EV_COUNT; i++) {
-        if ((events & J288_JOINT_EV_BIT(order[i])) != 0u) {
-            ev.kind = order[i];
-            ev.value = event_value(j, order[i]);
-            jb->on_event(jb->user, &ev);
-        }
+    e.kind = ev->kind;
+    e.id = ev->id; /* 0-14: a bound joint's */
+    e.joint = jb->joint[ev->id];
+    e.value = j288_joint_real_of_q24(ev->value);
+    jb->on_event(jb->user, &e);
+}
+
+int j288_joint_bus_init(j288_joint_bus_t *jb, j288_sched_t *sched, j288_joint_event_fn on_event,
+                        void *user)
+{
+    int err;
+    if (jb == NULL) {
+        return J288_ERR_NULL;
     }
+    err = j288_jointq_bus_init(&jb->core, sched, event_to_real, jb);
+    if (err == J288_OK) {
+        (void)memset(jb->joint, 0, sizeof jb->joint);
+        jb->on_event = on_event;
+        jb->user = user;
+    }
+    return err;
+}
+
+int j288_joint_bus_add(j288_joint_bus_t *jb, j288_joint_t *j)
+{
+    int err;
+    if ((jb == NULL) || (j == NULL)) {
+        return J288_ERR_NULL;
+    }
+    err = j288_jointq_bus_add(&jb->core, &j->core);
+    if (err == J288_OK) {
+        jb->joint[j->core.cfg.id] = j; /* 0-14: the core checked it */
+    }
+    return err;
 }
 
 void j288_joint_bus_on_reply(void *user, uint8_t id, const j288_slot_t *slot)
@@ -608,180 +387,26 @@ void j288_joint_bus_on_reply(void *user, uint8_t id, const j288_slot_t *slot)
     if ((j == NULL) || (j288_joint_take_reply(j, &slot->reply, &events) != J288_OK)) {
         return;
     }
-    if (!j->st.known && (slot->cmd.status != J288_MODE_LOCK)) {
-        j288_cmd_raw_t lock;
-        joint_lock_cmd(id, slot->cmd.watchdog, &lock);
-        (void)j288_sched_set_cmd(jb->sched, &lock); /* a valid lock is never refused */
-    }
-    report(jb, j, events);
+    j288_jointq_after_reply(&jb->core, &j->core, slot, events);
 }
 
-/* ---- calibration */
-
-int j288_cal_init(j288_cal_t *cal, const j288_joint_config_t *cfg)
+int j288_joint_bus_set_target(j288_joint_bus_t *jb, const j288_joint_t *j,
+                              const j288_joint_target_t *t, unsigned *clamped)
 {
-    static const j288_joint_config_t defaults = {0};
-    const j288_joint_config_t *given = (cfg != NULL) ? cfg : &defaults;
-    j288_joint_config_t c;
-    int err;
+    j288_jointq_target_t q;
 
-    if (cal == NULL) {
+    if ((jb == NULL) || (j == NULL) || (t == NULL)) {
         return J288_ERR_NULL;
     }
-    err = joint_check_config(given, &c);
-    if (err != J288_OK) {
-        return err;
+    if (!target_to_q(t, &q)) {
+        return J288_ERR_NOT_FINITE;
     }
-    (void)memset(cal, 0, sizeof *cal);
-    cal->dir = (c.direction < 0) ? (j288_real_t)-1 : (j288_real_t)1;
-    cal->zero = c.zero;
-    cal->centre = (c.pos_min + c.pos_max) * HALF;
-    cal->cal_tol = c.cal_tol;
-    return J288_OK;
+    return j288_jointq_bus_set_target(&jb->core, &j->core, &q, clamped);
 }
 
-/* The first pair: its labelled output angle fixes the turns of all later ones. */
-static void cal_first(j288_cal_t *cal, uint16_t count, int32_t pos)
+int j288_joint_bus_lock(j288_joint_bus_t *jb, const j288_joint_t *j)
 {
-    j288_real_t q = label_q(cal->dir, cal->zero, cal->centre, encoder_angle(count));
-    j288_real_t theta = cal->zero + (cal->dir * q);
-
-    cal->first_pos = pos;
-    cal->first_v = wrap_pi(rotor_frac(pos) - (N_RATIO * theta));
-    cal->prev_count = count;
-}
-
-/* Continue the OutPos count across the wrap (consecutive pairs within half a turn). */
-static void cal_continue(j288_cal_t *cal, uint16_t count)
-{
-    int32_t step = (int32_t)count - (int32_t)cal->prev_count;
-    if (step >= HALF_TURN_COUNTS) {
-        step -= TURN_COUNTS;
-    } else if (step < -HALF_TURN_COUNTS) {
-        step += TURN_COUNTS;
-    } else {
-        /* no wrap */
-    }
-    cal->prev_count = count;
-    cal->cont += step;
-    if (cal->cont < cal->cont_min) {
-        cal->cont_min = cal->cont;
-    }
-    if (cal->cont > cal->cont_max) {
-        cal->cont_max = cal->cont;
-    }
-}
-
-/* Welford updates: the residual v (unwrapped around the running mean) and the motion. */
-static void cal_accumulate(j288_cal_t *cal, j288_real_t x, j288_real_t y)
-{
-    j288_real_t n = (j288_real_t)cal->n;
-    j288_real_t v = cal->first_v + (y - (N_RATIO * x));
-    j288_real_t dv;
-    j288_real_t dx;
-    j288_real_t dy;
-
-    v = (cal->n == 1u) ? v : (cal->mean + wrap_pi(v - cal->mean));
-    dv = v - cal->mean;
-    cal->mean += dv / n;
-    cal->m2 += dv * (v - cal->mean);
-    if ((cal->n == 1u) || (v < cal->vmin)) {
-        cal->vmin = v;
-    }
-    if ((cal->n == 1u) || (v > cal->vmax)) {
-        cal->vmax = v;
-    }
-    dx = x - cal->mx;
-    dy = y - cal->my;
-    cal->mx += dx / n;
-    cal->my += dy / n;
-    cal->cxy += dx * (y - cal->my);
-    cal->m2y += dy * (y - cal->my);
-}
-
-int j288_cal_add(j288_cal_t *cal, uint16_t out_pos, int32_t rotor_pos)
-{
-    j288_real_t x;
-    j288_real_t y;
-
-    if (cal == NULL) {
-        return J288_ERR_NULL;
-    }
-    if ((out_pos > COUNT_MASK) || (cal->n == UINT32_MAX) || (cal->cont > CONT_LIMIT) ||
-        (cal->cont < -CONT_LIMIT)) {
-        return J288_ERR_RANGE;
-    }
-    if (cal->n == 0u) {
-        cal_first(cal, out_pos, rotor_pos);
-    } else {
-        cal_continue(cal, out_pos);
-    }
-    cal->n++;
-    x = (j288_real_t)cal->cont * OUT_RAD_PER_COUNT;
-    y = (j288_real_t)lsb_diff(rotor_pos, cal->first_pos) * ROTOR_RAD_PER_LSB;
-    cal_accumulate(cal, x, y);
-    return J288_OK;
-}
-
-int j288_cal_add_reply(j288_cal_t *cal, const j288_reply_raw_t *reply)
-{
-    if ((cal == NULL) || (reply == NULL)) {
-        return J288_ERR_NULL;
-    }
-    if ((reply->faults & J288_FAULT_OUTPUT_ENCODER) != 0u) {
-        cal->rejected++;
-        return J288_OK;
-    }
-    return j288_cal_add(cal, reply->out_pos, reply->pos);
-}
-
-/* Square root of x >= 0 by Newton's iteration from above (monotone, so it stops). */
-static j288_real_t sqrt_nonneg(j288_real_t x)
-{
-    j288_real_t y = (x > (j288_real_t)1) ? x : (j288_real_t)1;
-    if (x <= ZERO) {
-        return ZERO;
-    }
-    for (;;) {
-        j288_real_t next = HALF * (y + (x / y));
-        if (!(next < y)) {
-            return y;
-        }
-        y = next;
-    }
-}
-
-int j288_cal_result(const j288_cal_t *cal, j288_cal_report_t *report)
-{
-    j288_cal_report_t r;
-
-    if ((cal == NULL) || (report == NULL)) {
-        return J288_ERR_NULL;
-    }
-    (void)memset(&r, 0, sizeof r);
-    r.samples = cal->n;
-    r.rejected = cal->rejected;
-    r.span_counts = (uint32_t)cal->cont_max - (uint32_t)cal->cont_min; /* max >= 0 >= min */
-    r.phase = wrap_pi(cal->mean);
-    r.rms = (cal->n == 0u) ? ZERO : sqrt_nonneg(cal->m2 / (j288_real_t)cal->n);
-    r.max_abs = ((cal->vmax - cal->mean) > (cal->mean - cal->vmin)) ? (cal->vmax - cal->mean)
-                                                                    : (cal->mean - cal->vmin);
-    r.ratio = (abs_real(cal->cxy) > ZERO) ? (cal->m2y / cal->cxy) : ZERO;
-    if (r.samples < J288_CAL_MIN_SAMPLES) {
-        r.problems |= J288_CAL_FEW_SAMPLES;
-    }
-    if (r.span_counts < J288_CAL_MIN_SPAN) {
-        r.problems |= J288_CAL_SMALL_SPAN;
-    }
-    if (r.max_abs > cal->cal_tol) {
-        r.problems |= J288_CAL_NOISY;
-    }
-    if (abs_real((r.ratio / N_RATIO) - (j288_real_t)1) >
-        (j288_real_t)J288_CAL_MAX_RATIO_ERROR) {
-        r.problems |= J288_CAL_RATIO;
-    }
-    *report = r;
-    return (r.problems == 0u) ? J288_OK : J288_ERR_CAL_DATA;
+    return j288_jointq_bus_lock((jb == NULL) ? NULL : &jb->core, (j == NULL) ? NULL : &j->core);
 }
 
 #else

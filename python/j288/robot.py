@@ -72,7 +72,8 @@ def _doubles(values: Optional[Vector], n: int) -> Tuple[Any, Any]:
 
 class Robot(_native.Handle):
     """Every bus and joint of a robot config file (YAML: buses, joints with name, bus, id,
-    direction, zero, limits, gains; every key commented in examples/robot.yaml).
+    direction, zero, limits or continuous: true (a wheel: no limits, the angle never wrapped),
+    gains; every key commented in examples/robot.yaml).
 
     One cycle sends every joint its command on every bus at once and returns when each bus
     that answers has finished. Set targets between cycles::

@@ -6,6 +6,7 @@ margin, so that a loaded machine or valgrind does not fail a check; no check tim
 
 from __future__ import annotations
 
+import math
 import os
 import re
 import signal
@@ -258,6 +259,33 @@ def test_robot_two_buses(sims, tmp_path: Path) -> None:
     for s in (s0, s1):
         assert s.logged(" id=2 status=1 wd=1")
         assert s.logged(" id=15 status=0 wd=0")
+
+
+def test_robot_wheel_and_soft_limit(sims, tmp_path: Path) -> None:
+    """A continuous joint from the config (continuous: true) turns past any turn, its angle
+    never wrapped; a speed target held toward a soft limit stops the other joint at it."""
+    s = sims("1,2")
+    cfg = tmp_path / "wheel.yaml"
+    cfg.write_text(f"buses:\n  - name: b\n    port: {s.pty}\n    margin_us: {MARGIN}\n"
+                   "joints:\n  - {name: wheel, id: 1, continuous: true}\n"
+                   "  - {name: arm, id: 2, limits: [-1.0, 0.3]}\n")
+    with j288.Robot(str(cfg)) as robot:
+        cycle_until_known(robot)
+        start = robot.state("wheel").pos
+        arm = [robot.state("arm").pos]
+        for _ in range(40000):  # until the wheel has turned three turns (about 2.5 s)
+            robot.set_target("wheel", robot.state("wheel").pos, speed=8.0, kd=2.0)
+            robot.set_target("arm", robot.state("arm").pos, speed=1.0, kd=1.0)
+            robot.cycle()
+            arm.append(robot.state("arm").pos)
+            if robot.state("wheel").pos > start + 6.0 * math.pi:
+                break
+        assert robot.state("wheel").pos > start + 6.0 * math.pi  # not wrapped to [-pi, pi)
+        assert robot.state("wheel").known
+        # the arm (started wherever the simulator drew it) goes to its top limit and stays
+        # there: never further out than it started or 0.05 rad past the limit
+        assert all(abs(q - 0.3) < 0.05 for q in arm[-10:]), (arm[0], arm[-10:])
+        assert max(arm) <= max(arm[0], 0.3) + 0.05, (arm[0], max(arm))
 
 
 def test_robot_stop_on_exception(sims, tmp_path: Path) -> None:

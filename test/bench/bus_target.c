@@ -551,8 +551,8 @@ static uint32_t run_joint_command(void)
 }
 #endif
 
-#if J288_CONFIG_JOINT_FIXED
-/* ---- the fixed-point joint layer (j288/jointq.h), the same work as the rows above. */
+/* ---- the joint core (j288/jointq.h), the same work as the rows above (which run it through
+ * the float facade), and a speed target near a limit (the limit law's path). */
 static j288_jointq_t jointq;
 static uint32_t jointq_errors;
 
@@ -600,7 +600,41 @@ static uint32_t run_jointq_command(void)
     t1 = icount_now();
     return icount_between(t0, t1);
 }
-#endif
+
+/* kp 0, kd 1, 1 rad/s toward the top limit 0.1 rad away (the default range, the joint near
+ * pi): the target's law and the limit law compared at every call, the limit law sent. */
+static uint32_t run_jointq_limit(void)
+{
+    j288_jointq_config_t jc;
+    j288_jointq_target_t t;
+    j288_reply_raw_t r;
+    j288_cmd_raw_t cmd;
+    uint32_t i, t0, t1;
+    unsigned mask = 0u;
+    memset(&jc, 0, sizeof jc);
+    memset(&r, 0, sizeof r);
+    jc.id = 3u;
+    r.id = 3u;
+    r.pos = 5000;
+    r.out_pos = 3950u; /* 3.03 rad */
+    r.speed = 400;     /* 1 rad/s toward the top */
+    (void)j288_jointq_init(&jointq, &jc);
+    for (i = 0u; i < J288_JOINT_DEFAULT_INIT_SAMPLES; i++) {
+        (void)j288_jointq_take_reply(&jointq, &r, NULL);
+    }
+    j288_jointq_target_init(&jointq, &t);
+    t.kp = 0;
+    t.kd = J288_Q16(1.0);
+    t.speed = J288_Q16(1.0);
+    t0 = icount_now();
+    for (i = 0u; i < ITERATIONS; i++) {
+        t.speed = J288_Q16(1.0) + (j288_q16_t)(i & 7u);
+        jointq_errors += (uint32_t)(j288_jointq_command(&jointq, &t, &cmd, &mask) != J288_OK);
+    }
+    t1 = icount_now();
+    jointq_errors += (uint32_t)((mask & J288_JOINT_LIMITED) == 0u);
+    return icount_between(t0, t1);
+}
 
 static const char *backend_name(void)
 {
@@ -687,22 +721,21 @@ int main(void)
         row("scheduler sweeps, advance_in_isr", f_engine, isr);
     }
 #if J288_CONFIG_SI
-    row("joint: reply -> state", 0u, per_txn(RUN_ROW(32u, run_joint_reply()), ipt));
-    row("joint: target -> command", 0u, per_txn(RUN_ROW(32u, run_joint_command()), ipt));
+    row("joint (float facade): reply -> state", 0u, per_txn(RUN_ROW(32u, run_joint_reply()), ipt));
+    row("joint (float facade): target -> command", 0u, per_txn(RUN_ROW(32u, run_joint_command()), ipt));
     if (joint_errors != 0u) {
         printf("bus_target: the joint layer failed (%lu)\n", (unsigned long)joint_errors);
         return 1;
     }
 #endif
-#if J288_CONFIG_JOINT_FIXED
-    row("joint (fixed): reply -> state", 0u, per_txn(RUN_ROW(32u, run_jointq_reply()), ipt));
-    row("joint (fixed): target -> command", 0u, per_txn(RUN_ROW(32u, run_jointq_command()), ipt));
+    row("joint (core): reply -> state", 0u, per_txn(RUN_ROW(32u, run_jointq_reply()), ipt));
+    row("joint (core): target -> command", 0u, per_txn(RUN_ROW(32u, run_jointq_command()), ipt));
+    row("joint (core): speed target near a limit -> command", 0u,
+        per_txn(RUN_ROW(32u, run_jointq_limit()), ipt));
     if (jointq_errors != 0u) {
-        printf("bus_target: the fixed-point joint layer failed (%lu)\n",
-               (unsigned long)jointq_errors);
+        printf("bus_target: the joint core failed (%lu)\n", (unsigned long)jointq_errors);
         return 1;
     }
-#endif
     if (done_count != done_expected) {
         printf("bus_target: transactions did not complete (%lu of %lu)\n",
                (unsigned long)done_count, (unsigned long)done_expected);

@@ -182,6 +182,31 @@ static void test_joint_config(void)
     j288_robot_config_joint_config(&g_cfg.joint[0], NULL);
 }
 
+/* continuous: true (a wheel): no limits, passed to the joint; limits beside it are an error. */
+static void test_continuous(void)
+{
+    j288_joint_config_t jc;
+    j288_joint_t joint;
+    TEST_ASSERT_EQUAL_INT_MESSAGE(0, parse("joints:\n  - {name: w, id: 2, continuous: true}\n"),
+                                  g_err);
+    TEST_ASSERT_TRUE(g_cfg.joint[0].continuous);
+    TEST_ASSERT_FALSE(g_cfg.joint[0].has_limits);
+    memset(&jc, 0x5a, sizeof jc);
+    j288_robot_config_joint_config(&g_cfg.joint[0], &jc);
+    TEST_ASSERT_TRUE(jc.continuous);
+    TEST_ASSERT_EQUAL_DOUBLE(0.0, (double)jc.pos_min);
+    TEST_ASSERT_EQUAL_DOUBLE(0.0, (double)jc.pos_max);
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_joint_init(&joint, &jc));
+    TEST_ASSERT_TRUE(j288_joint_config(&joint)->continuous);
+    TEST_ASSERT_EQUAL_INT_MESSAGE(0, parse("joints:\n  - {name: w, id: 2, continuous: false}\n"),
+                                  g_err);
+    TEST_ASSERT_FALSE(g_cfg.joint[0].continuous);
+    check_error("joints:\n  - name: w\n    id: 1\n    continuous: true\n    limits: [-1, 1]\n", 5,
+                "limits: a continuous joint has none");
+    check_error("joints:\n  - name: w\n    id: 1\n    continuous: 1\n", 4,
+                "continuous: expected true or false");
+}
+
 static void test_defaults(void)
 {
     const j288_robot_config_joint_t *j;
@@ -911,6 +936,7 @@ int main(void)
     UNITY_BEGIN();
     RUN_TEST(test_full_file);
     RUN_TEST(test_defaults);
+    RUN_TEST(test_continuous);
     RUN_TEST(test_joint_config);
     RUN_TEST(test_byte_order_mark_crlf_and_unicode);
     RUN_TEST(test_errors_keys);

@@ -1,7 +1,7 @@
 /*
  * A typical MCU user of j288, linked only to measure it (make size): the STM32 port on one
  * UART, the bus engine, the cycle scheduler, SI conversion and error strings. Never run.
- * With SIZE_PROBE_JOINTQ (the FPU-less build, J288_CONFIG_SI=0): the fixed-point joint layer
+ * With SIZE_PROBE_JOINTQ (the FPU-less build, J288_CONFIG_SI=0): the joint core (j288/jointq.h)
  * for 15 joints bound to the scheduler instead of the SI conversion.
  */
 #include <stdint.h>

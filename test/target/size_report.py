@@ -119,7 +119,8 @@ INDIRECT_SITES = [
     (r"(parser|bus|frame)\.c:j288_crc_frame_hot", ["crc32"]),
     (r"sched\.c:(next_slot|sched_lock|sched_unlock)", ["lock", "unlock"]),
     (r"sched\.c:(emit|sched_done|take_reply)", ["app"]),
-    (r"^j288_joint(q)?_bus_on_reply|joint(q)?\.c:report", ["app"]),  # on_event
+    (r"^j288_joint(q)?_(bus_on_reply|after_reply)|joint(q)?\.c:(jq_)?report", ["app"]),  # on_event
+    (r"joint\.c:event_to_real", ["app"]),  # the facade's on_event
     (r"j288_stm32\.c:now_of", ["app"]),
 ]
 

@@ -78,7 +78,7 @@ typedef struct {
 
 typedef struct {
     const char *name;
-    int32_t q[5];      /* tau, speed, kp, kd in Q16; pos in Q24 */
+    int64_t q[5];      /* tau, speed, kp, kd in Q16; pos in Q24 */
     int expect;        /* j288_cmd_from_q() result */
     int32_t raw[5];    /* tau, speed, pos, kp, kd when expect is J288_OK */
     unsigned clamp_mask;
@@ -97,7 +97,7 @@ typedef struct {
 #define GOLDEN_SI_COUNT 1222u
 #define GOLDEN_FROM_RAW_COUNT 83u
 #define GOLDEN_SI_CMD_COUNT 58u
-#define GOLDEN_FIXED_CMD_COUNT 104u
+#define GOLDEN_FIXED_CMD_COUNT 110u
 #define GOLDEN_FIXED_REPLY_COUNT 45u
 #define GOLDEN_FAULT_NAME_COUNT 22u
 
@@ -3151,6 +3151,18 @@ static const golden_fixed_cmd_t golden_fixed_cmds[GOLDEN_FIXED_CMD_COUNT] = {
      {0, 0, 192486374, 0, 0}, 0u, {0, 0, 192486374, 0, 0}},
     {"pos_min", {0, 0, INT32_MIN, 0, 0}, J288_OK,
      {0, 0, -192486374, 0, 0}, 0u, {0, 0, -192486374, 0, 0}},
+    {"pos_128rad", {0, 0, 2147483648, 0, 0}, J288_OK,
+     {0, 0, 192486374, 0, 0}, 0u, {0, 0, 192486374, 0, 0}},
+    {"pos_reach", {0, 0, 4294967295, 0, 0}, J288_OK,
+     {0, 0, 384972748, 0, 0}, 0u, {0, 0, 384972748, 0, 0}},
+    {"pos_beyond_reach", {0, 0, 4294967296, 0, 0}, J288_ERR_RANGE_POS,
+     {0, 0, 0, 0, 0}, 4u, {0, 0, 2147483647, 0, 0}},
+    {"pos_beyond_reach_neg", {0, 0, -4294967296, 0, 0}, J288_ERR_RANGE_POS,
+     {0, 0, 0, 0, 0}, 4u, {0, 0, INT32_MIN, 0, 0}},
+    {"pos_far", {0, 0, 1099511627776, 0, 0}, J288_ERR_RANGE_POS,
+     {0, 0, 0, 0, 0}, 4u, {0, 0, 2147483647, 0, 0}},
+    {"pos_far_kp_bad", {0, 0, -1099511627776, -1, 0}, J288_ERR_RANGE_POS,
+     {0, 0, 0, 0, 0}, 12u, {0, 0, INT32_MIN, 0, 0}},
     {"all_out", {INT32_MIN, 2147483647, INT32_MIN, 2147483647, 2147483647}, J288_ERR_RANGE_TAU,
      {0, 0, 0, 0, 0}, 27u, {-32768, 32767, -192486374, 32767, 32767}},
     {"all_out_neg_gains", {2147483647, INT32_MIN, 0, INT32_MIN, -5}, J288_ERR_RANGE_TAU,

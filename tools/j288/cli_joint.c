@@ -143,7 +143,7 @@ void cli_joint_why_unknown(const j288_joint_t *j, const char *name, unsigned rep
                        "it (tolerance %.3f): the gear or the servo changed; run j288 calibrate, "
                        "or remove phase from the config to run uncalibrated",
                        name, j288_strerror(J288_ERR_CAL_MISMATCH), (double)st->cal_residual,
-                       (double)j->cfg.cal_tol);
+                       (double)j288_joint_config(j)->cal_tol);
     } else {
         (void)snprintf(buf, len, "%s: the joint angle is still unknown after %u replies (the "
                        "output encoder and the rotor disagree: the joint is moving fast, or the "
@@ -155,7 +155,8 @@ int cli_joint_acquire(cli_bus_t *b, j288_joint_t *j, const char *name, j288_txn_
                       unsigned *replies, bool report_unknown)
 {
     const j288_joint_state_t *st = j288_joint_state(j);
-    unsigned samples = j->cfg.init_samples != 0u ? j->cfg.init_samples : 8u;
+    unsigned given = j288_joint_config(j)->init_samples;
+    unsigned samples = given != 0u ? given : 8u;
     unsigned tries = samples * ACQUIRE_TRIES_PER_SAMPLE, n;
     j288_cmd_raw_t cmd;
     j288_txn_t txn;
@@ -165,7 +166,7 @@ int cli_joint_acquire(cli_bus_t *b, j288_joint_t *j, const char *name, j288_txn_
         tries = ACQUIRE_TRIES_MIN;
     }
     *replies = 0;
-    cli_lock_cmd(j->cfg.id, &cmd);
+    cli_lock_cmd(j288_joint_config(j)->id, &cmd);
     for (n = 0; n < tries && !st->known; n++) {
         rc = cli_bus_transfer(b, &cmd, &txn);
         /* A servo that does not answer the first exchange (after the bus's retries) is
@@ -195,7 +196,7 @@ int cli_joint_acquire(cli_bus_t *b, j288_joint_t *j, const char *name, j288_txn_
         return cli_signal_exit_code();
     }
     if (*replies == 0u || rc == J288_ERR_OFFLINE || (report_unknown && rc != J288_OK)) {
-        cli_report_txn_failure(b, j->cfg.id, rc);
+        cli_report_txn_failure(b, j288_joint_config(j)->id, rc);
     } else if (report_unknown) {
         char why[400];
         cli_joint_why_unknown(j, name, *replies, why, sizeof why);
@@ -227,7 +228,7 @@ int cli_joint_start_inside(const j288_joint_t *j, const char *name, double q, do
     double lo, hi, out;
     joint_range(&j->cfg, &lo, &hi);
     out = q < lo ? lo - q : (q > hi ? q - hi : 0.0);
-    if (j->cfg.clamp || out == 0.0) {
+    if (j288_joint_config(j)->clamp || out == 0.0) {
         *q_start = q;
         return 0;
     }
@@ -251,10 +252,10 @@ void cli_joint_target_error(const j288_joint_t *j, const char *name, const char 
                   lo, hi);
     } else if (rc == J288_ERR_LIMIT_SPEED) {
         cli_error("%s: %s %g: %s (%g rad/s); nothing sent", name, what, value,
-                  j288_strerror(rc), (double)j->cfg.max_speed);
+                  j288_strerror(rc), (double)j288_joint_config(j)->max_speed);
     } else if (rc == J288_ERR_LIMIT_TORQUE) {
         cli_error("%s: %s %g: %s (%g N*m); nothing sent", name, what, value, j288_strerror(rc),
-                  (double)j->cfg.max_torque);
+                  (double)j288_joint_config(j)->max_torque);
     } else {
         cli_error("%s: %s %g: %s", name, what, value, j288_strerror(rc));
     }

@@ -660,7 +660,8 @@ static void joint_setpoint(const drive_args_t *d, const drive_plan_t *p, double 
         }
     } else if (d->kind == DRIVE_TORQUE) {
         /* No stiffness: the position only has to pass the limit check. */
-        double lo = (double)d->j.cfg.pos_min, hi = (double)d->j.cfg.pos_max, q = (double)st->pos;
+        const j288_joint_config_t *jc = j288_joint_config(&d->j);
+        double lo = (double)jc->pos_min, hi = (double)jc->pos_max, q = (double)st->pos;
         if (lo == 0.0 && hi == 0.0) {
             lo = -J288_PI;
             hi = J288_PI;

@@ -212,7 +212,8 @@ typedef struct {
 static int cal_window(const joint_args_t *a, const j288_joint_t *j, double q, cal_path_t *p,
                       const char *name)
 {
-    double lmin = (double)j->cfg.pos_min, lmax = (double)j->cfg.pos_max, q0;
+    const j288_joint_config_t *cfg = j288_joint_config(j);
+    double lmin = (double)cfg->pos_min, lmax = (double)cfg->pos_max, q0;
     if (lmin == 0.0 && lmax == 0.0) {
         lmin = -J288_PI;
         lmax = J288_PI;
@@ -236,7 +237,7 @@ static int cal_window(const joint_args_t *a, const j288_joint_t *j, double q, ca
     if (p->lo < lmin) {
         cli_error("%s: no room for a %g rad motion inside the limits [%g, %g] (give a smaller "
                   "--range)",
-                  name, a->range, (double)j->cfg.pos_min, (double)j->cfg.pos_max);
+                  name, a->range, (double)cfg->pos_min, (double)cfg->pos_max);
         return -1;
     }
     return 0;
@@ -298,7 +299,7 @@ static int cal_move(cli_bus_t *b, j288_joint_t *j, j288_cal_t *cal, const cal_pa
         }
         rc = cli_bus_transfer(b, &cmd, &txn);
         if (rc == J288_ERR_OFFLINE) {
-            cli_report_txn_failure(b, j->cfg.id, rc);
+            cli_report_txn_failure(b, j288_joint_config(j)->id, rc);
             return CLI_EXIT_FAIL;
         }
         fails = rc == J288_OK ? 0 : fails + 1;
@@ -322,7 +323,7 @@ static int cal_move(cli_bus_t *b, j288_joint_t *j, j288_cal_t *cal, const cal_pa
             next = j288_robot_now_us();
         }
         if (cli_bus_sleep_until(b, next) == J288_ERR_OFFLINE) {
-            cli_report_txn_failure(b, j->cfg.id, J288_ERR_OFFLINE);
+            cli_report_txn_failure(b, j288_joint_config(j)->id, J288_ERR_OFFLINE);
             return CLI_EXIT_FAIL;
         }
     }

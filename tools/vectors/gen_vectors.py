@@ -566,8 +566,8 @@ def si_command_vectors():
 
 
 # ---------------------------------------------------------------------------------------------
-# The fixed-point joint layer (j288/jointq.h): output-side commands from Q16 (torque, speed,
-# gains) and Q24 (position) integers, and a reply's speed, torque and OutPos in Q16 / Q24.
+# The joint core (j288/jointq.h): output-side commands from Q16 (torque, speed, gains) and
+# Q24 (position, an int64) integers, and a reply's speed, torque and OutPos in Q16 / Q24.
 
 Q16 = 1 << 16
 Q24 = 1 << 24
@@ -575,12 +575,17 @@ FIXED_SCALE = {"torque": Q16, "speed": Q16, "pos": Q24, "kp": Q16, "kd": Q16}
 # Factors that contain pi: the fixed path rounds them to within 2^-15 LSB of the exact value,
 # so a vector whose exact value lies closer than this to a half is left out.
 FIXED_PI_MARGIN = Fraction(1, 10**4)
+# The position's reach: |pos| < 2^32 in Q24 (256 rad); beyond, J288_ERR_RANGE_POS (the header
+# says so; the wire itself would reach 1428 rad).
+FIXED_POS_REACH = 1 << 32
 
 
 def fixed_to_raw(q, v):
     """(expect, raw) for one Q integer, exactly (output side)."""
     if q in GAINS and v < 0:
         return "J288_ERR_NEG_GAIN", 0
+    if q == "pos" and abs(v) >= FIXED_POS_REACH:
+        return RANGE_ERR[q], 0
     x = Fraction(v, FIXED_SCALE[q]) * lsb_per_unit(q, "output")
     lo, hi = RANGE[q]
     r = round_half_away(x)
@@ -635,6 +640,12 @@ def fixed_command_vectors():
     add("neg_kd", 0, 0, 0, 0, -1)
     add("pos_extremes", 0, 0, (1 << 31) - 1, 0, 0)
     add("pos_min", 0, 0, -(1 << 31), 0, 0)
+    add("pos_128rad", 0, 0, 1 << 31, 0, 0)          # beyond the int32 Q24 of before
+    add("pos_reach", 0, 0, (1 << 32) - 1, 0, 0)      # 256 rad less one step: in reach
+    add("pos_beyond_reach", 0, 0, 1 << 32, 0, 0)     # 256 rad: J288_ERR_RANGE_POS
+    add("pos_beyond_reach_neg", 0, 0, -(1 << 32), 0, 0)
+    add("pos_far", 0, 0, 1 << 40, 0, 0)
+    add("pos_far_kp_bad", 0, 0, -(1 << 40), -1, 0)   # the position's error comes first
     add("all_out", -(1 << 31), (1 << 31) - 1, -(1 << 31), (1 << 31) - 1, (1 << 31) - 1)
     add("all_out_neg_gains", (1 << 31) - 1, -(1 << 31), 0, -(1 << 31), -5)
     # The inputs closest to a half without being one, both sides, for the rational factors
@@ -827,11 +838,12 @@ def render(outdir):
 
     fxc = fixed_command_vectors()
     fxr = fixed_reply_vectors()
-    lines = ["# j288 fixed-point joint layer conversions (j288/jointq.h); " + HEADER_NOTE,
+    lines = ["# j288 joint core conversions (j288/jointq.h); " + HEADER_NOTE,
              "# Lines starting with cmd: cmd name tau speed pos kp kd expect raw_tau raw_speed",
              "#   raw_pos raw_kp raw_kd clamp_mask c_tau c_speed c_pos c_kp c_kd",
              "#   Output side. Inputs are integers: tau, speed, kp, kd in Q16 (value * 2^16),",
-             "#   pos in Q24 (rad * 2^24). expect: ok or the first failing field's error in",
+             "#   pos in Q24 (rad * 2^24, beyond 2^32 out of reach). expect: ok or the first",
+             "#   failing field's error in",
              "#   frame order; raw_*: the rounded fields (0 on error); c_*: the saturating",
              "#   variant, clamp_mask bits tau=1 speed=2 pos=4 kp=8 kd=16. Speed and position",
              "#   vectors whose exact value lies within 1e-4 LSB of a half are left out (their",
@@ -943,7 +955,7 @@ def render_header(cmds, replies, sis, froms, sicmds, fxc, fxr):
          ""]
     h += ["typedef struct {",
           "    const char *name;",
-          "    int32_t q[5];      /* tau, speed, kp, kd in Q16; pos in Q24 */",
+          "    int64_t q[5];      /* tau, speed, kp, kd in Q16; pos in Q24 */",
           "    int expect;        /* j288_cmd_from_q() result */",
           "    int32_t raw[5];    /* tau, speed, pos, kp, kd when expect is J288_OK */",
           "    unsigned clamp_mask;",

@@ -25,14 +25,10 @@
 #define J288_CONFIG_SI 1
 #endif
 
-/* 1: compile the fixed-point joint layer (j288/jointq.h: j288_jointq_*, j288_cmd_from_q), integers
- * only, with or without J288_CONFIG_SI: the joint layer for cores without an FPU. 0: leave it
- * out. Its functions are separate from the floating-point j288_joint_*: an application picks
- * one by what it calls (and --gc-sections drops the other); an FPU-less build sets
- * J288_CONFIG_SI=0 as well, so that no floating point is compiled at all. */
-#ifndef J288_CONFIG_JOINT_FIXED
-#define J288_CONFIG_JOINT_FIXED 1
-#endif
+/* The joint core (j288/jointq.h) is always compiled: it is the one joint state machine, in
+ * integers, which the float API of j288/joint.h runs under J288_CONFIG_SI. An FPU-less
+ * firmware sets J288_CONFIG_SI=0 and calls j288_jointq_*: no floating point at all.
+ * (J288_CONFIG_JOINT_FIXED, which chose it before, has no effect any more.) */
 
 /* [layout] j288_real_t is double by default: a double holds every int32 position exactly, so
  * raw -> SI -> raw round trips are exact. Set 1 on a single-precision FPU (Cortex-M4F/M33)

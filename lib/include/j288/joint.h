@@ -1,72 +1,40 @@
 /*
- * j288/joint.h - the joint frame: an absolute joint angle from the first replies after
- * power-up, soft limits, and rotor-frame commands from joint-frame targets.
+ * j288/joint.h - the joint frame in SI units: a float facade over the joint core.
  *
- * The physics (docs/joint.md has the long form). The rotor turns N = J288_GEAR_RATIO times
- * per output turn: r = N * theta + c, with theta the output angle and c a rotor phase fixed
- * at assembly. The reply's rotor position is p = r - 2 pi k: the rotor encoder is absolute
- * over one turn only, so k (the turn count) is lost at every power-up, and p / N alone means
- * nothing after a power cycle. The 13-bit output encoder (OutPos) gives theta modulo 2 pi in
- * steps of 2 pi / 8192 (0.77 mrad) and survives power cycles. A joint combines the two:
+ * What a joint does is j288/jointq.h's, which has the model and the rules: the start from the
+ * first replies after power-up (uncalibrated to half an OutPos count, calibrated with the
+ * rotor's resolution), the turn choice, the tracking check, soft limits in every mode (the
+ * limit law), continuous joints, the events, the binding and its lock rules. The functions
+ * here convert at their edge and run the core: j288_joint_take_reply() runs
+ * j288_jointq_take_reply() and converts the state; j288_joint_command() converts the target
+ * and runs j288_jointq_command(). So a host, Python and a microcontroller run one state
+ * machine: for the same configuration, replies and targets (converted as below) the commands
+ * are the same, bit for bit, and the state is the core's, converted.
  *
- * - Start (both modes): init_samples replies (default 8) are averaged into the output angle
- *   at an anchor rotor position (each reply contributes OutPos minus the rotor's motion since
- *   the first, so motion during the start does not matter). An OutPos count covers
- *   [n, n + 1) * 2 pi / 8192; the centre of the count is used. Replies that disagree with the
- *   first by more than track_tol restart the collection.
- * - Turn choice: the output angle is labelled theta_abs = theta_out + 2 pi m with the m that
- *   puts the joint angle q = direction * (theta_abs - zero) within pi of the middle of
- *   [pos_min, pos_max]: inside the range when the joint is, else nearest to it (and a limit
- *   event). A range across the encoder's wrap is thus labelled continuously.
- * - Uncalibrated (no phase): from then on q follows the rotor, q = q0 + direction * (p - p0) / N.
- *   Absolute to within half an OutPos count (0.38 mrad) plus the gear's backlash at the
- *   start; it never drifts, and has the rotor's resolution (0.66 urad) relative to the start.
- * - Calibrated (phase = c, fitted by j288_cal_*): the turn count k is the integer that makes
- *   p + 2 pi k closest to N * theta_abs + c, and theta = (p + 2 pi k - c) / N: absolute with the
- *   rotor's resolution, the same after every power cycle. The residual
- *   eps = N * theta_abs + c - (p + 2 pi k), in [-pi, pi] rotor rad, says whether c still holds:
- *   beyond cal_tol the start fails with J288_JOINT_EV_CAL_MISMATCH and the joint stays
- *   unknown (it retries with the next replies). c belongs with the turn labelling above: it
- *   stays valid when zero or the range change as long as the poses it was fitted at stay
- *   within pi of the range's middle; a label one turn off moves eps by 2 pi * 0.35 rad and is
- *   reported as a mismatch, not taken.
- * - Tracking: every reply compares the rotor-derived angle with the output encoder; the
- *   difference (the residual, wrapped to [-pi, pi]) beyond track_tol (a power cycle of the
- *   servo, a slipped gear, a wrong calibration) makes the angle unknown again
- *   (J288_JOINT_EV_ANGLE_LOST) and the start begins anew. So on every reply with a working
- *   encoder the angle agrees with it to within track_tol. Fault bit 12 (output encoder) means
- *   the encoder is not used: no start from it and no comparison; a joint already known keeps
- *   following the rotor.
+ * The conversions (j288_real_t: double, or float with J288_CONFIG_SI_FLOAT=1):
+ * - real -> core: x * 2^24 (angles) or x * 2^16 (speeds, torques, gains) rounded to the
+ *   nearest integer, halves away from zero. Targets: NaN is refused here
+ *   (J288_ERR_NOT_FINITE, before any other check but NULL); infinities and values beyond the
+ *   core's range saturate at its extreme, which the core then refuses or clamps as any
+ *   value beyond a limit. Configuration: NaN and infinities are J288_ERR_BAD_CONFIG; a
+ *   speed, torque or gain beyond 32768 saturates there (beyond the wire's range anyway).
+ *   So a limit or tolerance of J288_PI is J288_JOINTQ_PI, 28 nrad above pi, and a target
+ *   within 30 nrad (half a Q24 step) of a limit is judged as its rounding. A float's pi
+ *   (and 2 pi) lies above pi by 87 nrad, 1.5 steps: as a tolerance (or phase) it is beyond
+ *   the bound and refused; the default range is [-pi, pi] as j288_real_t holds pi, so that
+ *   a target of pi is inside it with float too.
+ * - core -> real: exact in double for angles below 2^29 rad (a wheel at 30 rad/s for 200
+ *   days; beyond, double rounds to 53 bits); in float, angles keep 24 significant bits: 60
+ *   nrad below 1 rad, 0.5 urad at 8 rad, 8 urad at 128 rad, 0.25 rad at 2.6e6 rad (a wheel
+ *   at 30 rad/s for a day). A continuous joint's angle stays exact in the core however far it
+ *   turns; with float, read it with j288_jointq_state() (j288_joint_core()) and give
+ *   positions as j288_q24_t, or steer it by speed.
  *
- * The joint frame: q = direction * (theta_abs - zero); speed = direction * rotor speed / N;
- * torque = direction * N * rotor torque; stiffness and damping = rotor gains * N^2. An all-zero
- * configuration (but the id) gives the output encoder angle wrapped to [-pi, pi), direction
- * +1, no speed or torque limit, targets outside [-pi, pi] refused.
- *
- * Safety. While the angle is unknown every target is refused (J288_ERR_ANGLE_UNKNOWN, or
- * J288_ERR_CAL_MISMATCH after a failed calibrated start) and the binding below keeps lock on
- * the joint's slot; when the angle is lost, the slot's next command becomes lock from inside
- * the scheduler's on_reply hook, before anything else is sent. The one command that drew the
- * first reply after a power cycle was made in the old frame: the servo may act on it for
- * one sweep before lock arrives. A target outside [pos_min, pos_max], or beyond max_speed or
- * max_torque, is refused with J288_ERR_LIMIT_POS / _SPEED / _TORQUE and nothing is produced,
- * unless the joint is configured to clamp: then it is saturated and the call reports which
- * fields it changed. Refusing is the default because a target outside the limits is a bug
- * in the controller that clamping would hide. Limits bound the targets; the servo's own
- * control law acts on the error between target and state, and the limit events report the
- * joint's measured angle leaving the range.
- *
- * Precision with float (J288_CONFIG_SI_FLOAT=1): positions are kept as an integer rotor
- * anchor plus a small joint-frame angle, so p / N is never formed from a large p; angles
- * within J288_JOINT_MAX_ANGLE keep about 1 urad in float. Angles in the configuration must lie
- * within J288_JOINT_MAX_ANGLE.
- *
- * Objects are caller-allocated; nothing is allocated, no global state. Calling context:
- * every function on a joint, a binding or a calibration is for one context at a time. With
- * a binding, that is the context that advances the bus: the thread that polls, or with
+ * Objects are caller-allocated; nothing is allocated, no global state. Calling context: every
+ * function on a joint, a binding or a calibration is for one context at a time. With a
+ * binding, that is the context that advances the bus: the thread that polls, or with
  * advance_in_isr the bus's interrupt (e.g. set targets from the scheduler's on_sweep). The
- * functions take no lock. Compiled only with J288_CONFIG_SI (but the event kinds, which the
- * fixed-point layer of j288/jointq.h shares).
+ * functions take no lock. Compiled only with J288_CONFIG_SI.
  */
 #ifndef J288_JOINT_H
 #define J288_JOINT_H
@@ -76,28 +44,9 @@
 
 #include "j288/config.h"
 #include "j288/frame.h"
+#include "j288/jointq.h"
 #include "j288/sched.h"
 #include "j288/units.h"
-
-/* Events, reported by j288_joint_take_reply() (and j288_jointq_take_reply(), j288/jointq.h)
- * as bits (1u << kind), in this order. Outside J288_CONFIG_SI: the fixed-point layer has them
- * too. */
-typedef enum {
-    J288_JOINT_EV_ENCODER_FAULT = 0, /* fault bit 12 set: the output encoder is not used */
-    J288_JOINT_EV_ENCODER_OK,        /* fault bit 12 cleared */
-    J288_JOINT_EV_ANGLE_UNKNOWN,     /* first reply since init/reset: the angle is not yet known */
-    J288_JOINT_EV_ANGLE_LOST,        /* rotor and encoder disagree (value: the residual, rad):
-                                        unknown again, lock, the start begins anew */
-    J288_JOINT_EV_CAL_MISMATCH,      /* a calibrated start failed (value: eps, rotor rad);
-                                        reported once until a start succeeds */
-    J288_JOINT_EV_ANGLE_KNOWN,       /* the start is done (value: the joint angle) */
-    J288_JOINT_EV_LIMIT_REACHED,     /* the angle went outside [pos_min, pos_max] (value: it) */
-    J288_JOINT_EV_LIMIT_LEFT         /* back inside by J288_JOINT_LIMIT_HYST (value: it) */
-} j288_joint_event_kind_t;
-
-#define J288_JOINT_EV_BIT(kind) (1u << (unsigned)(kind))
-#define J288_JOINT_EV_COUNT 8u
-#define J288_JOINT_DEFAULT_INIT_SAMPLES 8u /* replies averaged at the start */
 
 #if J288_CONFIG_SI
 
@@ -109,27 +58,31 @@ extern "C" {
 #define J288_JOINT_DEFAULT_CAL_TOL 1.0     /* rad of rotor: 3.5 mrad of output */
 #define J288_JOINT_LIMIT_HYST 0.001        /* rad: inside the range by this to leave a limit */
 #define J288_JOINT_MAX_ANGLE 64.0          /* rad: bound of zero, pos_min, pos_max */
+#define J288_JOINT_HOLD_BEYOND 0.05        /* rad: J288_JOINTQ_HOLD_BEYOND */
 
-/* All-zero (but id) means the defaults described above. Checked by j288_joint_init(). */
+/* As j288_jointq_config_t, in SI units; all-zero (but id) means the same defaults.
+ * Checked by j288_joint_init(). */
 typedef struct {
     uint8_t id;             /* servo id, 0-14 */
     int8_t direction;       /* +1 or -1 (0: +1): the joint's sense against the output's */
     bool clamp;             /* true: saturate targets at the limits instead of refusing */
     bool has_phase;         /* phase holds a calibrated c: the calibrated mode */
+    bool continuous;        /* no position limits, the angle unbounded (a wheel); pos_min and
+                               pos_max must be 0 */
     uint8_t init_samples;   /* replies averaged at the start, 1-255; 0: 8 */
     j288_real_t zero;       /* rad, output-encoder frame: the output angle of joint angle 0 */
     j288_real_t pos_min;    /* rad, joint frame; pos_min = pos_max = 0: [-pi, pi] */
     j288_real_t pos_max;    /*   else pos_min < pos_max, both within J288_JOINT_MAX_ANGLE */
     j288_real_t max_speed;  /* rad/s, joint frame, >= 0; 0: only the wire's range */
     j288_real_t max_torque; /* N*m, joint frame, >= 0; 0: only the wire's range */
-    j288_real_t kp;         /* default stiffness, N*m/rad, joint frame, >= 0 */
-    j288_real_t kd;         /* default damping, N*m*s/rad, joint frame, >= 0 */
-    j288_real_t phase;      /* c, rotor rad, |c| <= 2 pi (see above); used when has_phase */
-    j288_real_t track_tol;  /* rad of output, >= 0; 0: J288_JOINT_DEFAULT_TRACK_TOL */
+    j288_real_t kp;         /* default stiffness (hold), N*m/rad, joint frame, >= 0 */
+    j288_real_t kd;         /* default damping (hold, the limit law), N*m*s/rad, >= 0 */
+    j288_real_t phase;      /* c, rotor rad, |c| <= 2 pi; used when has_phase */
+    j288_real_t track_tol;  /* rad of output, 0 to pi; 0: J288_JOINT_DEFAULT_TRACK_TOL */
     j288_real_t cal_tol;    /* rad of rotor, 0 to pi; 0: J288_JOINT_DEFAULT_CAL_TOL */
 } j288_joint_config_t;
 
-/* A joint's view of its latest reply (j288_joint_state()). */
+/* As j288_jointq_state_t, in SI units (converted from the core's after every reply). */
 typedef struct {
     bool known;            /* pos is the absolute joint angle */
     bool calibrated;       /* known through the phase, with the rotor's resolution */
@@ -146,9 +99,9 @@ typedef struct {
     j288_real_t cal_residual; /* rotor rad: eps of the latest calibrated start (0 before) */
 } j288_joint_state_t;
 
-/* Joint-frame targets. j288_joint_target_init() fills a hold-here target. */
+/* As j288_jointq_target_t; j288_joint_target_init() fills a hold target. */
 typedef struct {
-    j288_real_t pos;    /* rad, joint frame, within [pos_min, pos_max] */
+    j288_real_t pos;    /* rad, joint frame (used and checked only when kp > 0) */
     j288_real_t speed;  /* rad/s, joint frame */
     j288_real_t torque; /* N*m, joint frame, feed-forward */
     j288_real_t kp;     /* N*m/rad, joint frame, >= 0 */
@@ -156,69 +109,54 @@ typedef struct {
 } j288_joint_target_t;
 
 typedef struct {
-    /* Private: read with j288_joint_state(). */
-    j288_joint_config_t cfg;   /* defaults filled in, direction +-1 */
-    j288_real_t dir;           /* cfg.direction as a real */
-    j288_real_t centre;        /* middle of [pos_min, pos_max] */
-    j288_real_t k_q;           /* joint rad per rotor LSB (direction included) */
-    j288_real_t k_speed;       /* joint rad/s per rotor speed LSB (direction included) */
-    j288_real_t k_torque;      /* joint N*m per rotor torque LSB (direction included) */
-    int32_t ref_pos;           /* rotor LSB at the anchor */
-    j288_real_t ref_q;         /* joint angle at the anchor */
-    int32_t init_pos;          /* rotor LSB of the start's first sample */
-    j288_real_t init_e0;       /* its output angle */
-    j288_real_t init_sum;      /* sum of the later samples' differences to it */
-    uint8_t init_n;            /* samples collected */
-    bool seen;                 /* a reply came since init/reset */
-    j288_joint_state_t st;
+    /* Private: read with j288_joint_state(), j288_joint_config() and j288_joint_core(). */
+    j288_jointq_t core;      /* the joint */
+    j288_joint_config_t cfg; /* as given, defaults filled in */
+    j288_joint_state_t st;   /* the core's state, converted */
 } j288_joint_t;
 
-/* Check cfg and set the joint up (angle unknown). Errors (joint untouched): J288_ERR_NULL,
+/* Convert cfg and set the joint up (angle unknown). Errors (joint untouched): J288_ERR_NULL,
  * J288_ERR_BAD_ID (id > 14), J288_ERR_BAD_CONFIG (direction not -1/0/1, a value not finite
- * or outside its documented range, pos_min >= pos_max). */
+ * or outside its documented range, pos_min >= pos_max, limits on a continuous joint). */
 int j288_joint_init(j288_joint_t *j, const j288_joint_config_t *cfg);
 
-/* Forget the angle: the next replies start anew (e.g. the application knows the servo was
- * power-cycled). NULL is ignored. */
+/* As j288_jointq_reset(). */
 void j288_joint_reset(j288_joint_t *j);
 
-/* Take one reply of this joint's servo: update the state, run the start, the tracking
- * check and the limit check, and OR the events (J288_JOINT_EV_BIT) into *events (may be
- * NULL; set to 0 first). Errors (joint untouched): J288_ERR_NULL, J288_ERR_WRONG_ID (the
- * reply is from another id). The reply is only read during the call (not kept); no field of
- * it is trusted beyond its type's range (OutPos is taken modulo 8192). */
+/* The configuration as given, with the defaults filled in (pos_min = pos_max = 0 become
+ * -+J288_PI, direction 0 becomes 1, tolerances 0 their defaults ...); the core uses these
+ * values rounded to Q24 / Q16. NULL for NULL. Valid as long as j. */
+const j288_joint_config_t *j288_joint_config(const j288_joint_t *j);
+
+/* The joint core inside j, for its integer API (j288_jointq_state() ...: a continuous
+ * joint's exact angle). NULL for NULL. */
+const j288_jointq_t *j288_joint_core(const j288_joint_t *j);
+
+/* As j288_jointq_take_reply(), and the state converted. */
 int j288_joint_take_reply(j288_joint_t *j, const j288_reply_raw_t *reply, unsigned *events);
 
 /* The state after the latest reply (all zero before one), or NULL for NULL. Valid as long as
- * the joint; changed by the next j288_joint_take_reply(). */
+ * the joint; changed by the next j288_joint_take_reply() (or the binding's hook). */
 const j288_joint_state_t *j288_joint_state(const j288_joint_t *j);
 
-/* A target that holds the joint where it is (the latest angle, 0 while unknown), at rest,
- * with the joint's default gains. NULL arguments are ignored. */
+/* As j288_jointq_target_init(): hold at rest with the default gains, where the joint is or
+ * at the nearest limit when it is beyond one by at most J288_JOINT_HOLD_BEYOND. */
 void j288_joint_target_init(const j288_joint_t *j, j288_joint_target_t *t);
 
-/*
- * Target -> FOC command in the rotor frame (watchdog bit on). *clamped (may be NULL) gets
- * the J288_FIELD_* bits (units.h) of the fields saturated in clamp mode, 0 otherwise.
- * Errors (cmd untouched, nothing produced): J288_ERR_NULL; J288_ERR_ANGLE_UNKNOWN, or
- * J288_ERR_CAL_MISMATCH when the latest calibrated start failed; J288_ERR_NOT_FINITE (NaN);
- * J288_ERR_LIMIT_POS / _SPEED / _TORQUE (refuse mode); then as j288_cmd_from_si() on the
- * output side (J288_ERR_NEG_GAIN, J288_ERR_RANGE_*; clamp mode saturates those as
- * j288_cmd_from_si_clamped() does); J288_ERR_RANGE_POS also when the rotor target would
- * leave the int32 wire range (never clamped: that would be a different place).
- */
+/* As j288_jointq_command() for the target converted: J288_ERR_NULL, J288_ERR_NOT_FINITE (a
+ * NaN anywhere in the target), then j288_jointq_command()'s errors in its order. *clamped as
+ * there (J288_FIELD_* bits, J288_JOINT_LIMITED). */
 int j288_joint_command(const j288_joint_t *j, const j288_joint_target_t *t, j288_cmd_raw_t *cmd,
                        unsigned *clamped);
 
 /* The lock command for this joint (no torque; watchdog bit on). Errors: J288_ERR_NULL. */
 int j288_joint_lock_command(const j288_joint_t *j, j288_cmd_raw_t *cmd);
 
-/* Zero at the current pose: the zero (output-encoder frame) that makes the latest angle
- * joint angle 0, for the configuration file; j288_joint_init() with it to use it. Errors:
- * J288_ERR_NULL, J288_ERR_ANGLE_UNKNOWN. */
+/* As j288_jointq_zero_here(), in rad: J288_ERR_NULL, J288_ERR_ANGLE_UNKNOWN, J288_ERR_RANGE
+ * (the zero beyond +-J288_JOINT_MAX_ANGLE). */
 int j288_joint_zero_here(const j288_joint_t *j, j288_real_t *zero);
 
-/* ---- binding: the joints of one scheduler (one bus); a robot has one binding per bus. */
+/* ---- binding: as j288_jointq_bus_t (j288/jointq.h), for these joints. */
 
 typedef struct {
     j288_joint_event_kind_t kind;
@@ -233,8 +171,8 @@ typedef void (*j288_joint_event_fn)(void *user, const j288_joint_event_t *ev);
 
 typedef struct {
     /* Private. */
-    j288_sched_t *sched;
-    j288_joint_t *joint[J288_MAX_SERVOS];
+    j288_jointq_bus_t core;
+    j288_joint_t *joint[J288_MAX_SERVOS]; /* the facade joints whose cores are bound */
     j288_joint_event_fn on_event;
     void *user;
 } j288_joint_bus_t;
@@ -249,40 +187,40 @@ typedef struct {
 int j288_joint_bus_init(j288_joint_bus_t *jb, j288_sched_t *sched, j288_joint_event_fn on_event,
                         void *user);
 
-/* Add joint j (initialised) under its id and set its slot's command to lock. Enabling the
- * slot is the application's (j288_sched_enable()). The binding keeps the pointer: j must
- * stay valid and in place as long as the binding is in use (there is no remove). Errors:
- * J288_ERR_NULL, J288_ERR_BAD_CONFIG (another joint has that id here). */
+/* As j288_jointq_bus_add(): joint j under its id, its slot at lock. Errors: J288_ERR_NULL,
+ * J288_ERR_BAD_CONFIG (another joint has that id here). */
 int j288_joint_bus_add(j288_joint_bus_t *jb, j288_joint_t *j);
 
-/* The scheduler's reply hook (j288_reply_fn; user: the binding). Feeds the reply to the
- * joint with that id (none: nothing happens), keeps its slot at lock while the angle is
- * unknown (replacing any other command at once, so a loss is answered before the next
- * transaction), then reports the joint's events to on_event in J288_JOINT_EV_* order. */
+/* The scheduler's reply hook: as j288_jointq_bus_on_reply() (the reply taken, the lock while
+ * unknown, a kept target's command made again, the events in J288_JOINT_EV_* order), with
+ * the joint's state converted before the events are reported. */
 void j288_joint_bus_on_reply(void *user, uint8_t id, const j288_slot_t *slot);
 
-/* j288_joint_command() for joint j, then j288_sched_set_cmd() (its next transaction).
- * Errors: those of j288_joint_command(); J288_ERR_BAD_ARG when j is not bound here. */
+/* As j288_jointq_bus_set_target() for the target converted: j288_joint_command()'s errors,
+ * J288_ERR_BAD_ARG when j is not bound here. */
 int j288_joint_bus_set_target(j288_joint_bus_t *jb, const j288_joint_t *j,
                               const j288_joint_target_t *t, unsigned *clamped);
 
-/* Put joint j's slot at lock (no torque). Errors: J288_ERR_NULL, J288_ERR_BAD_ARG. */
+/* Put joint j's slot at lock (no torque), and forget its target. Errors: J288_ERR_NULL,
+ * J288_ERR_BAD_ARG. */
 int j288_joint_bus_lock(j288_joint_bus_t *jb, const j288_joint_t *j);
 
-/* ---- calibration: fit the rotor phase c from (OutPos, rotor position) pairs
+/* ---- calibration: fit the rotor phase c from (OutPos, rotor position) pairs (joint_cal.c)
  *
  * Stream the pairs of a slow motion over a small range (both directions, so that backlash
  * averages out) into j288_cal_add() or j288_cal_add_reply(); nothing is buffered. The fit is
  * the circular mean of p_i - N * theta_i over the pairs, with theta_i (count centres) continued
- * across the encoder's wrap and labelled as the joint labels its start (so the c it gives
- * belongs to that joint configuration's turn labelling). Residuals are unwrapped around the
- * running mean, which equals the circular mean while they stay well within pi of it, as a
- * usable fit's do (the quality check says when they do not). Expected accuracy: each pair's
+ * across the encoder's wrap and labelled by the core's turn choice (so the c it gives belongs
+ * to that joint configuration's turn labelling). Residuals are unwrapped around the running
+ * mean, which equals the circular mean while they stay well within pi of it, as a usable
+ * fit's do (the quality check says when they do not). Expected accuracy: each pair's
  * residual carries up to +-0.11 rotor rad of OutPos quantization (half a count times N) and
  * N * backlash / 2; the mean over a motion that covers many counts evenly cancels the
  * quantization to about 0.22 rad / span_counts, so c comes within about 0.02 rotor rad
  * (70 urad of output) for a 16-count span without backlash. Backlash is averaged only as
- * evenly as the motion loads each side of the teeth. docs/joint.md has the measurements.
+ * evenly as the motion loads each side of the teeth. docs/joint.md has the measurements. The
+ * fit runs in j288_real_t (on a host, as `j288 calibrate` does); a firmware configures the
+ * phase it gives as J288_Q24(c).
  */
 
 #define J288_CAL_MIN_SAMPLES 100u  /* fewer pairs: J288_CAL_FEW_SAMPLES */
@@ -308,9 +246,8 @@ typedef struct {
 
 typedef struct {
     /* Private. */
-    j288_real_t zero;      /* the labelling: as the joint's */
-    j288_real_t dir;
-    j288_real_t centre;
+    j288_jointq_config_t label; /* the joint's configuration (core units): its turn choice */
+    j288_q24_t centre;
     j288_real_t cal_tol;
     uint32_t n;
     uint32_t rejected;
