@@ -3,8 +3,10 @@
 #   test/linux/test_robot.c   several j288-sim buses from one loop (HOST_TESTS)
 #   test/e2e/cli_robot.sh     j288 --config FILE log|status|hold|stop (TEST_SCRIPTS)
 #   test/e2e/host_stack.sh    a second session after a stop, every front end (TEST_SCRIPTS)
-# (the runner, and its one OS-specific call, the wait over every bus: host/j288_host_wait.c)
-ROBOT_OBJ := $(OBJ)/host/j288_robot.o $(OBJ)/host/j288_host_wait.o
+# (the runner, and its one OS-specific call, the wait over every bus: host/j288_host_wait.c;
+# the loop's real time and timing: host/j288_rt.c, its OS part host/j288_rt_linux.c)
+ROBOT_OBJ := $(OBJ)/host/j288_robot.o $(OBJ)/host/j288_host_wait.o $(OBJ)/host/j288_rt.o \
+    $(OBJ)/host/j288_rt_linux.o
 
 ROBOT_TEST := $(BUILD)/test/test_robot
 $(ROBOT_TEST): $(OBJ)/test/linux/test_robot.o $(SIM_PROCESS_OBJ) $(ROBOT_OBJ) $(CONFIG_OBJ) $(UNITY_OBJ) $(LINUX_A) $(LIB_A) \
@@ -12,6 +14,13 @@ $(ROBOT_TEST): $(OBJ)/test/linux/test_robot.o $(SIM_PROCESS_OBJ) $(ROBOT_OBJ) $(
 	$(LINK)
 
 HOST_TESTS += $(ROBOT_TEST)
+
+# The real-time module alone: histograms, the pacing rule, the set-up through its seam.
+RT_TEST := $(BUILD)/test/test_rt
+$(RT_TEST): $(OBJ)/test/linux/test_rt.o $(OBJ)/host/j288_rt.o $(OBJ)/host/j288_rt_linux.o \
+    $(UNITY_OBJ) $(LIB_A)
+	$(LINK)
+HOST_TESTS += $(RT_TEST)
 TEST_DEPS += $(SIM_BIN)
 
 # The j288 tool's bus commands use the runner (cli_bus.h includes it) and the config reader.

@@ -28,7 +28,7 @@ $(OBJ)/test/cli/test_cli_joint.o: $(YAML_ENV)
 
 $(CLI_JOINT_TEST): $(OBJ)/test/cli/test_cli_joint.o $(CLI_CAPTURE_OBJ) \
     $(addprefix $(OBJ)/tools/j288/,cli_joint.o cli_bus.o args.o json.o report.o) \
-    $(OBJ)/host/j288_robot.o $(OBJ)/host/j288_host_wait.o $(CONFIG_OBJ) \
+    $(ROBOT_OBJ) $(CONFIG_OBJ) \
     $(UNITY_OBJ) $(LINUX_A) $(LIB_A) $(YAML_ENV)
 	$(LINK)
 HOST_TESTS += $(CLI_JOINT_TEST)
