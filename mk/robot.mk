@@ -9,7 +9,8 @@ ROBOT_OBJ := $(OBJ)/host/j288_robot.o $(OBJ)/host/j288_host_wait.o $(OBJ)/host/j
     $(OBJ)/host/j288_rt_linux.o
 
 ROBOT_TEST := $(BUILD)/test/test_robot
-$(ROBOT_TEST): $(OBJ)/test/linux/test_robot.o $(SIM_PROCESS_OBJ) $(ROBOT_OBJ) $(CONFIG_OBJ) $(UNITY_OBJ) $(LINUX_A) $(LIB_A) \
+# (alloc_count.o: malloc and its family replaced by counting ones, for the cycle's promise of none)
+$(ROBOT_TEST): $(OBJ)/test/linux/test_robot.o $(OBJ)/test/linux/alloc_count.o $(SIM_PROCESS_OBJ) $(ROBOT_OBJ) $(CONFIG_OBJ) $(UNITY_OBJ) $(LINUX_A) $(LIB_A) \
     $(YAML_ENV)
 	$(LINK)
 

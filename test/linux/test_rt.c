@@ -11,8 +11,12 @@
 #include "unity.h"
 
 #include <errno.h>
+#include <grp.h>
 #include <sched.h>
 #include <string.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include "j288/error.h"
 #include "j288_rt.h"
@@ -343,6 +347,45 @@ static void test_nothing_asked_nothing_done(void)
     TEST_ASSERT_EQUAL_INT(-1, g_st.cpu);
 }
 
+/* The real refusal: a child process without the rights (root drops to nobody, which ends
+ * its capabilities; everyone lowers RLIMIT_RTPRIO and RLIMIT_MEMLOCK to 0) asks for priority
+ * 80: the kernel says EPERM, set-up says how to allow it and returns J288_OK, and the child
+ * runs on under its old scheduling. Its exit status names the first check that failed. */
+static int refused_child(void)
+{
+    struct rlimit none = {0, 0};
+    j288_rt_options_t o = {80, -1};
+    static j288_rt_status_t st;
+    if (geteuid() == 0 && (setgroups(0, NULL) != 0 || setgid(65534) != 0 || setuid(65534) != 0))
+        return 10;
+    if (setrlimit(RLIMIT_RTPRIO, &none) != 0 || setrlimit(RLIMIT_MEMLOCK, &none) != 0)
+        return 11;
+    if (j288_rt_setup(&o, &st) != J288_OK)
+        return 12;
+    if (!st.refused || st.priority != 0 || sched_getscheduler(0) != SCHED_OTHER)
+        return 13;
+    if (strstr(st.notice, "SCHED_FIFO priority 80 refused (Operation not permitted)") == NULL ||
+        strstr(st.notice, "ulimit -r 80") == NULL || strstr(st.notice, "CAP_SYS_NICE") == NULL)
+        return 14;
+    if (st.memory_locked || strstr(st.notice, "memory not locked") == NULL)
+        return 15;
+    return 0;
+}
+
+static void test_refused_for_real_without_the_rights(void)
+{
+    int status = -1;
+    pid_t pid = fork();
+    TEST_ASSERT_TRUE(pid >= 0);
+    if (pid == 0)
+        _exit(refused_child());
+    TEST_ASSERT_EQUAL_INT(pid, waitpid(pid, &status, 0));
+    TEST_ASSERT_TRUE(WIFEXITED(status));
+    TEST_ASSERT_EQUAL_INT_MESSAGE(0, WEXITSTATUS(status), "the child's check that failed: "
+                                                          "10 drop root, 11 limits, 12 result, "
+                                                          "13 refused, 14 notice, 15 memory");
+}
+
 /* The real clock and sleep: the sleep returns at or after its deadline (an order, not a
  * duration). */
 static void test_sleep_until_an_absolute_time(void)
@@ -368,6 +411,7 @@ int main(void)
     RUN_TEST(test_memory_refused_is_explained);
     RUN_TEST(test_a_cpu_not_allowed_is_refused_before_anything_changes);
     RUN_TEST(test_nothing_asked_nothing_done);
+    RUN_TEST(test_refused_for_real_without_the_rights);
     RUN_TEST(test_sleep_until_an_absolute_time);
     return UNITY_END();
 }
