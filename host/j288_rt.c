@@ -96,9 +96,9 @@ void j288_rt_report(const j288_rt_timing_t *t, const j288_rt_status_t *st, j288_
     summarise(&t->lateness, &out->lateness);
     summarise(&t->duration, &out->duration);
     out->cpu = -1;
-    if (st != NULL) {
-        out->priority = st->priority;
-        out->cpu = st->cpu;
+    if (st != NULL) { /* what is in effect (an all-zero status: nothing) */
+        out->priority = st->sched_changed ? st->priority : 0;
+        out->cpu = st->affinity_changed ? st->cpu : -1;
         out->memory_locked = st->memory_locked ? 1u : 0u;
     }
 }

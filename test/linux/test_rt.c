@@ -178,7 +178,9 @@ static void test_report_and_its_text(void)
     g_t.period_us = 2000;
     memset(&st, 0, sizeof st);
     st.priority = 80;
+    st.sched_changed = true;
     st.cpu = 1;
+    st.affinity_changed = true;
     st.memory_locked = true;
     j288_rt_report(&g_t, &st, &rep);
     TEST_ASSERT_EQUAL_UINT32(1000, rep.cycles);

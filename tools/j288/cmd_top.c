@@ -12,7 +12,7 @@
 
 static const char top_help[] =
     "usage: j288 top (--config FILE | --port DEV [--ids LIST]) [--once] [--rate HZ]\n"
-    "                [--interval S]\n"
+    "                [--interval S] [--realtime[=PRIO]] [--cpu N]\n"
     "\n"
     "A live view: every joint's angle (rad, joint frame), speed (rad/s), torque (N*m), case\n"
     "and winding temperatures, voltage and faults, and each bus's counters, redrawn every\n"
@@ -34,7 +34,7 @@ static const char top_help[] =
     "means.\n"
     "Exit status: 0 quit with q, or one frame printed; 1 no servo answered, a device or\n"
     "config error, every bus gone; 2 bad arguments; 130/143 stopped by SIGINT/SIGTERM.\n"
-    "\n" CLI_BUS_COMMON_HELP;
+    "\n" CLI_BUS_RT_HELP "\n" CLI_BUS_COMMON_HELP;
 
 #define TOP_ACQUIRE_CYCLES 200u /* the most cycles --once waits for every angle */
 #define TOP_SCAN_CYCLES    5u   /* cycles that tell which of --ids answer */
@@ -114,14 +114,30 @@ static void print_notices(FILE *f, const j288_robot_t *r, const char *eol)
     unsigned b;
     if (quiet != NULL && strcmp(quiet, "1") == 0)
         return;
-    for (b = 0; b < j288_robot_nbuses(r); b++) {
+    for (b = 0; b <= j288_robot_nbuses(r); b++) { /* and last, the real-time set-up's */
         const char *n;
-        for (n = j288_robot_notices(r, b); *n != '\0'; n++) {
+        for (n = b < j288_robot_nbuses(r) ? j288_robot_notices(r, b) : j288_robot_rt_notice(r);
+             *n != '\0'; n++) {
             if (*n == '\n')
                 fputs(eol, f);
             else
                 fputc(*n, f);
         }
+    }
+}
+
+/* The loop's timing lines (cli_print_timing()), each ending in eol. */
+static void print_timing(FILE *f, const j288_robot_t *r, const char *eol)
+{
+    j288_rt_report_t rep;
+    char text[640];
+    const char *c;
+    (void)j288_robot_timing(r, &rep);
+    for (c = j288_rt_format(&rep, text, sizeof text); *c != '\0'; c++) {
+        if (*c == '\n')
+            fputs(eol, f);
+        else
+            fputc(*c, f);
     }
 }
 
@@ -197,6 +213,7 @@ static void draw(const j288_robot_t *r, const char *source, bool ansi)
            (unsigned long)rs.last_cycle_us, ansi ? "  q or Ctrl-C quits" : "", eol);
     if (ansi)
         print_notices(stdout, r, eol);
+    print_timing(stdout, r, eol);
     fputs(eol, stdout);
     print_joints(stdout, r, eol);
     fputs(eol, stdout);
@@ -310,6 +327,7 @@ int cli_cmd_top(int argc, char **argv, const cli_global_t *g)
                                      {"--rate", true, OPT_RATE},
                                      {"--interval", true, OPT_INTERVAL},
                                      {"--ids", true, OPT_IDS},
+                                     CLI_BUS_RT_OPTS,
                                      CLI_BUS_COMMON_OPTS,
                                      {NULL, false, 0}};
     static j288_robot_t robot; /* large: not on the stack */
@@ -341,6 +359,7 @@ int cli_cmd_top(int argc, char **argv, const cli_global_t *g)
     ro.margin_us = o.margin_us;
     ro.echo = o.echo;
     ro.retries = (uint8_t)(o.retries > 0 ? o.retries : 0);
+    cli_bus_rt_options(&o, &ro);
     cli_signals_install();
     rc = (o.config != NULL) ? j288_robot_open_file(&robot, o.config, &ro)
                             : open_bus_ids(&robot, &o, &a, &ro);
@@ -348,7 +367,8 @@ int cli_cmd_top(int argc, char **argv, const cli_global_t *g)
         if (rc != J288_ERR_TIMEOUT && rc != J288_ERR_ABORTED)
             cli_error("%s", j288_robot_error(&robot));
         j288_robot_close(&robot);
-        return cli_stop_signal != 0 ? cli_signal_exit_code() : CLI_EXIT_FAIL;
+        return cli_stop_signal != 0 ? cli_signal_exit_code()
+                                    : (rc == J288_ERR_BAD_ARG ? CLI_EXIT_USAGE : CLI_EXIT_FAIL);
     }
     j288_robot_set_stop_flag(&robot, &cli_stop_signal);
     ansi = !a.once && isatty(STDOUT_FILENO);
