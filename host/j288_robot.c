@@ -374,7 +374,8 @@ static int add_joint(j288_robot_t *r, const j288_robot_config_joint_t *cj, unsig
     return J288_OK;
 }
 
-/* The thread's real time (j288_rt.h), last: nothing to undo when an open fails before it. */
+/* The thread's real time (j288_rt.h), before any bus is opened: a CPU it may not run on is
+ * refused with nothing opened (an open that fails later undoes it). */
 static int setup_rt(j288_robot_t *r)
 {
     j288_rt_options_t o;
@@ -414,6 +415,8 @@ int j288_robot_open(j288_robot_t *r, const j288_robot_config_t *cfg,
         return J288_ERR_NULL;
     }
     rc = check_config(r, cfg);
+    if (rc == J288_OK)
+        rc = setup_rt(r);
     if (rc != J288_OK)
         return rc;
     if (cfg->nbuses == 0u) {
@@ -426,9 +429,8 @@ int j288_robot_open(j288_robot_t *r, const j288_robot_config_t *cfg,
     }
     for (i = 0; rc == J288_OK && i < cfg->njoints; i++)
         rc = add_joint(r, &cfg->joint[i], (cfg->nbuses == 0u) ? 0u : (unsigned)cfg->joint[i].bus);
-    if (rc == J288_OK)
-        rc = setup_rt(r);
     if (rc != J288_OK) {
+        j288_rt_restore(&r->rt);
         close_buses(r);
         r->nbuses = 0;
         r->njoints = 0;

@@ -278,12 +278,13 @@ size_t j288_robot_sizeof(void);
 /* The library's version (J288_VERSION_STRING). */
 const char *j288_robot_version(void);
 
-/* Open every bus of cfg (buses in cfg order; a config without buses: opt->port) and set up
- * its joints (every joint's slot enabled, at lock), then the calling thread's real time
- * (opt->realtime, pin_cpu). Errors: J288_ERR_NULL, J288_ERR_BAD_CONFIG (see the top),
- * J288_ERR_BAD_ARG (realtime above 99, a cpu this process may not run on), j288_linux_open()'s
- * codes; the message in j288_robot_error(). r need not be initialised before; after a failure
- * j288_robot_error() stays valid and close is harmless. */
+/* Set up the calling thread's real time (opt->realtime, pin_cpu), then open every bus of cfg
+ * (buses in cfg order; a config without buses: opt->port) and set up its joints (every
+ * joint's slot enabled, at lock). Errors: J288_ERR_NULL, J288_ERR_BAD_CONFIG (see the top),
+ * J288_ERR_BAD_ARG (realtime above 99, a cpu this process may not run on: nothing opened),
+ * j288_linux_open()'s codes; the message in j288_robot_error(). r need not be initialised
+ * before; after a failure (the real-time set-up undone) j288_robot_error() stays valid and
+ * close is harmless. */
 int j288_robot_open(j288_robot_t *r, const j288_robot_config_t *cfg,
                     const j288_robot_options_t *opt);
 

@@ -29,6 +29,8 @@ $(J288_BIN): $(ROBOT_OBJ) $(CONFIG_OBJ)
 # (the archives again after them: the tool's link rule lists its own prerequisites first)
 $(J288_BIN): LDFLAGS_COMMON += $(LINUX_A) $(LIB_A) $(call yaml_var,YAML_LIBS)
 TEST_SCRIPTS += test/e2e/cli_robot.sh
+# --realtime, --cpu and the loop's timing in the tool's reports (test/e2e/cli_realtime.sh)
+TEST_SCRIPTS += test/e2e/cli_realtime.sh
 TEST_DEPS += $(J288_BIN)
 # One host stack: a second session after every form of stop holds a loaded joint (the CLI's
 # forms and Python's; the Python ones use the shared library, which python.mk adds).

@@ -32,13 +32,6 @@ SAG_MAX=0.6
 # where the reply comes.
 MARGIN_US=1000000
 
-logged() { # FILE NEEDLE [FROM_LINE]: wait (bounded, 20 s) until the simulator has logged it
-    for _ in $(seq 1 400); do
-        tail -n +"$((${3:-0} + 1))" "$1" 2>/dev/null | grep -q -- "$2" && return 0
-        sleep 0.05
-    done
-    return 1
-}
 lines() { cat "$1" 2>/dev/null | wc -l; }
 
 # A fresh simulator with one loaded servo (id 1) and a config without gains (the defaults);
