@@ -39,6 +39,13 @@ SIM_PRIO=$((PRIO - 10))
 PERIOD_US=$((1000000 / RATE))
 if [ "${1:-}" = dds-inside ]; then # the bridge's part, re-run in a private network namespace
     . test/dds/lib_dds.sh
+    # root: a network namespace alone (`unshare -n`), so that SCHED_FIFO stays allowed (in the
+    # user namespace of `unshare -rn` it needs RLIMIT_RTPRIO, which root may not be able to
+    # raise); others: lib_dds.sh's `unshare -rn`
+    if ! dds_private_netns && [ "$(id -u)" = 0 ] && [ "${J288_DDS_NETNS:-}" != $$ ] &&
+        unshare -n true 2>/dev/null; then
+        J288_DDS_NETNS=$$ exec unshare -n bash "$0" "$@"
+    fi
     dds_netns "$0" "$@"
 fi
 
@@ -47,10 +54,6 @@ need cyclictest rt-tests
 need stress-ng stress-ng
 need python3 python3
 [ -x "$BIN/j288" ] && [ -x "$BIN/j288-sim" ] || { echo "bench-rt: make all first" >&2; exit 1; }
-# Real-time rights for this run and, through the private network namespace of the dds part
-# (a user namespace: its root has no CAP_SYS_NICE there), for the programs in it.
-ulimit -r 99 2>/dev/null || true
-ulimit -l unlimited 2>/dev/null || true
 FIFO=(chrt -f "$SIM_PRIO")
 chrt -f "$SIM_PRIO" true 2>/dev/null || { FIFO=(); echo "bench-rt: no SCHED_FIFO here (ulimit -r): simulators at normal priority" >&2; }
 
