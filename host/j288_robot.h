@@ -44,6 +44,13 @@
  * set by a SIGINT handler installed without SA_RESTART) becomes non-zero, then return
  * J288_ERR_ABORTED. j288_robot_close() stops first if any target was sent since the last stop.
  *
+ * Pacing and real time (host/j288_rt.h, docs/realtime.md): j288_robot_pace() waits for the
+ * next cycle by absolute deadlines (a missed one skipped, never caught up) and
+ * j288_robot_run() paces with it; the options realtime, pin_cpu and cpu put the opening
+ * thread under SCHED_FIFO with memory locked, on one CPU; j288_robot_timing() reports the
+ * loop's wake-up lateness, cycle durations, misses, skips and cut cycles. A cycle allocates
+ * nothing and does no I/O but the ports' (non-blocking) reads and writes.
+ *
  * Joints: each joint of the config becomes a j288_joint_t (lib/joint.h) bound to its bus's
  * scheduler, in the config's order (joint index 0 .. njoints-1); a joint whose config gives no
  * kp (kd) gets J288_ROBOT_DEFAULT_KP (_KD). A joint's angle is unknown
