@@ -5,6 +5,38 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "j288/error.h"
+#include "j288_rt_os.h"
+
+/* ---- set-up: the arguments here, the rest in the OS's file ---------------------------------- */
+
+void j288_rt_options_init(j288_rt_options_t *o)
+{
+    o->priority = 0;
+    o->cpu = -1;
+}
+
+int j288_rt_setup_with(const j288_rt_options_t *o, const j288_rt_sys_t *sys, j288_rt_status_t *st)
+{
+    if (st == NULL)
+        return J288_ERR_NULL;
+    memset(st, 0, sizeof *st);
+    st->cpu = -1;
+    if (o == NULL)
+        return J288_ERR_NULL;
+    if (o->priority < 0 || o->priority > 99) {
+        (void)snprintf(st->notice, sizeof st->notice,
+                       "real time: priority %d is not 1-99 (0: none)\n", o->priority);
+        return J288_ERR_BAD_ARG;
+    }
+    return j288_rt_os_setup(o, sys, st);
+}
+
+int j288_rt_setup(const j288_rt_options_t *o, j288_rt_status_t *st)
+{
+    return j288_rt_setup_with(o, NULL, st);
+}
+
 /* Bucket of a value: exact below J288_RT_HIST_EXACT; above, the power of two it lies in and
  * its top J288_RT_HIST_SUB_BITS bits after the leading one. */
 static unsigned bucket_of(uint32_t v)

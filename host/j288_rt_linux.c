@@ -13,6 +13,7 @@
 #include <time.h>
 
 #include "j288/error.h"
+#include "j288_rt_os.h"
 
 /* ---- the real calls ------------------------------------------------------------------------ */
 
@@ -77,12 +78,6 @@ static const j288_rt_sys_t real_sys = {sys_lock_memory, sys_unlock_memory, sys_g
                                         sys_set_sched,   sys_get_cpus,      sys_set_cpus};
 
 /* ---- set-up ---------------------------------------------------------------------------------- */
-
-void j288_rt_options_init(j288_rt_options_t *o)
-{
-    o->priority = 0;
-    o->cpu = -1;
-}
 
 /* Append a formatted line to st->notice (cut short when full). */
 static void note(j288_rt_status_t *st, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
@@ -178,22 +173,12 @@ static void set_fifo(const j288_rt_sys_t *sys, int priority, j288_rt_status_t *s
          priority, strerror(e), priority, priority, priority);
 }
 
-int j288_rt_setup_with(const j288_rt_options_t *o, const j288_rt_sys_t *sys, j288_rt_status_t *st)
+int j288_rt_os_setup(const j288_rt_options_t *o, const j288_rt_sys_t *sys, j288_rt_status_t *st)
 {
     unsigned char allowed[J288_RT_CPU_MASK_BYTES];
-    if (st == NULL)
-        return J288_ERR_NULL;
-    memset(st, 0, sizeof *st);
-    st->cpu = -1;
-    if (o == NULL)
-        return J288_ERR_NULL;
     if (sys == NULL)
         sys = &real_sys;
     st->sys = sys;
-    if (o->priority < 0 || o->priority > 99) {
-        note(st, "real time: priority %d is not 1-99 (0: none)\n", o->priority);
-        return J288_ERR_BAD_ARG;
-    }
     if (o->cpu >= 0) {
         char list[256];
         if (sys->get_cpus(allowed) != 0 || !mask_has(allowed, o->cpu)) {
@@ -227,11 +212,6 @@ int j288_rt_setup_with(const j288_rt_options_t *o, const j288_rt_sys_t *sys, j28
     if (o->priority > 0)
         set_fifo(sys, o->priority, st);
     return J288_OK;
-}
-
-int j288_rt_setup(const j288_rt_options_t *o, j288_rt_status_t *st)
-{
-    return j288_rt_setup_with(o, NULL, st);
 }
 
 void j288_rt_restore(j288_rt_status_t *st)

@@ -11,29 +11,13 @@
 #include <windows.h>
 
 #include "j288/error.h"
+#include "j288_rt_os.h"
 
-void j288_rt_options_init(j288_rt_options_t *o)
-{
-    o->priority = 0;
-    o->cpu = -1;
-}
-
-int j288_rt_setup_with(const j288_rt_options_t *o, const j288_rt_sys_t *sys, j288_rt_status_t *st)
+int j288_rt_os_setup(const j288_rt_options_t *o, const j288_rt_sys_t *sys, j288_rt_status_t *st)
 {
     DWORD_PTR proc_mask = 0, sys_mask = 0;
     HANDLE self = GetCurrentThread();
     (void)sys; /* the seam is Linux's */
-    if (st == NULL)
-        return J288_ERR_NULL;
-    memset(st, 0, sizeof *st);
-    st->cpu = -1;
-    if (o == NULL)
-        return J288_ERR_NULL;
-    if (o->priority < 0 || o->priority > 99) {
-        (void)snprintf(st->notice, sizeof st->notice,
-                       "real time: priority %d is not 1-99 (0: none)\n", o->priority);
-        return J288_ERR_BAD_ARG;
-    }
     if (o->cpu >= 0) {
         (void)GetProcessAffinityMask(GetCurrentProcess(), &proc_mask, &sys_mask);
         if (o->cpu >= (int)(8u * sizeof(DWORD_PTR)) ||
@@ -61,11 +45,6 @@ int j288_rt_setup_with(const j288_rt_options_t *o, const j288_rt_sys_t *sys, j28
                        "  no memory is locked and there is no SCHED_FIFO (docs/realtime.md)\n");
     }
     return J288_OK;
-}
-
-int j288_rt_setup(const j288_rt_options_t *o, j288_rt_status_t *st)
-{
-    return j288_rt_setup_with(o, NULL, st);
 }
 
 void j288_rt_restore(j288_rt_status_t *st)

@@ -12,6 +12,8 @@ import json
 import os
 import sys
 
+import wire_latency  # (beside this file)
+
 D = sys.argv[1]
 PERIOD = int(sys.argv[2])
 QS = (0.5, 0.99, 0.999, 1.0)
@@ -160,29 +162,9 @@ def dds_table():
     print("%-30s %31s | %27s | %23s" % ("run", "wire p50 p99 p99.9 max (n)",
                                        "cyclictest p50 p99 p99.9 max", "ratio p50 p99 p99.9 max"))
     for name, load, mode in r:
-        sent = [(int(t), float(p)) for _, t, p in
-                (l.split() for l in open(os.path.join(D, name + ".sent")) if l.startswith("sent "))]
-        frames = [(int(t), h) for t, _, h in
-                  (l.split() for l in open(os.path.join(D, name + ".stamps")))]
-        dec = {}
-        for l in open(os.path.join(D, name + ".log0")):
-            f = l.split()
-            if len(f) >= 8 and f[2] == "id=1" and f[3] == "status=1":
-                dec[f[1]] = int(f[7].split("=")[1])
-        raws = sorted(set(dec.values()))
-        if len(raws) != 2:
-            print("%-30s (expected two targets on the wire, saw %d)" % (name, len(raws)))
-            continue
-        raw_of = {0.30: raws[0], 0.35: raws[1]}
-        lat, j = [], 0
-        for t, p in sent:
-            while j < len(frames) and frames[j][0] < t:
-                j += 1
-            k = j
-            while k < len(frames) and dec.get(frames[k][1]) != raw_of[round(p, 2)]:
-                k += 1
-            if k < len(frames):
-                lat.append(round((frames[k][0] - t) / 1000.0))
+        lat = [round(v) for v in wire_latency.latencies(
+            os.path.join(D, name + ".sent"), os.path.join(D, name + ".stamps"),
+            os.path.join(D, name + ".log0"))[0]]
         wp = values(lat)
         cp = cyclictest(os.path.join(D, name + ".ct"))
         print("%-30s %6d %6d %6d %7d (%d) | %6d %6d %6d %7d | %5s %5s %5s %5s"
