@@ -72,14 +72,16 @@ def loop_tables():
         print("%-30s %6d %6d %6d %7d | %6d %6d %6d %7d | %5s %5s %5s %5s"
               % ("%s, %s" % (LABEL[load], "--realtime" if mode == "realtime" else "normal"),
                  *lp, *cp, *(ratio(a, b) for a, b in zip(lp, cp))))
-    print("%-30s %9s %8s %8s %5s %13s %10s %10s" % ("", "cycles/s", "missed", "skipped", "cut",
-                                                     "cycle p99.9", "cycle max", "bus down"))
+    print("%-30s %9s %9s %8s %8s %5s %10s %11s %10s %9s" % (
+        "", "cycles/s", "wake-ups", "missed", "skipped", "cut", "cycle p50", "cycle p99.9",
+        "cycle max", "bus down"))
     for name, load, mode, down, _ in r:
         j = json.load(open(os.path.join(D, name + ".json")))
         t = j["timing"]
-        print("%-30s %9.1f %8d %8d %5d %10d us %7d us %10s"
+        print("%-30s %9.1f %9d %8d %8d %5d %7d us %8d us %7d us %9s"
               % ("%s, %s" % (LABEL[load], "--realtime" if mode == "realtime" else "normal"),
-                 j["cycles_per_s"], t["missed_deadlines"], t["skipped_periods"], t["cut_cycles"],
+                 j["cycles_per_s"], t["lateness_us"]["count"], t["missed_deadlines"],
+                 t["skipped_periods"], t["cut_cycles"], t["duration_us"]["p50"],
                  t["duration_us"]["p99_9"], t["duration_us"]["max"], down))
 
 
@@ -129,9 +131,9 @@ def trace_table():
         return
     print("\nthe kernel worker's share (--realtime beside stress-ng): delay of each tty flush, "
           "queued by the writer -> run by a kworker (flush_to_ldisc), us")
-    print("%-44s %7s %7s %7s %7s %9s | %10s %10s %9s" % ("run", "p50", "p99", "p99.9", "max",
-                                                         "flushes", "lat p99.9", "cycles/s",
-                                                         "bus down"))
+    print("%-44s %7s %7s %7s %7s %9s | %10s %9s %10s %9s" % (
+        "run", "p50", "p99", "p99.9", "max", "flushes", "cycle p99", "wake-ups", "cycles/s",
+        "bus down"))
     for name, down in r:
         queued, delays = {}, []
         for line in open(os.path.join(D, name + ".trace")):
@@ -148,9 +150,9 @@ def trace_table():
         p = values(delays) if delays else [0] * 4
         label = ("kworkers as the kernel made them (SCHED_OTHER)" if name.endswith("default")
                  else "the flush kworkers under SCHED_FIFO PRIO-1")
-        print("%-44s %7d %7d %7d %7d %9d | %7d us %10.1f %9s"
-              % (label, *p, len(delays), j["timing"]["lateness_us"]["p99_9"], j["cycles_per_s"],
-                 down))
+        print("%-44s %7d %7d %7d %7d %9d | %7d us %9d %10.1f %9s"
+              % (label, *p, len(delays), j["timing"]["duration_us"]["p99"],
+                 j["timing"]["lateness_us"]["count"], j["cycles_per_s"], down))
 
 
 def dds_table():

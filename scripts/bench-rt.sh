@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # usage: [BUILD=build] [DURATION=30] [RATE=1000] [PRIO=80] [CPU=1] [PARTS="loop dds"]
-#        [OLD_BIN=DIR] [TRACE=1] [COUNT=300] scripts/bench-rt.sh            (make bench-rt)
+#        [LOADS="idle stress"] [MODES="normal realtime"] [OLD_BIN=DIR] [TRACE=1] [COUNT=300]
+#        scripts/bench-rt.sh                                                  (make bench-rt)
 # The robot loop's timing against the machine's own floor, side by side in one run
 # (docs/realtime.md, docs/performance.md "Real time"). Needs the machine to itself: not in CI.
 #
@@ -35,6 +36,8 @@ PRIO=${PRIO:-80}
 CPU=${CPU:-1}
 COUNT=${COUNT:-300}
 PARTS=${PARTS:-loop dds}
+LOADS=${LOADS:-idle stress}
+MODES=${MODES:-normal realtime}
 SIM_PRIO=$((PRIO - 10))
 PERIOD_US=$((1000000 / RATE))
 if [ "${1:-}" = dds-inside ]; then # the bridge's part, re-run in a private network namespace
@@ -199,7 +202,7 @@ if [ "${1:-}" = dds-inside ]; then # (in the namespace now) the rows and files g
     [ -f "$BUILD/bench/write_stamp.so" ] && [ -x "$BUILD/test/dds_peer" ] && [ -x "$BIN/j288-dds" ] ||
         { echo "bench-rt: make dds build/bench/write_stamp.so first" >&2; exit 1; }
     : >"$tmp/dds.rows"
-    for load in idle stress; do for mode in normal realtime; do
+    for load in $LOADS; do for mode in $MODES; do
         dds_run "dds-$load-$mode" "$load" "$mode"
     done; done
     cp "$tmp"/dds-* "$tmp/dds.rows" "$2"/
@@ -212,11 +215,11 @@ echo "bench-rt: before: load $(cut -d' ' -f1-3 /proc/loadavg); busiest other pro
 ps -eo pcpu,comm --sort=-pcpu | sed -n '2,6p' | sed 's/^/    /'
 : >"$tmp/loop.rows"; : >"$tmp/csv.rows"; : >"$tmp/trace.rows"; : >"$tmp/dds.rows"
 case " $PARTS " in *" loop "*)
-    for load in idle stress; do for mode in normal realtime; do
+    for load in $LOADS; do for mode in $MODES; do
         loop_run "loop-$load-$mode" "$load" "$mode"
     done; done
     if [ -n "${OLD_BIN:-}" ]; then
-        for load in idle stress; do for mode in normal realtime; do
+        for load in $LOADS; do for mode in $MODES; do
             csv_run "new-$load-$mode" "$load" "$mode" "$BIN"
             csv_run "old-$load-$mode" "$load" "$mode" "$OLD_BIN"
         done; done
@@ -234,7 +237,7 @@ case " $PARTS " in *" loop "*)
 esac
 case " $PARTS " in *" dds "*)
     if [ -x "$BIN/j288-dds" ]; then
-        bash "$0" dds-inside "$tmp"
+        bash "$0" dds-inside "$tmp" || echo "bench-rt: the bridge's part failed (above)" >&2
     else
         echo "bench-rt: no j288-dds (make dds): the bridge's rows skipped" >&2
     fi
