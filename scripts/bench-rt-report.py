@@ -148,8 +148,9 @@ def trace_table():
                     delays.append(round((t - queued.pop(w)) * 1e6))
         j = json.load(open(os.path.join(D, name + ".json")))
         p = values(delays) if delays else [0] * 4
-        label = ("kworkers as the kernel made them (SCHED_OTHER)" if name.endswith("default")
-                 else "the flush kworkers under SCHED_FIFO PRIO-1")
+        label = {"trace-default": "kworkers as the kernel makes them (SCHED_OTHER)",
+                 "trace-nice": "stress-ng at nice 19 (the rest at low weight)",
+                 "trace-raised": "unbound kworkers under SCHED_FIFO PRIO-1"}.get(name, name)
         print("%-44s %7d %7d %7d %7d %9d | %7d us %9d %10.1f %9s"
               % (label, *p, len(delays), j["timing"]["duration_us"]["p99"],
                  j["timing"]["lateness_us"]["count"], j["cycles_per_s"], down))

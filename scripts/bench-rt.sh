@@ -17,8 +17,10 @@
 #   the p99.9 of the jitter of cycle starts (|start interval - period|) from the CSV.
 #   TRACE=1 (root, tracefs): the kernel worker's share. With --realtime beside stress-ng, the
 #   delay of every tty flush (workqueue_queue_work -> workqueue_execute_start of
-#   flush_to_ldisc: the kworker that moves a pty's, or a USB adapter's, bytes to the reader),
-#   then the same with those kworkers under SCHED_FIFO PRIO-1 (the tuning of docs/realtime.md).
+#   flush_to_ldisc: the kworker that moves a pty's, or a USB adapter's, bytes to the reader);
+#   then the two tunings of docs/realtime.md: stress-ng at nice 19 (the rest at a lower CPU
+#   weight), and every unbound kworker under SCHED_FIFO PRIO-1 (re-applied every half second,
+#   as the pool makes new workers; put back after).
 # dds: j288-dds at RATE on the same buses, in a private network namespace: command to wire (a
 #   peer's dds_write of a joint_command to the write() of the first frame carrying it, stamped
 #   by test/bench/write_stamp.so), p50 / p99 / p99.9 / max over COUNT commands, idle and beside
@@ -87,7 +89,7 @@ sims_down() { stop_pids TERM "${SIM_PIDS[@]}"; SIM_PIDS=(); }
 load_on() {
     LOAD_PID=
     if [ "$1" = stress ]; then
-        stress-ng --cpu 2 --timeout $((DURATION + 15)) >/dev/null 2>&1 &
+        nice -n "${LOAD_NICE:-0}" stress-ng --cpu 2 --timeout $((DURATION + 15)) >/dev/null 2>&1 &
         LOAD_PID=$!
         BG_PIDS+=("$LOAD_PID")
         sleep 1
@@ -140,7 +142,7 @@ csv_run() {
 # ---- the kernel worker (TRACE=1) --------------------------------------------------------------
 
 TR=/sys/kernel/tracing
-trace_run() { # NAME: the loop with --realtime beside stress-ng, tty flushes traced
+trace_run() { # NAME [nice]: the loop with --realtime beside stress-ng, tty flushes traced
     local name=$1 inst=$TR/instances/j288-bench-rt
     mkdir -p "$inst"
     echo 65536 >"$inst/buffer_size_kb"
@@ -149,7 +151,7 @@ trace_run() { # NAME: the loop with --realtime beside stress-ng, tty flushes tra
     echo 1 >"$inst/events/sched/sched_wakeup/enable"
     echo >"$inst/trace"
     sims_up
-    load_on stress
+    LOAD_NICE=${2:-0} load_on stress
     echo 1 >"$inst/tracing_on"
     "$BIN/j288" --config "$tmp/robot.yaml" log --rate "$RATE" --duration "$DURATION" --json \
         --cpu "$CPU" --realtime="$PRIO" >"$tmp/$name.json" 2>"$tmp/$name.err" || true
@@ -162,11 +164,15 @@ trace_run() { # NAME: the loop with --realtime beside stress-ng, tty flushes tra
     rmdir "$inst" 2>/dev/null || true
     echo "$name $(grep -c 'stopped answering' "$tmp/$name.err" || true)" >>"$tmp/trace.rows"
 }
-# the kworkers seen running flush_to_ldisc in a trace, raised to SCHED_FIFO PRIO-1 (the loop
-# above them, the simulators below)
-raise_flush_workers() {
-    local pid
-    for pid in $(sed -n 's/^ *kworker[^ ]*-\([0-9]*\) .*workqueue_execute_start.*/\1/p' "$1" | sort -u); do
+# every unbound kworker (kworker/u*: they run the tty flushes) not yet real-time, under
+# SCHED_FIFO PRIO-1 (the loop above them, the simulators below); the pids in $tmp/raised
+raise_unbound_workers() {
+    local f pid
+    for f in /proc/[0-9]*/comm; do
+        read -r c <"$f" 2>/dev/null || continue
+        case $c in kworker/u*) ;; *) continue ;; esac
+        pid=${f#/proc/}; pid=${pid%/comm}
+        [ "$(chrt -p "$pid" 2>/dev/null | sed -n 's/.*policy: *SCHED_\([A-Z]*\).*/\1/p')" = FIFO ] && continue
         chrt -f -p $((PRIO - 1)) "$pid" 2>/dev/null && echo "$pid" >>"$tmp/raised"
     done
 }
@@ -228,10 +234,14 @@ case " $PARTS " in *" loop "*)
         mountpoint -q "$TR" || mount -t tracefs nodev "$TR"
         : >"$tmp/raised"
         trace_run trace-default
-        raise_flush_workers "$tmp/trace-default.trace"
+        trace_run trace-nice 19
+        ( while :; do raise_unbound_workers; sleep 0.5; done ) &
+        RAISER=$!
+        BG_PIDS+=("$RAISER")
         trace_run trace-raised
+        stop_pids TERM "$RAISER"
         # back to normal: the kworkers serve everyone
-        for pid in $(cat "$tmp/raised"); do chrt -o -p 0 "$pid" 2>/dev/null || true; done
+        for pid in $(sort -u "$tmp/raised"); do chrt -o -p 0 "$pid" 2>/dev/null || true; done
     fi
     ;;
 esac
