@@ -169,7 +169,7 @@ trace_run() { # NAME [nice]: the loop with --realtime beside stress-ng, tty flus
 raise_unbound_workers() {
     local f pid
     for f in /proc/[0-9]*/comm; do
-        read -r c <"$f" 2>/dev/null || continue
+        { read -r c <"$f"; } 2>/dev/null || continue
         case $c in kworker/u*) ;; *) continue ;; esac
         pid=${f#/proc/}; pid=${pid%/comm}
         [ "$(chrt -p "$pid" 2>/dev/null | sed -n 's/.*policy: *SCHED_\([A-Z]*\).*/\1/p')" = FIFO ] && continue
