@@ -21,8 +21,8 @@ if(TARGET j288_cli AND TARGET j288_sim)
 endif()
 if(TARGET j288_shared)
     install(TARGETS j288_shared EXPORT j288Targets LIBRARY DESTINATION "${CMAKE_INSTALL_LIBDIR}")
-    install(FILES "${PROJECT_SOURCE_DIR}/port/linux/j288_linux.h"
-                  "${PROJECT_SOURCE_DIR}/host/j288_host_port.h"
+    install(FILES "${PROJECT_SOURCE_DIR}/port/desktop/j288_serial.h"
+                  "${PROJECT_SOURCE_DIR}/port/linux/j288_linux.h"
                   "${PROJECT_SOURCE_DIR}/host/j288_robot.h"
                   "${PROJECT_SOURCE_DIR}/host/j288_rt.h"
                   "${PROJECT_SOURCE_DIR}/host/j288_robot_config.h"

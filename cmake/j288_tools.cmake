@@ -9,14 +9,16 @@ if(NOT CMAKE_SYSTEM_NAME STREQUAL "Linux")
 endif()
 find_library(J288_LIBM m)
 
-add_library(j288_linux STATIC "${PROJECT_SOURCE_DIR}/port/linux/j288_linux.c")
-target_include_directories(j288_linux PUBLIC "${PROJECT_SOURCE_DIR}/port/linux")
+set(_j288_port_sources "${PROJECT_SOURCE_DIR}/port/desktop/j288_serial.c"
+                       "${PROJECT_SOURCE_DIR}/port/linux/j288_linux.c")
+add_library(j288_linux STATIC ${_j288_port_sources})
+target_include_directories(j288_linux PUBLIC "${PROJECT_SOURCE_DIR}/port/desktop"
+                                             "${PROJECT_SOURCE_DIR}/port/linux")
 target_link_libraries(j288_linux PUBLIC j288::j288)
 
 find_library(J288_YAML_LIB yaml)
 find_path(J288_YAML_INCLUDE yaml.h)
 set(_j288_robot_sources "${PROJECT_SOURCE_DIR}/host/j288_robot.c"
-                        "${PROJECT_SOURCE_DIR}/host/j288_host_wait.c"
                         "${PROJECT_SOURCE_DIR}/host/j288_rt.c"
                         "${PROJECT_SOURCE_DIR}/host/j288_rt_linux.c"
                         "${PROJECT_SOURCE_DIR}/host/j288_robot_config.c"
@@ -28,10 +30,9 @@ target_link_libraries(j288_robot PUBLIC j288_linux)
 add_library(j288::robot ALIAS j288_robot)
 
 file(GLOB _j288_shared_sources CONFIGURE_DEPENDS "${PROJECT_SOURCE_DIR}/lib/src/*.c")
-add_library(j288_shared SHARED ${_j288_shared_sources} "${PROJECT_SOURCE_DIR}/port/linux/j288_linux.c"
-            ${_j288_robot_sources})
+add_library(j288_shared SHARED ${_j288_shared_sources} ${_j288_port_sources} ${_j288_robot_sources})
 target_include_directories(j288_shared PUBLIC
-    "$<BUILD_INTERFACE:${PROJECT_SOURCE_DIR}/lib/include;${PROJECT_SOURCE_DIR}/port/linux;${PROJECT_SOURCE_DIR}/host>"
+    "$<BUILD_INTERFACE:${PROJECT_SOURCE_DIR}/lib/include;${PROJECT_SOURCE_DIR}/port/desktop;${PROJECT_SOURCE_DIR}/port/linux;${PROJECT_SOURCE_DIR}/host>"
     "$<INSTALL_INTERFACE:include;include/j288>")
 get_target_property(_j288_defs j288 INTERFACE_COMPILE_DEFINITIONS)
 target_compile_definitions(j288_shared PUBLIC ${_j288_defs})

@@ -1,10 +1,10 @@
 /*
  * j288_robot.c - the host layer's runner (see j288_robot.h for the contract).
  *
- * Every bus is driven from one loop: poll each bus, then sleep in j288_host_wait() over all
- * of their devices (the one OS-specific call, host/j288_host_wait.c) until bytes come or the
- * earliest port deadline (j288_linux_next_deadline()), then let each ready port service
- * itself (j288_linux_service()), so that reading, flushing and the vanished-device handling
+ * Every bus is driven from one loop: poll each bus, then sleep in j288_serial_wait_any() over
+ * all of their devices until bytes come or the earliest port deadline
+ * (j288_serial_next_deadline()), then let each ready port service itself
+ * (j288_serial_service()), so that reading, flushing and the vanished-device handling
  * stay in the port. Cycles, single transactions (j288_robot_transfer()), idle waits and the
  * stop all go through that loop.
  */
@@ -13,9 +13,6 @@
 #include <stdarg.h>
 #include <stdio.h>
 #include <string.h>
-#include <sys/stat.h>
-
-#include "j288_host_wait.h"
 
 /* While a transaction is pending, wake at least this often to let each bus check its reply
  * deadline (the port's timer gives the exact time when it is armed). */
@@ -44,6 +41,8 @@ static int32_t us_until(uint32_t t, uint32_t now) { return (int32_t)(t - now); }
 size_t j288_robot_sizeof(void) { return sizeof(j288_robot_t); }
 
 const char *j288_robot_version(void) { return J288_VERSION_STRING; }
+
+uint32_t j288_robot_now_us(void) { return j288_serial_now_us(); }
 
 static bool bus_live(const j288_robot_bus_t *b) { return b->open && !b->stats.gone; }
 
@@ -254,12 +253,11 @@ static int check_config(j288_robot_t *r, const j288_robot_config_t *cfg)
 /* Two names for one device (a symlink and its target) would open it twice: the second open
  * would fail as "in use" by this very process, which says less than this. Checked before
  * opening bus i; a path that cannot be examined is left to the open to report. */
-#ifdef _WIN32
 static int check_same_device(j288_robot_t *r, unsigned i, const char *port)
 {
     unsigned k;
     for (k = 0; k < i; k++) {
-        if (j288_windows_same_device(port, j288_windows_device(&r->bus[k].lp))) {
+        if (j288_serial_same_device(&r->bus[k].serial, port)) {
             set_err(r, "buses '%s' and '%s' are the same device", r->bus[k].name,
                     r->bus[i].name);
             return J288_ERR_BAD_CONFIG;
@@ -267,30 +265,12 @@ static int check_same_device(j288_robot_t *r, unsigned i, const char *port)
     }
     return J288_OK;
 }
-#else
-static int check_same_device(j288_robot_t *r, unsigned i, const char *port)
-{
-    struct stat si, sk;
-    unsigned k;
-    if (stat(port, &si) != 0)
-        return J288_OK;
-    for (k = 0; k < i; k++) {
-        if (fstat(j288_linux_fd(&r->bus[k].lp), &sk) == 0 && si.st_rdev == sk.st_rdev &&
-            si.st_ino == sk.st_ino && si.st_dev == sk.st_dev) {
-            set_err(r, "buses '%s' and '%s' are the same device", r->bus[k].name,
-                    r->bus[i].name);
-            return J288_ERR_BAD_CONFIG;
-        }
-    }
-    return J288_OK;
-}
-#endif
 
 static int open_bus(j288_robot_t *r, unsigned i, const char *name, const char *port,
                     const j288_robot_config_bus_t *cb)
 {
     j288_robot_bus_t *b = &r->bus[i];
-    j288_linux_options_t lo;
+    j288_serial_options_t lo;
     j288_bus_config_t bc;
     j288_sched_config_t sc;
     uint32_t baud = r->opt.baud;
@@ -317,16 +297,16 @@ static int open_bus(j288_robot_t *r, unsigned i, const char *name, const char *p
     rc = check_same_device(r, i, port);
     if (rc != J288_OK)
         return rc;
-    rc = j288_linux_open(&b->lp, port, baud, &lo);
+    rc = j288_serial_open(&b->serial, port, baud, &lo);
     if (rc != J288_OK) {
-        set_err(r, "bus '%s': %s", name, j288_linux_error(&b->lp));
+        set_err(r, "bus '%s': %s", name, j288_serial_error(&b->serial));
         return rc;
     }
     b->open = true;
     b->stats.up = true;
-    j288_linux_bus_config(&b->lp, &bc);
+    j288_serial_bus_config(&b->serial, &bc);
     bc.retries = r->opt.retries;
-    rc = j288_linux_bus_init(&b->lp, &b->bus, &bc);
+    rc = j288_serial_bus_init(&b->serial, &b->bus, &bc);
     if (rc == J288_OK) {
         memset(&sc, 0, sizeof sc);
         sc.on_event = on_servo_event;
@@ -397,7 +377,7 @@ static void close_buses(j288_robot_t *r)
     unsigned i;
     for (i = 0; i < J288_ROBOT_MAX_BUSES; i++) {
         if (r->bus[i].open)
-            j288_linux_close(&r->bus[i].lp);
+            j288_serial_close(&r->bus[i].serial);
         r->bus[i].open = false;
     }
 }
@@ -516,10 +496,10 @@ static void poll_all(j288_robot_t *r, uint32_t now)
         if (!bus_live(b))
             continue;
         j288_sched_poll(&b->sched, now);
-        if (j288_linux_offline(&b->lp)) {
+        if (j288_serial_offline(&b->serial)) {
             b->stats.gone = true;
             b->stats.up = false;
-            set_err(r, "bus '%s': %s", b->name, j288_linux_error(&b->lp));
+            set_err(r, "bus '%s': %s", b->name, j288_serial_error(&b->serial));
             emit_bus(r, J288_ROBOT_EV_BUS_GONE, i);
         }
     }
@@ -534,7 +514,7 @@ static bool bus_pending(const j288_robot_bus_t *b)
  * is pending, at least every SLICE_US), or until_us; then let each ready port read its device. */
 static void wait_all(j288_robot_t *r, uint32_t now, uint32_t until_us)
 {
-    j288_linux_t *ports[J288_ROBOT_MAX_BUSES];
+    j288_serial_t *ports[J288_ROBOT_MAX_BUSES];
     bool ready[J288_ROBOT_MAX_BUSES];
     unsigned n = 0, i;
     int32_t left = us_until(until_us, now);
@@ -546,23 +526,23 @@ static void wait_all(j288_robot_t *r, uint32_t now, uint32_t until_us)
             continue;
         if (bus_pending(b) && left > (int32_t)SLICE_US)
             left = (int32_t)SLICE_US;
-        if (j288_linux_next_deadline(&b->lp, &at) && us_until(at, now) <= 0) {
-            (void)j288_linux_service(&b->lp); /* due now: deliver it rather than sleep 0 */
+        if (j288_serial_next_deadline(&b->serial, &at) && us_until(at, now) <= 0) {
+            (void)j288_serial_service(&b->serial); /* due now: deliver it rather than sleep 0 */
             left = 0;
-        } else if (j288_linux_next_deadline(&b->lp, &at) && us_until(at, now) < left) {
+        } else if (j288_serial_next_deadline(&b->serial, &at) && us_until(at, now) < left) {
             left = us_until(at, now);
         }
-        ports[n++] = &b->lp;
+        ports[n++] = &b->serial;
     }
     if (r->stop_flag != NULL && left > (int32_t)STOP_SLICE_US)
         left = (int32_t)STOP_SLICE_US;
     if (left < 0)
         left = 0;
-    if (j288_host_wait(ports, n, (uint32_t)left, ready) == 0u)
+    if (j288_serial_wait_any(ports, n, (uint32_t)left, ready) == 0u)
         return; /* timeout, or a signal: the caller looks at its flags */
     for (i = 0; i < n; i++) {
         if (ready[i])
-            (void)j288_linux_service(ports[i]);
+            (void)j288_serial_service(ports[i]);
     }
 }
 
@@ -605,7 +585,7 @@ static void start_sweeps(j288_robot_t *r, uint32_t now)
 static void finish_cycle(j288_robot_t *r, uint32_t start, j288_robot_cycle_t *info)
 {
     unsigned j, fresh = 0;
-    uint32_t took = j288_linux_now_us() - start;
+    uint32_t took = j288_serial_now_us() - start;
     for (j = 0; j < r->njoints; j++) {
         if (r->fresh_at[j] == r->cycle) {
             fresh++;
@@ -663,11 +643,11 @@ int j288_robot_cycle(j288_robot_t *r, uint32_t timeout_us, j288_robot_cycle_t *i
         timeout_us = J288_ROBOT_DEFAULT_CYCLE_TIMEOUT_US;
     if (timeout_us > (uint32_t)INT32_MAX)
         timeout_us = (uint32_t)INT32_MAX; /* beyond it the wrapped clock reads as past */
-    start = j288_linux_now_us();
+    start = j288_serial_now_us();
     until = start + timeout_us;
     start_sweeps(r, start);
     for (;;) {
-        uint32_t now = j288_linux_now_us();
+        uint32_t now = j288_serial_now_us();
         poll_all(r, now);
         if (stop_requested(r)) {
             (void)j288_robot_stop(r);
@@ -714,7 +694,7 @@ static int sleep_until_ns(j288_robot_t *r, uint64_t until_ns, uint64_t *woke_ns)
 {
     for (;;) {
         uint64_t now_ns = j288_rt_now_ns();
-        uint32_t now = j288_linux_now_us();
+        uint32_t now = j288_serial_now_us();
         if (now_ns >= until_ns) {
             *woke_ns = now_ns;
             poll_all(r, now);
@@ -825,7 +805,7 @@ int j288_robot_stop(j288_robot_t *r)
     int rc = J288_OK;
     if (r == NULL)
         return J288_ERR_NULL;
-    start = j288_linux_now_us();
+    start = j288_serial_now_us();
     bound = stop_bound_us(r);
     for (i = 0; i < r->nbuses; i++) {
         if (bus_live(&r->bus[i])) {
@@ -843,13 +823,13 @@ int j288_robot_stop(j288_robot_t *r)
     r->driven = false;
     for (;;) {
         bool pending = false;
-        now = j288_linux_now_us();
+        now = j288_serial_now_us();
         for (i = 0; i < r->nbuses; i++) {
             j288_robot_bus_t *b = &r->bus[i];
             if (!bus_live(b))
                 continue;
             j288_bus_poll(&b->bus, now);
-            if (j288_linux_offline(&b->lp)) {
+            if (j288_serial_offline(&b->serial)) {
                 b->stats.gone = true;
                 rc = J288_ERR_OFFLINE;
                 continue;
@@ -1193,14 +1173,14 @@ static uint32_t txn_bound_us(const j288_robot_t *r, const j288_robot_bus_t *b)
 static int run_txn(j288_robot_t *r, j288_robot_bus_t *b, const j288_cmd_raw_t *cmd,
                    j288_txn_t *out)
 {
-    uint32_t start = j288_linux_now_us(), bound = txn_bound_us(r, b);
+    uint32_t start = j288_serial_now_us(), bound = txn_bound_us(r, b);
     int rc;
     b->txn_done = false;
     rc = j288_bus_submit(&b->bus, cmd, start, txn_done, b);
     if (rc != J288_OK)
         return rc;
     for (;;) {
-        uint32_t now = j288_linux_now_us();
+        uint32_t now = j288_serial_now_us();
         poll_all(r, now);
         if (b->txn_done)
             break;
@@ -1382,7 +1362,7 @@ int j288_robot_idle(j288_robot_t *r, uint32_t until_us)
     if (r == NULL)
         return J288_ERR_NULL;
     for (;;) {
-        uint32_t now = j288_linux_now_us();
+        uint32_t now = j288_serial_now_us();
         poll_all(r, now);
         if (!any_live(r))
             return J288_ERR_OFFLINE;
@@ -1398,7 +1378,7 @@ const char *j288_robot_notices(const j288_robot_t *r, unsigned bus)
 {
     if (r == NULL || bus >= r->nbuses || !r->bus[bus].open)
         return "";
-    return j288_linux_notices(&r->bus[bus].lp);
+    return j288_serial_notices(&r->bus[bus].serial);
 }
 
 j288_sched_t *j288_robot_bus_sched(j288_robot_t *r, unsigned bus)

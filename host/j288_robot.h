@@ -1,6 +1,6 @@
 /*
  * j288_robot.h - the host layer: several buses from one loop, the joints of a robot config,
- * one thread, one wait over every bus's device (host/j288_host_wait.h). Every host front end
+ * one thread, one wait over every bus's device (j288_serial_wait_any()). Every host front end
  * (the j288 tool's bus commands, the Python package, a DDS bridge) drives servos through it:
  * one loop, one stop path, one watchdog policy.
  *
@@ -60,7 +60,7 @@
  * Bad input (J288_ERR_BAD_CONFIG with a message in j288_robot_error()): no bus, a bus
  * named twice, two buses on the same device, a joint on a bus that does not exist, an id
  * used twice on one bus, a joint the joint layer refuses. A device that cannot be opened:
- * j288_linux_open()'s code and message. Nothing stays open after a failed open.
+ * j288_serial_open()'s code and message. Nothing stays open after a failed open.
  *
  * Objects are caller-allocated (j288_robot_sizeof() for foreign callers), hold no heap memory
  * and must not move while open. One thread owns a robot; nothing here is ISR- or
@@ -79,7 +79,7 @@
 #include <stdint.h>
 
 #include "j288/j288.h"
-#include "j288_host_port.h"
+#include "j288_serial.h"
 #include "j288_robot_config.h"
 #include "j288_rt.h"
 
@@ -128,7 +128,7 @@ typedef struct {
 /* What on_cycle is told. */
 typedef struct {
     uint32_t cycle;       /* cycles completed, this one included */
-    uint32_t start_us;    /* j288_linux_now_us() clock */
+    uint32_t start_us;    /* j288_robot_now_us() clock */
     uint32_t duration_us;
     unsigned fresh;       /* joints with a new reply in this cycle */
     unsigned joints;      /* joints in all */
@@ -146,7 +146,7 @@ typedef struct {
     uint32_t baud;         /* for buses that give none; 0: 6000000 */
     uint32_t margin_us;    /* reply margin for buses that give none; 0: 20 ms (USB) */
     uint8_t down_after;    /* 0: J288_ROBOT_DEFAULT_DOWN_AFTER */
-    bool no_low_latency;   /* as j288_linux_options_t */
+    bool no_low_latency;   /* as j288_serial_options_t */
     j288_robot_event_fn on_event; /* may be NULL */
     j288_robot_cycle_fn on_cycle; /* may be NULL; called at the end of every cycle */
     void *user;
@@ -235,7 +235,7 @@ typedef struct {
 } j288_robot_servo_t;
 
 typedef struct {
-    j288_linux_t lp;
+    j288_serial_t serial;
     j288_bus_t bus;
     j288_sched_t sched;
     j288_joint_bus_t jb;
@@ -285,11 +285,16 @@ size_t j288_robot_sizeof(void);
 /* The library's version (J288_VERSION_STRING). */
 const char *j288_robot_version(void);
 
+/* The runner's clock: monotonic microseconds, wrapping at 2^32 (the buses' clock,
+ * j288_serial_now_us()): what every *_us time the runner takes or reports is counted in.
+ * Any thread. */
+uint32_t j288_robot_now_us(void);
+
 /* Set up the calling thread's real time (opt->realtime, pin_cpu), then open every bus of cfg
  * (buses in cfg order; a config without buses: opt->port) and set up its joints (every
  * joint's slot enabled, at lock). Errors: J288_ERR_NULL, J288_ERR_BAD_CONFIG (see the top),
  * J288_ERR_BAD_ARG (realtime above 99, a cpu this process may not run on: nothing opened),
- * j288_linux_open()'s codes; the message in j288_robot_error(). r need not be initialised
+ * j288_serial_open()'s codes; the message in j288_robot_error(). r need not be initialised
  * before; after a failure (the real-time set-up undone) j288_robot_error() stays valid and
  * close is harmless. */
 int j288_robot_open(j288_robot_t *r, const j288_robot_config_t *cfg,
@@ -462,7 +467,7 @@ int j288_robot_transfer(j288_robot_t *r, unsigned bus, const j288_cmd_raw_t *cmd
                         j288_txn_t *txn, bool *wd_cleared);
 
 /* Serve every bus (background sweeps, the port's events) without starting anything until
- * until_us (a j288_linux_now_us() time, at most 35 minutes ahead): a front end's pause
+ * until_us (a j288_robot_now_us() time, at most 35 minutes ahead): a front end's pause
  * between commands. J288_OK, J288_ERR_ABORTED (the stop flag: nothing is sent, the caller
  * stops), J288_ERR_OFFLINE (every bus is gone), J288_ERR_NULL. */
 int j288_robot_idle(j288_robot_t *r, uint32_t until_us);

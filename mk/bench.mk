@@ -41,7 +41,7 @@ bench-codec: $(CODEC_BENCH)
 	 bash scripts/bench-codec.sh $(CODEC_BENCH) $(CODEC_BENCH_N) "$(CC), $(OPT)"
 
 LINUX_BENCH := $(BUILD)/bench/bench_linux_port
-$(LINUX_BENCH): $(OBJ)/test/linux/bench_linux_port.o $(LINUX_A) $(LIB_A)
+$(LINUX_BENCH): $(OBJ)/test/linux/bench_linux_port.o $(SERIAL_LOOP_OBJ) $(LINUX_A) $(LIB_A)
 	$(LINK)
 
 bench-linux: $(LINUX_BENCH) $(SIM_BIN)

@@ -121,8 +121,8 @@ SOAK_TXNS ?= 100000
 SOAK_SHORT_TXNS ?= 10000
 SOAK_BIN := $(BUILD)/soak/soak
 
-$(OBJ)/test/soak/%.o: CPPFLAGS_OBJ = $(LINUX_CPPFLAGS)
-$(SOAK_BIN): $(OBJ)/test/soak/soak.o $(LINUX_A) $(LIB_A)
+$(OBJ)/test/soak/%.o: CPPFLAGS_OBJ = $(LINUX_CPPFLAGS) -Itest/desktop
+$(SOAK_BIN): $(OBJ)/test/soak/soak.o $(SERIAL_LOOP_OBJ) $(LINUX_A) $(LIB_A)
 	$(LINK)
 
 .PHONY: soak soak-short

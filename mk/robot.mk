@@ -3,10 +3,9 @@
 #   test/linux/test_robot.c   several j288-sim buses from one loop (HOST_TESTS)
 #   test/e2e/cli_robot.sh     j288 --config FILE log|status|hold|stop (TEST_SCRIPTS)
 #   test/e2e/host_stack.sh    a second session after a stop, every front end (TEST_SCRIPTS)
-# (the runner, and its one OS-specific call, the wait over every bus: host/j288_host_wait.c;
-# the loop's real time and timing: host/j288_rt.c, its OS part host/j288_rt_linux.c)
-ROBOT_OBJ := $(OBJ)/host/j288_robot.o $(OBJ)/host/j288_host_wait.o $(OBJ)/host/j288_rt.o \
-    $(OBJ)/host/j288_rt_linux.o
+# (the runner, its wait over every bus the port's, j288_serial_wait_any(); the loop's real
+# time and timing: host/j288_rt.c, its OS part host/j288_rt_linux.c)
+ROBOT_OBJ := $(OBJ)/host/j288_robot.o $(OBJ)/host/j288_rt.o $(OBJ)/host/j288_rt_linux.o
 
 ROBOT_TEST := $(BUILD)/test/test_robot
 # (alloc_count.o: malloc and its family replaced by counting ones, for the cycle's promise of none)

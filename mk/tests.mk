@@ -28,8 +28,7 @@ $(OBJ)/test/cli/test_cli_joint.o: $(YAML_ENV)
 
 $(CLI_JOINT_TEST): $(OBJ)/test/cli/test_cli_joint.o $(CLI_CAPTURE_OBJ) \
     $(addprefix $(OBJ)/tools/j288/,cli_joint.o cli_bus.o args.o json.o report.o) \
-    $(OBJ)/host/j288_robot.o $(OBJ)/host/j288_host_wait.o $(OBJ)/host/j288_rt.o \
-    $(OBJ)/host/j288_rt_linux.o $(CONFIG_OBJ) \
+    $(OBJ)/host/j288_robot.o $(OBJ)/host/j288_rt.o $(OBJ)/host/j288_rt_linux.o $(CONFIG_OBJ) \
     $(UNITY_OBJ) $(LINUX_A) $(LIB_A) $(YAML_ENV)
 	$(LINK)
 HOST_TESTS += $(CLI_JOINT_TEST)
@@ -79,13 +78,19 @@ $(foreach n,$(FUZZ_NAMES),$(eval $(BUILD)/test/fuzz_replay_$(n): $(FUZZ_EXTRA_$(
 
 # ---- the Linux port, the simulator's model, the STM32 port -----------------------------------
 LINUX_PORT_TEST := $(BUILD)/test/test_linux_port
-$(OBJ)/test/linux/%.o: CPPFLAGS_OBJ = $(TEST_CPPFLAGS) -Iport/linux -Ihost -DJ288_SIM_DEFAULT='"$(SIM_BIN)"' \
+$(OBJ)/test/linux/%.o $(OBJ)/test/desktop/%.o: CPPFLAGS_OBJ = $(TEST_CPPFLAGS) -Iport/desktop -Iport/linux -Ihost \
+    -Itest/desktop -DJ288_SIM_DEFAULT='"$(SIM_BIN)"' \
     -DJ288_EXAMPLE_CONFIG='"examples/robot.yaml"'
 
 # j288-sim as a child process, for the tests that drive it (test/linux/sim_process.c).
 SIM_PROCESS_OBJ := $(OBJ)/test/linux/sim_process.o
 
-$(LINUX_PORT_TEST): $(OBJ)/test/linux/test_linux_port.o $(SIM_PROCESS_OBJ) $(UNITY_OBJ) $(LINUX_A) $(LIB_A)
+# test/desktop/: the bus loop the port tests (and benchmarks, the soak) drive a port with, and
+# the checks every OS's port test runs alike.
+SERIAL_LOOP_OBJ := $(OBJ)/test/desktop/serial_loop.o
+
+$(LINUX_PORT_TEST): $(OBJ)/test/linux/test_linux_port.o $(SIM_PROCESS_OBJ) $(SERIAL_LOOP_OBJ) \
+    $(OBJ)/test/desktop/serial_checks.o $(UNITY_OBJ) $(LINUX_A) $(LIB_A)
 	$(LINK)
 
 CONFIG_TEST := $(BUILD)/test/test_robot_config

@@ -1,5 +1,6 @@
 # The Linux port and the programs built on it:
-#   $(LINUX_A)     libj288_linux.a, port/linux (termios2): -Iport/linux, link it before $(LIB_A)
+#   $(LINUX_A)     libj288_linux.a, the desktop serial port on Linux (port/desktop's core over
+#                  port/linux, termios2): -Iport/desktop -Iport/linux, link it before $(LIB_A)
 #   $(CONFIG_OBJ)  the robot config reader (port/linux, libyaml)
 #   $(J288_BIN)    tools/j288: offline frame calculator and bus commands over the Linux port
 #   $(SIM_BIN)     tools/j288-sim: simulated servos on a pseudo-terminal
@@ -8,12 +9,12 @@
 #   make vectors   regenerate the golden vectors from tools/vectors/gen_vectors.py
 .PHONY: linux cli sim demo vectors
 
-LINUX_CPPFLAGS := $(CPPFLAGS_LIB) -Iport/linux
+LINUX_CPPFLAGS := $(CPPFLAGS_LIB) -Iport/desktop -Iport/linux
 HOST_CPPFLAGS := $(LINUX_CPPFLAGS) -Ihost
-$(OBJ)/port/linux/%.o: CPPFLAGS_OBJ = $(LINUX_CPPFLAGS)
+$(OBJ)/port/linux/%.o $(OBJ)/port/desktop/%.o: CPPFLAGS_OBJ = $(LINUX_CPPFLAGS)
 $(OBJ)/host/%.o: CPPFLAGS_OBJ = $(HOST_CPPFLAGS)
 
-$(LINUX_A): $(OBJ)/port/linux/j288_linux.o
+$(LINUX_A): $(OBJ)/port/desktop/j288_serial.o $(OBJ)/port/linux/j288_linux.o
 	@mkdir -p $(@D)
 	rm -f $@
 	$(AR) rcs $@ $^

@@ -1,7 +1,7 @@
 # Windows: cross-built with mingw-w64, tested under Wine (docs: README "Windows").
 #   make windows        into $(WIN): j288.exe (the CLI), j288.dll with its import library
 #                       libj288.dll.a (lib/ + port/windows + the runner and config reader),
-#                       libj288.a (lib/), libj288_windows.a (port/windows), every test/unit
+#                       libj288.a (lib/), libj288_windows.a (port/desktop + port/windows), every test/unit
 #                       program, the Windows port's test, a benchmark; all -Werror
 #   make test-windows   every unit test program under Wine, then the Windows port and j288.exe
 #                       end to end against j288-sim through Wine's COM mapping
@@ -17,7 +17,7 @@ WIN := $(BUILD)/windows
 WIN_OBJ := $(WIN)/obj
 # $(DEPFLAGS): each object's header dependencies beside it (X.d, included by the Makefile).
 WIN_CFLAGS := $(CSTD) $(WARN) $(OPT) $(DEPFLAGS)
-WIN_CPPFLAGS := $(CPPFLAGS_LIB) -Iport/windows
+WIN_CPPFLAGS := $(CPPFLAGS_LIB) -Iport/desktop -Iport/windows
 # winmm: timeBeginPeriod (1 ms timer waits) in the port.
 WIN_LIBS := -lwinmm
 
@@ -39,21 +39,22 @@ $(WIN_OBJ)/%.o: %.c
 	$(COMPILE)
 $(WIN_OBJ)/test/%.o: test/%.c $(UNITY)/unity.c
 	$(COMPILE)
-$(WIN_OBJ)/port/windows/%.o: CPPFLAGS_OBJ = $(WIN_CPPFLAGS)
-$(WIN_OBJ)/test/%.o: CPPFLAGS_OBJ = $(TEST_CPPFLAGS) -Iport/windows
+$(WIN_OBJ)/port/%.o: CPPFLAGS_OBJ = $(WIN_CPPFLAGS)
+$(WIN_OBJ)/test/%.o: CPPFLAGS_OBJ = $(TEST_CPPFLAGS) -Iport/desktop -Iport/windows -Itest/desktop
 
 $(WIN_LIB_A): $(LIB_SRC:%.c=$(WIN_OBJ)/%.o)
 	@mkdir -p $(@D)
 	rm -f $@
 	$(WIN_AR) rcs $@ $^
 
-$(WIN_PORT_A): $(WIN_OBJ)/port/windows/j288_windows.o
+WIN_PORT_OBJ := $(WIN_OBJ)/port/desktop/j288_serial.o $(WIN_OBJ)/port/windows/j288_windows.o
+$(WIN_PORT_A): $(WIN_PORT_OBJ)
 	@mkdir -p $(@D)
 	rm -f $@
 	$(WIN_AR) rcs $@ $^
 
 # ---- the host layer and the CLI: j288.exe ----------------------------------------------------
-# The runner, the config reader and tools/j288 over the Windows port (host/j288_host_port.h),
+# The runner, the config reader and tools/j288 over the Windows port (port/desktop/j288_serial.h),
 # with Debian's libyaml source cross-built (scripts/libyaml-mingw.sh; without it the reader's
 # stubs refuse config files). C99 printf (%zu, %lld) from mingw-w64's own stdio.
 # -Wno-float-conversion: mingw-w64's isfinite/isnan/signbit macros type-check a float branch
@@ -62,8 +63,7 @@ WIN_TOOL_CPPFLAGS := $(WIN_CPPFLAGS) -Ihost -Itools/j288 -D__USE_MINGW_ANSI_STDI
 WIN_TOOL_CFLAGS := $(WIN_CFLAGS) -Wno-float-conversion
 WIN_YAML_ENV := $(WIN)/libyaml/libyaml.env
 WIN_HOST_OBJ := $(WIN_OBJ)/host/j288_robot.o $(WIN_OBJ)/host/j288_robot_config.o \
-    $(WIN_OBJ)/host/j288_number.o $(WIN_OBJ)/host/j288_host_wait_win32.o \
-    $(WIN_OBJ)/host/j288_rt.o $(WIN_OBJ)/host/j288_rt_win32.o
+    $(WIN_OBJ)/host/j288_number.o $(WIN_OBJ)/host/j288_rt.o $(WIN_OBJ)/host/j288_rt_win32.o
 # j288 top is a POSIX terminal program: tools/j288/windows/cmd_top.c says so instead.
 WIN_J288_OBJ := $(patsubst %.c,$(WIN_OBJ)/%.o,$(filter-out tools/j288/cmd_top.c,$(J288_SRC)) \
     tools/j288/windows/cmd_top.c)
@@ -83,7 +83,7 @@ $(WIN_J288): $(WIN_J288_OBJ) $(WIN_HOST_OBJ) $(WIN_PORT_A) $(WIN_LIB_A) $(WIN_YA
 # The DLL exports every global symbol of lib/ and the port (no __declspec in the headers:
 # mingw's linker exports all when none is marked); programs link the import library.
 # It holds the runner and the config reader too: what the Python package binds.
-WIN_DLL_OBJ := $(LIB_SRC:%.c=$(WIN_OBJ)/%.o) $(WIN_OBJ)/port/windows/j288_windows.o $(WIN_HOST_OBJ)
+WIN_DLL_OBJ := $(LIB_SRC:%.c=$(WIN_OBJ)/%.o) $(WIN_PORT_OBJ) $(WIN_HOST_OBJ)
 $(WIN_DLL) $(WIN_IMPLIB) &: $(WIN_DLL_OBJ) $(WIN_YAML_ENV)
 	@mkdir -p $(@D)
 	$(WIN_CC) -shared $(WIN_CFLAGS) $(WIN_DLL_OBJ) -o $(WIN_DLL) \
@@ -100,10 +100,12 @@ $(WIN)/test/%.exe: $(WIN_OBJ)/test/unit/%.o $(WIN_TEST_SUPPORT_OBJ) $(WIN_UNITY_
 	$(LINK)
 
 # The port's test goes through the DLL (its import library): that checks the DLL too.
-$(WIN_PORT_TEST): $(WIN_OBJ)/test/windows/test_windows_port.o $(WIN_UNITY_OBJ) $(WIN_IMPLIB)
+WIN_SERIAL_LOOP_OBJ := $(WIN_OBJ)/test/desktop/serial_loop.o
+$(WIN_PORT_TEST): $(WIN_OBJ)/test/windows/test_windows_port.o $(WIN_SERIAL_LOOP_OBJ) \
+    $(WIN_OBJ)/test/desktop/serial_checks.o $(WIN_UNITY_OBJ) $(WIN_IMPLIB)
 	$(LINK)
 
-$(WIN_BENCH): $(WIN_OBJ)/test/windows/bench_windows_port.o $(WIN_PORT_A) $(WIN_LIB_A)
+$(WIN_BENCH): $(WIN_OBJ)/test/windows/bench_windows_port.o $(WIN_SERIAL_LOOP_OBJ) $(WIN_PORT_A) $(WIN_LIB_A)
 	$(LINK)
 
 WIN_ALL := $(WIN_LIB_A) $(WIN_PORT_A) $(WIN_DLL) $(WIN_IMPLIB) $(WIN_UNIT_TESTS) $(WIN_PORT_TEST) \

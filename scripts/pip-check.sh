@@ -25,7 +25,7 @@ echo "pip install: $out"
 
 timeout 60 "$sim" --ids 1,2,3 --link "$root/bus" --quiet --exit-after 60 >"$root/sim.out" 2>"$root/sim.err" &
 sim_pid=$!
-trap 'kill $sim_pid 2>/dev/null; wait $sim_pid 2>/dev/null' EXIT
+trap 'kill $sim_pid 2>/dev/null || true; wait $sim_pid 2>/dev/null || true' EXIT
 for _ in $(seq 1 600); do [ -s "$root/sim.out" ] && break; sleep 0.05; done
 out=$(cd / && env -u J288_LIB "$root/v/bin/python" -c \
     'import sys, j288; print(sorted(j288.Bus(sys.argv[1], margin_us=250000).scan()))' "$root/bus")

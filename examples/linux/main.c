@@ -7,11 +7,11 @@
 #include <stdlib.h>
 
 #include "j288/j288.h"
-#include "j288_linux.h"
+#include "j288_serial.h"
 
 int main(int argc, char **argv)
 {
-    static j288_linux_t port; /* caller-allocated: the library allocates nothing */
+    static j288_serial_t port; /* caller-allocated: the library allocates nothing */
     static j288_bus_t bus;
     j288_bus_config_t cfg;
     j288_cmd_raw_t cmd = {0};
@@ -25,14 +25,14 @@ int main(int argc, char **argv)
         fprintf(stderr, "usage: linux-status DEVICE ID(0-14)\n");
         return 2;
     }
-    if (j288_linux_open(&port, argv[1], 0, NULL) != J288_OK) {
-        fprintf(stderr, "linux-status: %s\n", j288_linux_error(&port));
+    if (j288_serial_open(&port, argv[1], 0, NULL) != J288_OK) {
+        fprintf(stderr, "linux-status: %s\n", j288_serial_error(&port));
         return 1;
     }
-    j288_linux_bus_config(&port, &cfg); /* the opened baud, a reply margin for USB adapters */
+    j288_serial_bus_config(&port, &cfg); /* the opened baud, a reply margin for USB adapters */
     cfg.margin_us = 250000u;            /* a status read, not a control loop: be patient */
     cfg.retries = 2u;
-    j288_linux_bus_init(&port, &bus, &cfg);
+    j288_serial_bus_init(&port, &bus, &cfg);
 
     /* The protocol has no read-only query: a lock command (no torque) asks for the reply. */
     cmd.id = (uint8_t)id;
@@ -43,12 +43,12 @@ int main(int argc, char **argv)
     }
     if (rc != J288_OK) {
         fprintf(stderr, "linux-status: servo %ld: %s\n", id, j288_strerror(rc));
-        j288_linux_close(&port);
+        j288_serial_close(&port);
         return 1;
     }
     printf("servo %ld: output %.4f rad, %.4f rad/s, %.3f N*m; %.1f V, case %.0f C, faults 0x%lx\n",
            id, (double)si.out_pos, (double)si.speed, (double)si.torque, (double)si.voltage_v,
            (double)si.case_temp_c, (unsigned long)si.faults);
-    j288_linux_close(&port);
+    j288_serial_close(&port);
     return 0;
 }

@@ -3,7 +3,9 @@
 
 #include <string.h>
 
-#include "internal.h"
+#include "bus_priv.h"
+#include "frame_priv.h"
+#include "parser_priv.h"
 
 #define RING_MASK  (J288_CONFIG_RX_RING_SIZE - 1u)
 #define MAX_CFG_US 60000000u /* longest turnaround, margin or guard: 1 minute */
@@ -40,7 +42,7 @@ static bool is_active(uint8_t state)
     return (state >= (uint8_t)J288_BUS_TX) && (state <= (uint8_t)J288_BUS_WAIT_REPLY);
 }
 
-/* The flags (J288_BUSF_*, internal.h): one byte, so that "anything pending?" is one test. */
+/* The flags (J288_BUSF_*, bus_priv.h): one byte, so that "anything pending?" is one test. */
 static bool has_flag(const j288_bus_t *bus, uint8_t f)
 {
     return (bus->flags & f) != 0u;

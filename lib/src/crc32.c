@@ -1,7 +1,7 @@
 /* CRC32 as the STM32 CRC unit computes it; see j288/crc32.h for the contract. */
 #include "j288/crc32.h"
 
-#include "internal.h"
+#include "crc32_priv.h"
 
 /* T0[i] = i * x^32 mod P (poly 0x04C11DB7, MSB first): the CRC register's top byte i shifted
  * out through 8 bits. Generated once and checked against the bitwise backend by the tests. */

@@ -3,7 +3,7 @@
 
 #include <string.h>
 
-#include "internal.h"
+#include "frame_priv.h"
 
 /* Byte offsets on the wire (spec tables). */
 enum {

@@ -7,7 +7,7 @@
 
 #include <string.h>
 
-#include "internal.h"
+#include "frame_priv.h"
 
 /* ---- constants. Each is the exact value rounded to an integer (pi taken to 60 digits, the
  * gear ratio N = 5767 / 20 exactly); test_jointq pins them through the generator's golden

@@ -3,7 +3,8 @@
 
 #include <string.h>
 
-#include "internal.h"
+#include "frame_priv.h"
+#include "parser_priv.h"
 
 /* The frame held: from the second byte of the word-aligned store (parser.h). */
 static uint8_t *buf(j288_parser_t *p)

@@ -3,7 +3,8 @@
 
 #include <string.h>
 
-#include "internal.h"
+#include "bus_priv.h"
+#include "frame_priv.h"
 
 #define ALL_SLOTS ((uint16_t)(((uint32_t)1u << J288_MAX_SERVOS) - 1u))
 
@@ -60,14 +61,10 @@ int j288_sched_set_cmd(j288_sched_t *s, const j288_cmd_raw_t *cmd)
         return err;
     }
     locked = j288_bus_needs_lock(s->bus); /* once: nothing in between changes it */
-    if (locked) {
-        s->bus->port->lock(s->bus->port_ctx);
-    }
+    j288_bus_port_lock(s->bus, locked);
     s->slot[cmd->id].cmd = *cmd;
     s->frame_stale |= (uint16_t)((uint32_t)1u << cmd->id);
-    if (locked) {
-        s->bus->port->unlock(s->bus->port_ctx);
-    }
+    j288_bus_port_unlock(s->bus, locked);
     return J288_OK;
 }
 
@@ -218,34 +215,26 @@ static int submit_slot(j288_sched_t *s, uint8_t id, uint32_t now, bool locked)
         cleared.watchdog = false;
         return j288_bus_submit(bus, &cleared, now, sched_done, s);
     }
-    if (locked) {
-        bus->port->lock(bus->port_ctx);
-    }
+    j288_bus_port_lock(bus, locked);
     rc = J288_ERR_BUSY;
     if (j288_bus_accepts(bus)) {
         if ((s->frame_stale & bit) != 0u) {
             /* Checked fields (set_cmd, init and estop make only such commands), its id the
              * slot's */
-            j288_cmd_pack(&slot->cmd, s->frame[id], &bus->crc);
+            j288_cmd_pack(&slot->cmd, s->frame[id], j288_bus_crc(bus));
             s->frame_stale &= (uint16_t)~bit;
         }
-        if (bus->in_advance) {
-            j288_bus_queue_frame(bus, s->frame[id], id, sched_done, s); /* a completion's */
-        } else {
-            j288_bus_accept_frame(bus, s->frame[id], id, now, sched_done, s);
-        }
+        j288_bus_take_frame(bus, s->frame[id], id, now, sched_done, s);
         rc = J288_OK;
     }
-    if (locked) {
-        bus->port->unlock(bus->port_ctx);
-    }
+    j288_bus_port_unlock(bus, locked);
     return rc;
 }
 
 /* Submit the next enabled slot of this sweep; end the sweep (and start the next one when
  * continuous) when none is left. Returns J288_ERR_BUSY if the bus refused the submit. locked:
  * j288_bus_needs_lock() as the caller found it, the same before and after the submit (false
- * in a completion callback, which runs with the lock held or not needed: internal.h). */
+ * in a completion callback, which runs with the lock held or not needed: bus_priv.h). */
 static int next_slot(j288_sched_t *s, uint32_t now, bool locked)
 {
     for (;;) {

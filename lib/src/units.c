@@ -6,7 +6,7 @@
 #include <stdint.h>
 #include <string.h>
 
-#include "internal.h"
+#include "hints.h"
 
 #define N_RATIO ((j288_real_t)J288_GEAR_RATIO)
 

@@ -1,5 +1,9 @@
 """The C library, loaded with ctypes: prototypes and the structures j288_robot.h declares.
 
+Every structure below names the C type it mirrors (_c_type_); python/tests/test_layout.py
+compiles a program that prints the C compiler's size, offsets and field kinds of each, and
+fails on any difference, so that a field changed in C fails a test, not a robot.
+
 ctypes is in the standard library: nothing to install and nothing to compile for the
 binding itself, on every Python 3 Debian ships. cffi would need python3-cffi and a C compiler
 at install time (API mode) or the same hand-written declarations (ABI mode), for no gain
@@ -33,6 +37,7 @@ BROADCAST_ID = 15
 class Target(Structure):
     """j288_robot_target_t: joint frame (Robot) or output side (Bus), SI units."""
 
+    _c_type_ = "j288_robot_target_t"
     _fields_ = [("pos", c_double), ("speed", c_double), ("torque", c_double),
                 ("kp", c_double), ("kd", c_double)]
 
@@ -40,6 +45,7 @@ class Target(Structure):
 class ServoReply(Structure):
     """j288_robot_servo_t: one reply, output side."""
 
+    _c_type_ = "j288_robot_servo_t"
     _fields_ = [("id", c_uint8), ("mode", c_uint8), ("watchdog_tripped", c_bool),
                 ("pos", c_double), ("speed", c_double), ("torque", c_double),
                 ("out_pos", c_double), ("case_temp_c", c_double),
@@ -52,6 +58,7 @@ class ServoReply(Structure):
 class JointState(Structure):
     """j288_robot_state_t: one joint, joint frame."""
 
+    _c_type_ = "j288_robot_state_t"
     _fields_ = [("known", c_bool), ("online", c_bool), ("fresh", c_bool),
                 ("pos", c_double), ("speed", c_double), ("torque", c_double),
                 ("faults", c_uint32), ("warnings", c_uint8),
@@ -62,6 +69,7 @@ class JointState(Structure):
 class CycleInfo(Structure):
     """j288_robot_cycle_t."""
 
+    _c_type_ = "j288_robot_cycle_t"
     _fields_ = [("cycle", c_uint32), ("start_us", c_uint32), ("duration_us", c_uint32),
                 ("fresh", c_uint), ("joints", c_uint), ("complete", c_bool),
                 ("watchdog", c_uint)]
@@ -70,6 +78,7 @@ class CycleInfo(Structure):
 class RobotStats(Structure):
     """j288_robot_stats_t."""
 
+    _c_type_ = "j288_robot_stats_t"
     _fields_ = [("cycles", c_uint32), ("complete_cycles", c_uint32),
                 ("last_cycle_us", c_uint32), ("worst_cycle_us", c_uint32)]
 
@@ -77,6 +86,7 @@ class RobotStats(Structure):
 class BusStats(Structure):
     """j288_robot_bus_stats_t."""
 
+    _c_type_ = "j288_robot_bus_stats_t"
     _fields_ = [("sweeps", c_uint32), ("empty_sweeps", c_uint32), ("down_events", c_uint32),
                 ("last_sweep_us", c_uint32), ("worst_sweep_us", c_uint32),
                 ("up", c_bool), ("gone", c_bool)]
@@ -85,6 +95,7 @@ class BusStats(Structure):
 class SlotStats(Structure):
     """j288_slot_stats_t (sched.h)."""
 
+    _c_type_ = "j288_slot_stats_t"
     _fields_ = [(n, c_uint32) for n in (
         "transactions", "successes", "timeouts", "crc_errors", "wrong_id", "collisions",
         "other_errors", "consecutive_failures", "last_latency_us", "worst_latency_us")]
@@ -93,12 +104,14 @@ class SlotStats(Structure):
 class JointStats(Structure):
     """j288_robot_joint_stats_t."""
 
+    _c_type_ = "j288_robot_joint_stats_t"
     _fields_ = [("fresh_cycles", c_uint32), ("stale_cycles", c_uint32), ("servo", SlotStats)]
 
 
 class Options(Structure):
     """j288_robot_options_t (callbacks left NULL: Python polls)."""
 
+    _c_type_ = "j288_robot_options_t"
     _fields_ = [("port", c_char_p), ("baud", c_uint32), ("margin_us", c_uint32),
                 ("down_after", c_uint8), ("no_low_latency", c_bool),
                 ("on_event", c_void_p), ("on_cycle", c_void_p), ("user", c_void_p),
@@ -109,13 +122,14 @@ class Options(Structure):
 class TimingSummary(Structure):
     """j288_rt_summary_t (host/j288_rt.h): one histogram's percentiles, microseconds."""
 
+    _c_type_ = "j288_rt_summary_t"
     _fields_ = [(n, c_uint32) for n in ("count", "p50_us", "p99_us", "p999_us", "max_us")]
 
 
 class TimingReport(Structure):
-    """j288_rt_report_t: the loop's timing (python/tests check that the C side writes no
-    more than this)."""
+    """j288_rt_report_t: the loop's timing."""
 
+    _c_type_ = "j288_rt_report_t"
     _fields_ = [("cycles", c_uint32), ("period_us", c_uint32), ("missed", c_uint32),
                 ("skipped", c_uint32), ("cut", c_uint32), ("lateness", TimingSummary),
                 ("duration", TimingSummary), ("priority", c_int32), ("cpu", c_int32),

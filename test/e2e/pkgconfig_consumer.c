@@ -28,7 +28,7 @@ int main(void)
         return 1;
     for (i = 0; i < J288_CMD_LEN; i++)
         (void)snprintf(hex + 2 * i, 3, "%02x", out[i]);
-    if (strcmp(hex, expect) != 0 || !j288_linux_baud_ok(6000000u, 6000000u) ||
+    if (strcmp(hex, expect) != 0 || !j288_serial_baud_ok(6000000u, 6000000u) ||
         strcmp(j288_robot_version(), J288_VERSION_STRING) != 0) {
         fprintf(stderr, "pkgconfig_consumer: got %s\n", hex);
         return 1;

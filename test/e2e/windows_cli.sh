@@ -37,7 +37,7 @@ sim b com12 --seed 7 || exit 1
 
 t_6mbps_refused() {
     J288_BAUD= j288 --port COM11 scan
-    [ "$E2E_RC" -eq 1 ] && [[ "$E2E_ERR" == *"cannot do 6000000 baud (its driver reports 38400)"* ]] ||
+    [ "$E2E_RC" -eq 1 ] && [[ "$E2E_ERR" == *"cannot do 6000000 baud (it reports 38400)"* ]] ||
         { echo "exit $E2E_RC: $E2E_ERR"; return 1; }
     J288_BAUD=fast j288 --port COM11 scan
     [ "$E2E_RC" -eq 2 ] && [[ "$E2E_ERR" == *'$J288_BAUD'* ]] || { echo "exit $E2E_RC: $E2E_ERR"; return 1; }

@@ -51,7 +51,7 @@
 #include "j288/bus.h"
 #include "j288/frame.h"
 
-#include "../../lib/src/internal.h" /* j288_bus_accepts(), j288_bus_accept_frame() */
+#include "../../lib/src/bus_priv.h" /* j288_bus_accepts(), j288_bus_accept_frame() */
 
 #include <string.h>
 

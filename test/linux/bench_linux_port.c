@@ -18,7 +18,8 @@
 #include <unistd.h>
 
 #include "j288/j288.h"
-#include "j288_linux.h"
+#include "j288_serial.h"
+#include "serial_loop.h"
 
 #ifndef J288_SIM_DEFAULT
 #define J288_SIM_DEFAULT "build/bin/j288-sim"
@@ -64,14 +65,14 @@ int main(int argc, char **argv)
     const char *sim = (argc > 1) ? argv[1] : J288_SIM_DEFAULT;
     long n = (argc > 2) ? strtol(argv[2], NULL, 10) : 5000;
     char pty[128];
-    j288_linux_t lp;
-    j288_linux_options_t opt;
+    j288_serial_t sp;
+    j288_serial_options_t opt;
     j288_bus_t bus;
     j288_sched_t s;
     j288_cmd_raw_t c;
     j288_txn_t txn;
     uint32_t *lat, t0, t1, waits0;
-    j288_linux_stats_t st0;
+    j288_serial_stats_t st0;
     long i, ok = 0, sweeps = 0;
     pid_t pid;
     int status, rc = 0;
@@ -88,9 +89,9 @@ int main(int argc, char **argv)
     }
     memset(&opt, 0, sizeof opt);
     opt.margin_us = 10000;
-    if (j288_linux_open(&lp, pty, 0, &opt) != J288_OK ||
-        j288_linux_bus_init(&lp, &bus, NULL) != J288_OK) {
-        fprintf(stderr, "%s\n", j288_linux_error(&lp));
+    if (j288_serial_open(&sp, pty, 0, &opt) != J288_OK ||
+        j288_serial_bus_init(&sp, &bus, NULL) != J288_OK) {
+        fprintf(stderr, "%s\n", j288_serial_error(&sp));
         rc = 1;
         goto out;
     }
@@ -98,13 +99,13 @@ int main(int argc, char **argv)
     c.id = 1;
     c.watchdog = true;
 
-    st0 = *j288_linux_stats(&lp);
-    t0 = j288_linux_now_us();
+    st0 = *j288_serial_stats(&sp);
+    t0 = j288_serial_now_us();
     for (i = 0; i < n; i++) {
         if (j288_bus_transfer_blocking(&bus, &c, &txn) == J288_OK)
             lat[ok++] = txn.latency_us;
     }
-    t1 = j288_linux_now_us();
+    t1 = j288_serial_now_us();
     qsort(lat, (size_t)ok, sizeof *lat, cmp_u32);
     printf("blocking transfers: %ld of %ld ok, %.0f per second\n", ok, n,
            (double)n * 1e6 / (double)(t1 - t0));
@@ -114,7 +115,7 @@ int main(int argc, char **argv)
                (unsigned long)lat[ok / 2], (unsigned long)lat[ok * 9 / 10],
                (unsigned long)lat[ok * 99 / 100], (unsigned long)lat[ok - 1]);
     {
-        const j288_linux_stats_t *st = j288_linux_stats(&lp);
+        const j288_serial_stats_t *st = j288_serial_stats(&sp);
         printf("  per transaction: %.2f waits (ppoll), %.1f bytes out, %.1f bytes in, "
                "%.2f partial writes\n",
                (double)(st->waits - st0.waits) / (double)n,
@@ -126,23 +127,23 @@ int main(int argc, char **argv)
     (void)j288_sched_init(&s, &bus, NULL);
     for (c.id = 1; c.id <= 3; c.id++)
         (void)j288_sched_enable(&s, c.id, true);
-    waits0 = j288_linux_stats(&lp)->waits;
-    t0 = j288_linux_now_us();
+    waits0 = j288_serial_stats(&sp)->waits;
+    t0 = j288_serial_now_us();
     for (i = 0; i < n / 3; i++)
-        if (j288_linux_sweep(&lp, &s, 0) == J288_OK)
+        if (serial_loop_sweep(&sp, &bus, &s, 0) == J288_OK)
             sweeps++;
-    t1 = j288_linux_now_us();
+    t1 = j288_serial_now_us();
     printf("back-to-back sweeps over 3 servos: %ld of %ld complete, %.0f sweeps per second, "
            "%.2f waits per sweep\n",
            sweeps, n / 3, (double)(n / 3) * 1e6 / (double)(t1 - t0),
-           (double)(j288_linux_stats(&lp)->waits - waits0) / (double)(n / 3));
+           (double)(j288_serial_stats(&sp)->waits - waits0) / (double)(n / 3));
     for (c.id = 1; c.id <= 3; c.id++) {
         const j288_slot_t *sl = j288_sched_slot(&s, c.id);
         printf("  servo %u: %lu ok, %lu timeouts, worst latency %lu us\n", (unsigned)c.id,
                (unsigned long)sl->stats.successes, (unsigned long)sl->stats.timeouts,
                (unsigned long)sl->stats.worst_latency_us);
     }
-    j288_linux_close(&lp);
+    j288_serial_close(&sp);
 out:
     (void)kill(pid, SIGTERM);
     (void)waitpid(pid, &status, 0);

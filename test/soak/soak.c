@@ -57,7 +57,8 @@
 #include <unistd.h>
 
 #include "j288/j288.h"
-#include "j288_linux.h"
+#include "j288_serial.h"
+#include "serial_loop.h"
 
 #define MAX_ARGS         40
 #define SIM_LATE_US      30000u /* --late-us below */
@@ -323,22 +324,22 @@ static uint16_t parse_ids(const char *s)
     return m;
 }
 
-static int open_bus(j288_linux_t *lp, j288_bus_t *bus, const char *pty, uint32_t margin_us)
+static int open_bus(j288_serial_t *sp, j288_bus_t *bus, const char *pty, uint32_t margin_us)
 {
-    j288_linux_options_t opt;
+    j288_serial_options_t opt;
     memset(&opt, 0, sizeof opt);
     opt.margin_us = margin_us;
     opt.no_low_latency = true;
-    if (j288_linux_open(lp, pty, 0, &opt) != J288_OK) {
-        fprintf(stderr, "soak: %s\n", j288_linux_error(lp));
+    if (j288_serial_open(sp, pty, 0, &opt) != J288_OK) {
+        fprintf(stderr, "soak: %s\n", j288_serial_error(sp));
         return -1;
     }
-    return (j288_linux_bus_init(lp, bus, NULL) == J288_OK) ? 0 : -1;
+    return (j288_serial_bus_init(sp, bus, NULL) == J288_OK) ? 0 : -1;
 }
 
 /* The whole run's state: one simulator, one port, one bus, one scheduler. */
 typedef struct {
-    j288_linux_t lp;
+    j288_serial_t sp;
     j288_bus_t bus;
     j288_sched_t sched;
     baseline_t base[J288_MAX_SERVOS];
@@ -390,7 +391,7 @@ static void enable_slots(soak_t *k)
 static int sweep_checked(soak_t *k, bool clean, const char *what)
 {
     uint8_t id;
-    int rc = j288_linux_sweep(&k->lp, &k->sched, 0);
+    int rc = serial_loop_sweep(&k->sp, &k->bus, &k->sched, 0);
     CHECK(rc == J288_OK, "%s: sweep %lu: %s", what, k->sweeps, j288_strerror(rc));
     if (rc != J288_OK) {
         return rc;
@@ -543,7 +544,7 @@ int main(int argc, char **argv)
                               "--late", "0.001",     "--late-us", late_text, "--noise",
                               "0.01",   "--dup",     dup_text,    NULL};
         if (sim_start(&sim, sim_path, args) != 0 ||
-            open_bus(&k.lp, &k.bus, sim.pty, margin_us) != 0) {
+            open_bus(&k.sp, &k.bus, sim.pty, margin_us) != 0) {
             fprintf(stderr, "soak: cannot start the simulator or open %s\n", sim.pty);
             return 1;
         }
@@ -610,16 +611,16 @@ int main(int argc, char **argv)
      * failure guard after that (one budget) are over before the next sweep. */
     settle_us = SIM_LATE_US + 2u * j288_bus_reply_budget_us(&k.bus);
     stale_settle = j288_bus_stats(&k.bus)->stale_bytes;
-    (void)j288_linux_run(&k.lp, &k.sched, j288_linux_now_us() + settle_us, 0u);
+    (void)serial_loop_run(&k.sp, &k.bus, &k.sched, j288_serial_now_us() + settle_us, 0u);
     stale_settle = j288_bus_stats(&k.bus)->stale_bytes - stale_settle;
 
     /* ---- phase 2: the very next sweep brings every servo back, then a clean bus */
     failure_counters(&k.bus, fail_before);
     {
         unsigned long before = g_failures;
-        uint32_t t0 = j288_linux_now_us();
+        uint32_t t0 = j288_serial_now_us();
         int rc = sweep_checked(&k, true, "first sweep after the faults stopped");
-        recovery_us = j288_linux_now_us() - t0;
+        recovery_us = j288_serial_now_us() - t0;
         recovered = (rc == J288_OK && g_failures == before);
         for (id = 0; id < J288_MAX_SERVOS; id++) {
             online_ev_recovery += in_ids(&k, id) ? k.online_ev[id] : 0u;
@@ -652,7 +653,7 @@ int main(int argc, char **argv)
            "the first sweep after brought %lu back in %u us\n",
            offline_at_switch, extra_sweeps, online_ev_recovery, recovery_us);
 
-    j288_linux_close(&k.lp);
+    j288_serial_close(&k.sp);
     sim_stop(&sim, &st_end);
     CHECK(st_end.parsed, "no statistics line from the simulator");
     CHECK(injected_faults(&st_end) == injected_faults(&st_off),

@@ -12,7 +12,8 @@
 #include <string.h>
 
 #include "j288/j288.h"
-#include "j288_windows.h"
+#include "j288_serial.h"
+#include "serial_loop.h"
 
 static int cmp_u32(const void *a, const void *b)
 {
@@ -20,10 +21,10 @@ static int cmp_u32(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
-static void transfers(j288_windows_t *wp, j288_bus_t *bus, long n, uint32_t *lat)
+static void transfers(j288_serial_t *sp, j288_bus_t *bus, long n, uint32_t *lat)
 {
-    j288_windows_stats_t st0 = *j288_windows_stats(wp);
-    const j288_windows_stats_t *st = j288_windows_stats(wp);
+    j288_serial_stats_t st0 = *j288_serial_stats(sp);
+    const j288_serial_stats_t *st = j288_serial_stats(sp);
     j288_cmd_raw_t c;
     j288_txn_t txn;
     uint32_t t0, t1;
@@ -31,12 +32,12 @@ static void transfers(j288_windows_t *wp, j288_bus_t *bus, long n, uint32_t *lat
     memset(&c, 0, sizeof c);
     c.id = 1;
     c.watchdog = true;
-    t0 = j288_windows_now_us();
+    t0 = j288_serial_now_us();
     for (i = 0; i < n; i++) {
         if (j288_bus_transfer_blocking(bus, &c, &txn) == J288_OK)
             lat[ok++] = txn.latency_us;
     }
-    t1 = j288_windows_now_us();
+    t1 = j288_serial_now_us();
     qsort(lat, (size_t)ok, sizeof *lat, cmp_u32);
     printf("blocking transfers: %ld of %ld ok, %.0f per second\n", ok, n,
            (double)n * 1e6 / (double)(t1 - t0));
@@ -52,7 +53,7 @@ static void transfers(j288_windows_t *wp, j288_bus_t *bus, long n, uint32_t *lat
            (double)(st->rx_bytes - st0.rx_bytes) / (double)n);
 }
 
-static void sweeps(j288_windows_t *wp, j288_bus_t *bus, long n)
+static void sweeps(j288_serial_t *sp, j288_bus_t *bus, long n)
 {
     j288_sched_t s;
     uint32_t t0, t1, waits0;
@@ -61,16 +62,16 @@ static void sweeps(j288_windows_t *wp, j288_bus_t *bus, long n)
     (void)j288_sched_init(&s, bus, NULL);
     for (id = 1; id <= 3; id++)
         (void)j288_sched_enable(&s, id, true);
-    waits0 = j288_windows_stats(wp)->waits;
-    t0 = j288_windows_now_us();
+    waits0 = j288_serial_stats(sp)->waits;
+    t0 = j288_serial_now_us();
     for (i = 0; i < n; i++)
-        if (j288_windows_sweep(wp, &s, 0) == J288_OK)
+        if (serial_loop_sweep(sp, bus, &s, 0) == J288_OK)
             done++;
-    t1 = j288_windows_now_us();
+    t1 = j288_serial_now_us();
     printf("back-to-back sweeps over 3 servos: %ld of %ld complete, %.0f sweeps per second, "
            "%.2f waits per sweep\n",
            done, n, (double)n * 1e6 / (double)(t1 - t0),
-           (double)(j288_windows_stats(wp)->waits - waits0) / (double)n);
+           (double)(j288_serial_stats(sp)->waits - waits0) / (double)n);
     for (id = 1; id <= 3; id++) {
         const j288_slot_t *sl = j288_sched_slot(&s, id);
         printf("  servo %u: %lu ok, %lu timeouts, worst latency %lu us\n", (unsigned)id,
@@ -83,8 +84,8 @@ int main(int argc, char **argv)
 {
     long n = (argc > 2) ? strtol(argv[2], NULL, 10) : 5000;
     uint32_t baud = (argc > 3) ? (uint32_t)strtoul(argv[3], NULL, 10) : 4000000u;
-    j288_windows_options_t opt;
-    j288_windows_t wp;
+    j288_serial_options_t opt;
+    j288_serial_t sp;
     j288_bus_t bus;
     uint32_t *lat;
     if (argc < 2 || n < 10 || n > 1000000) {
@@ -94,16 +95,16 @@ int main(int argc, char **argv)
     lat = calloc((size_t)n, sizeof *lat);
     memset(&opt, 0, sizeof opt);
     opt.margin_us = 10000;
-    if (lat == NULL || j288_windows_open(&wp, argv[1], baud, &opt) != J288_OK ||
-        j288_windows_bus_init(&wp, &bus, NULL) != J288_OK) {
-        fprintf(stderr, "%s\n", j288_windows_error(&wp));
+    if (lat == NULL || j288_serial_open(&sp, argv[1], baud, &opt) != J288_OK ||
+        j288_serial_bus_init(&sp, &bus, NULL) != J288_OK) {
+        fprintf(stderr, "%s\n", j288_serial_error(&sp));
         free(lat);
         return 1;
     }
-    printf("%s at %lu baud\n", argv[1], (unsigned long)j288_windows_baud(&wp));
-    transfers(&wp, &bus, n, lat);
-    sweeps(&wp, &bus, n / 3);
-    j288_windows_close(&wp);
+    printf("%s at %lu baud\n", argv[1], (unsigned long)j288_serial_baud(&sp));
+    transfers(&sp, &bus, n, lat);
+    sweeps(&sp, &bus, n / 3);
+    j288_serial_close(&sp);
     free(lat);
     return 0;
 }

@@ -66,7 +66,7 @@ typedef enum { TIMEOUT_HOLD = 0, TIMEOUT_LOCK } bridge_timeout_policy_t;
 
 typedef struct {
     bridge_joint_mode_t mode;
-    uint32_t last_cmd_us;  /* j288_linux_now_us() when its latest command was accepted */
+    uint32_t last_cmd_us;  /* j288_robot_now_us() when its latest command was accepted */
     uint32_t accepted;     /* commands accepted for this joint */
     uint32_t timeouts;
     uint32_t watchdog;     /* servo watchdog trips the runner found and cleared */

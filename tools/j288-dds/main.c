@@ -15,7 +15,6 @@
 #include <dds/dds.h>
 
 #include "bridge.h"
-#include "j288_linux.h"
 
 #define DIAG_PERIOD_US 1000000u
 #define DEFAULT_RATE_HZ 500.0
@@ -312,7 +311,7 @@ static void take_commands(bridge_t *b, const dds_io_t *io, bool unitree)
     void *samples[TAKE_MAX] = {NULL};
     dds_sample_info_t info[TAKE_MAX];
     dds_return_t n = dds_take(io->cmd_r, samples, info, TAKE_MAX, TAKE_MAX);
-    uint32_t now = j288_linux_now_us();
+    uint32_t now = j288_robot_now_us();
     dds_return_t i;
     for (i = 0; i < n; i++) {
         if (!info[i].valid_data)
@@ -426,13 +425,13 @@ static int run(const options_t *o)
             o->ns != NULL ? " in namespace " : "", o->ns != NULL ? o->ns : "",
             o->rate_hz > 0 ? "paced" : "back to back");
     start_s = mono_s();
-    last_diag = j288_linux_now_us();
+    last_diag = j288_robot_now_us();
     publish_diagnostics(&b, &io);
     j288_robot_timing_reset(&robot);
     (void)j288_robot_pace(&robot, period_us); /* the schedule starts with the first cycle */
     while (stop_signal == 0) {
         take_commands(&b, &io, o->unitree);
-        bridge_check_timeouts(&b, j288_linux_now_us());
+        bridge_check_timeouts(&b, j288_robot_now_us());
         rc = j288_robot_cycle(&robot, 0, NULL);
         handle_events(&b, &pending);
         if (rc == J288_ERR_ABORTED)
@@ -445,8 +444,8 @@ static int run(const options_t *o)
         if (rc == J288_ERR_OFFLINE) /* stop on bus loss: the runner locked every bus */
             bridge_stopped(&b, j288_robot_error(&robot));
         publish_state(&b, &io, o->unitree, start_s);
-        if ((uint32_t)(j288_linux_now_us() - last_diag) >= DIAG_PERIOD_US) {
-            last_diag = j288_linux_now_us();
+        if ((uint32_t)(j288_robot_now_us() - last_diag) >= DIAG_PERIOD_US) {
+            last_diag = j288_robot_now_us();
             publish_diagnostics(&b, &io);
         }
         rc = j288_robot_pace(&robot, period_us); /* absolute deadlines, j288_rt.h */

@@ -327,7 +327,7 @@ void cli_lock_cmd(uint8_t id, j288_cmd_raw_t *cmd)
 /* Whether a lock not yet confirmed is sent once more (see LOCK_CONFIRM_US). */
 static bool lock_keeps_trying(int attempts, uint32_t start_us)
 {
-    return attempts < LOCK_ATTEMPTS || j288_linux_now_us() - start_us < LOCK_CONFIRM_US;
+    return attempts < LOCK_ATTEMPTS || j288_robot_now_us() - start_us < LOCK_CONFIRM_US;
 }
 
 int cli_bus_lock_driven(cli_bus_t *b)
@@ -340,7 +340,7 @@ int cli_bus_lock_driven(cli_bus_t *b)
     if (cli_bus_gone(b)) {
         return b->driven != 0u ? 1 : 0;
     }
-    start = j288_linux_now_us();
+    start = j288_robot_now_us();
     for (id = 0; id <= J288_MAX_ID; id++) {
         int attempt, rc = J288_ERR_TIMEOUT;
         if ((b->driven & (1u << id)) == 0u) {

@@ -21,7 +21,6 @@
 
 #include "args.h"
 #include "cli.h"
-#include "j288_host_port.h"
 #include "j288_robot.h"
 #include "j288_robot_config.h"
 #include "json.h"
@@ -173,7 +172,7 @@ int cli_bus_lock_driven(cli_bus_t *b);
  * or the port's own message when the device is gone. */
 void cli_report_txn_failure(cli_bus_t *b, uint8_t id, int rc);
 
-/* Sleep until until_us (j288_linux_now_us() time) while the runner keeps the port serviced
+/* Sleep until until_us (j288_robot_now_us() time) while the runner keeps the port serviced
  * (j288_robot_idle()). Returns J288_OK, J288_ERR_ABORTED (stop signal) or J288_ERR_OFFLINE. */
 int cli_bus_sleep_until(cli_bus_t *b, uint32_t until_us);
 

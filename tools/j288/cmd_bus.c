@@ -878,14 +878,14 @@ static drive_end_t drive_loop_run(cli_bus_t *b, drive_args_t *d, const drive_pla
                               drive_result_t *res)
 {
     uint32_t period_us = (uint32_t)lround(1e6 / d->rate_hz);
-    uint32_t t0 = j288_linux_now_us();
+    uint32_t t0 = j288_robot_now_us();
     int fails = 0, rc;
     res->robot = b->robot;
     j288_robot_timing_reset(b->robot); /* the start's reads are not the loop's */
     (void)j288_robot_pace(b->robot, period_us); /* the schedule starts with the first step */
     for (;;) {
         j288_rt_report_t rep;
-        double t = (double)(uint32_t)(j288_linux_now_us() - t0) / 1e6;
+        double t = (double)(uint32_t)(j288_robot_now_us() - t0) / 1e6;
         if (cli_stop_signal != 0) {
             return DRIVE_END_SIGNAL;
         }

@@ -273,7 +273,7 @@ static int cal_move(cli_bus_t *b, j288_joint_t *j, j288_cal_t *cal, const cal_pa
                     const joint_args_t *a, const char *name)
 {
     uint32_t period_us = (uint32_t)lround(1e6 / a->rate_hz);
-    uint32_t t0 = j288_linux_now_us(), next = t0;
+    uint32_t t0 = j288_robot_now_us(), next = t0;
     int fails = 0;
     double end_s = -1.0; /* when the path ended */
     for (;;) {
@@ -281,7 +281,7 @@ static int cal_move(cli_bus_t *b, j288_joint_t *j, j288_cal_t *cal, const cal_pa
         j288_cmd_raw_t cmd;
         j288_txn_t txn;
         unsigned events = 0;
-        double el = (double)(uint32_t)(j288_linux_now_us() - t0) / 1e6;
+        double el = (double)(uint32_t)(j288_robot_now_us() - t0) / 1e6;
         int rc;
         if (cli_stop_signal != 0) {
             return cli_signal_exit_code();
@@ -320,8 +320,8 @@ static int cal_move(cli_bus_t *b, j288_joint_t *j, j288_cal_t *cal, const cal_pa
             }
         }
         next += period_us;
-        if ((int32_t)(next - j288_linux_now_us()) < 0) {
-            next = j288_linux_now_us();
+        if ((int32_t)(next - j288_robot_now_us()) < 0) {
+            next = j288_robot_now_us();
         }
         if (cli_bus_sleep_until(b, next) == J288_ERR_OFFLINE) {
             cli_report_txn_failure(b, j->cfg.id, J288_ERR_OFFLINE);

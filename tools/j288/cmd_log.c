@@ -823,11 +823,11 @@ static log_end_t log_cycles(log_run_t *r)
 {
     uint32_t period_us = (uint32_t)lround(1e6 / r->a.rate_hz);
     log_end_t end = LOG_DONE;
-    r->t0 = j288_linux_now_us();
+    r->t0 = j288_robot_now_us();
     j288_robot_timing_reset(r->b.robot); /* the probe's sweeps are not the log's */
     (void)j288_robot_pace(r->b.robot, period_us); /* the schedule starts with the first tick */
     for (;;) {
-        double t = (double)(uint32_t)(j288_linux_now_us() - r->t0) / 1e6;
+        double t = (double)(uint32_t)(j288_robot_now_us() - r->t0) / 1e6;
         if (t >= r->a.duration_s) {
             break;
         }
@@ -841,7 +841,7 @@ static log_end_t log_cycles(log_run_t *r)
             break;
         }
     }
-    r->rs.elapsed_s = (double)(uint32_t)(j288_linux_now_us() - r->t0) / 1e6;
+    r->rs.elapsed_s = (double)(uint32_t)(j288_robot_now_us() - r->t0) / 1e6;
     return end;
 }
 

@@ -516,7 +516,7 @@ int cli_cmd_robot(int argc, char **argv, const cli_global_t *g)
         period_us = 1u;
     {
         j288_robot_stats_t before, after;
-        uint32_t t0 = j288_linux_now_us(), dur_us;
+        uint32_t t0 = j288_robot_now_us(), dur_us;
         bool forever = strcmp(cmd, "hold") == 0 && !a.have_duration;
         (void)j288_robot_stats(&robot, &before);
         j288_robot_timing_reset(&robot);
@@ -527,11 +527,11 @@ int cli_cmd_robot(int argc, char **argv, const cli_global_t *g)
         t_end = t0 + dur_us;
         do {
             /* Runs of at most 10 min keep the 32-bit clock's comparisons valid. */
-            uint32_t left = forever ? 600000000u : t_end - j288_linux_now_us();
+            uint32_t left = forever ? 600000000u : t_end - j288_robot_now_us();
             if (!forever && (int32_t)left <= 0)
                 break;
             rc = j288_robot_run(&robot, period_us, 0, left > 600000000u ? 600000000u : left);
-        } while (rc == J288_OK && (forever || (int32_t)(t_end - j288_linux_now_us()) > 0));
+        } while (rc == J288_OK && (forever || (int32_t)(t_end - j288_robot_now_us()) > 0));
         (void)j288_robot_stats(&robot, &after);
         run.csv = NULL;
         if (csv != NULL && fclose(csv) != 0)
@@ -539,7 +539,7 @@ int cli_cmd_robot(int argc, char **argv, const cli_global_t *g)
         if (rc == J288_ERR_OFFLINE)
             cli_error("%s", j288_robot_error(&robot));
         if (rc != J288_ERR_ABORTED || cli_stop_signal != 0) {
-            double secs = (double)(j288_linux_now_us() - t0) * 1e-6;
+            double secs = (double)(j288_robot_now_us() - t0) * 1e-6;
             if (a.json) {
                 cli_json_t jw;
                 cli_json_init(&jw, stdout);
