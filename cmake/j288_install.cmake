@@ -24,6 +24,7 @@ if(TARGET j288_shared)
     install(FILES "${PROJECT_SOURCE_DIR}/port/desktop/j288_serial.h"
                   "${PROJECT_SOURCE_DIR}/port/linux/j288_linux.h"
                   "${PROJECT_SOURCE_DIR}/host/j288_robot.h"
+                  "${PROJECT_SOURCE_DIR}/host/j288_rt.h"
                   "${PROJECT_SOURCE_DIR}/host/j288_robot_config.h"
             DESTINATION "${CMAKE_INSTALL_INCLUDEDIR}/j288")
     # prefix relative to ${pcfiledir}: the file holds wherever the files land (DESTDIR) or move.

@@ -19,6 +19,8 @@ target_link_libraries(j288_linux PUBLIC j288::j288)
 find_library(J288_YAML_LIB yaml)
 find_path(J288_YAML_INCLUDE yaml.h)
 set(_j288_robot_sources "${PROJECT_SOURCE_DIR}/host/j288_robot.c"
+                        "${PROJECT_SOURCE_DIR}/host/j288_rt.c"
+                        "${PROJECT_SOURCE_DIR}/host/j288_rt_linux.c"
                         "${PROJECT_SOURCE_DIR}/host/j288_robot_config.c"
                         "${PROJECT_SOURCE_DIR}/host/j288_number.c")
 add_library(j288_robot STATIC ${_j288_robot_sources})

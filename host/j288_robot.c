@@ -354,6 +354,24 @@ static int add_joint(j288_robot_t *r, const j288_robot_config_joint_t *cj, unsig
     return J288_OK;
 }
 
+/* The thread's real time (j288_rt.h), before any bus is opened: a CPU it may not run on is
+ * refused with nothing opened (an open that fails later undoes it). */
+static int setup_rt(j288_robot_t *r)
+{
+    j288_rt_options_t o;
+    int rc;
+    j288_rt_options_init(&o);
+    o.priority = r->opt.realtime;
+    if (r->opt.pin_cpu)
+        o.cpu = r->opt.cpu;
+    if (o.priority == 0 && o.cpu < 0)
+        return J288_OK;
+    rc = j288_rt_setup(&o, &r->rt);
+    if (rc != J288_OK)
+        set_err(r, "%.*s", (int)strcspn(r->rt.notice, "\n"), r->rt.notice);
+    return rc;
+}
+
 static void close_buses(j288_robot_t *r)
 {
     unsigned i;
@@ -377,6 +395,8 @@ int j288_robot_open(j288_robot_t *r, const j288_robot_config_t *cfg,
         return J288_ERR_NULL;
     }
     rc = check_config(r, cfg);
+    if (rc == J288_OK)
+        rc = setup_rt(r);
     if (rc != J288_OK)
         return rc;
     if (cfg->nbuses == 0u) {
@@ -390,6 +410,7 @@ int j288_robot_open(j288_robot_t *r, const j288_robot_config_t *cfg,
     for (i = 0; rc == J288_OK && i < cfg->njoints; i++)
         rc = add_joint(r, &cfg->joint[i], (cfg->nbuses == 0u) ? 0u : (unsigned)cfg->joint[i].bus);
     if (rc != J288_OK) {
+        j288_rt_restore(&r->rt);
         close_buses(r);
         r->nbuses = 0;
         r->njoints = 0;
@@ -442,12 +463,15 @@ void j288_robot_close(j288_robot_t *r)
     if (r->driven)
         (void)j288_robot_stop(r);
     close_buses(r);
+    j288_rt_restore(&r->rt);
 }
 
 void j288_robot_close_keep(j288_robot_t *r)
 {
-    if (r != NULL)
+    if (r != NULL) {
         close_buses(r);
+        j288_rt_restore(&r->rt);
+    }
 }
 
 void j288_robot_set_stop_flag(j288_robot_t *r, const volatile sig_atomic_t *flag)
@@ -632,8 +656,10 @@ int j288_robot_cycle(j288_robot_t *r, uint32_t timeout_us, j288_robot_cycle_t *i
         if (cycle_done(r))
             break;
         if (us_until(until, now) <= 0) {
-            if (drained)
+            if (drained) {
+                r->timing.cut++; /* ended by its bound, not by its buses */
                 break;
+            }
             /* A host woken past the bound (a loaded machine) first takes the replies that
              * came meanwhile, as the ports do before a reply's deadline. */
             drained = true;
@@ -649,45 +675,102 @@ int j288_robot_cycle(j288_robot_t *r, uint32_t timeout_us, j288_robot_cycle_t *i
     return info->complete ? J288_OK : J288_ERR_TIMEOUT;
 }
 
-/* Sleep until t (a cycle's start), still serving buses that sweep in the background. */
-static int wait_until(j288_robot_t *r, uint32_t t)
+static bool any_pending(const j288_robot_t *r)
+{
+    unsigned i;
+    for (i = 0; i < r->nbuses; i++) {
+        if (bus_live(&r->bus[i]) && bus_pending(&r->bus[i]))
+            return true;
+    }
+    return false;
+}
+
+/* Sleep until the monotonic time until_ns, still serving buses that sweep in the background
+ * (then in the ports' wait, to the microsecond); with nothing in flight, in one absolute
+ * clock_nanosleep (in slices of STOP_SLICE_US with a stop flag, which a signal landing just
+ * before the sleep could otherwise miss). *woke_ns: the first clock reading past until_ns,
+ * taken before anything else runs. */
+static int sleep_until_ns(j288_robot_t *r, uint64_t until_ns, uint64_t *woke_ns)
 {
     for (;;) {
+        uint64_t now_ns = j288_rt_now_ns();
         uint32_t now = j288_serial_now_us();
+        if (now_ns >= until_ns) {
+            *woke_ns = now_ns;
+            poll_all(r, now);
+            return J288_OK;
+        }
         poll_all(r, now);
+        if (!any_live(r))
+            return J288_ERR_OFFLINE;
         if (stop_requested(r))
             return J288_ERR_ABORTED;
-        if (us_until(t, now) <= 0)
-            return J288_OK;
-        wait_all(r, now, t);
+        if (any_pending(r)) {
+            uint64_t left_us = (until_ns - now_ns + 999u) / 1000u;
+            wait_all(r, now, now + (uint32_t)(left_us < STOP_SLICE_US ? left_us : STOP_SLICE_US));
+        } else {
+            uint64_t t = until_ns;
+            if (r->stop_flag != NULL && t - now_ns > (uint64_t)STOP_SLICE_US * 1000u)
+                t = now_ns + (uint64_t)STOP_SLICE_US * 1000u;
+            (void)j288_rt_sleep_until(t);
+        }
     }
+}
+
+int j288_robot_pace(j288_robot_t *r, uint32_t period_us)
+{
+    uint64_t until = 0, woke;
+    bool slept = false;
+    int rc;
+    if (r == NULL)
+        return J288_ERR_NULL;
+    woke = j288_rt_now_ns();
+    if (j288_rt_pace_begin(&r->pacer, &r->timing, (uint64_t)period_us * 1000u, woke, &until)) {
+        rc = sleep_until_ns(r, until, &woke);
+        if (rc != J288_OK)
+            return rc;
+        slept = true;
+    }
+    j288_rt_pace_woke(&r->pacer, &r->timing, woke, slept);
+    if (!any_live(r))
+        return J288_ERR_OFFLINE;
+    return stop_requested(r) ? J288_ERR_ABORTED : J288_OK;
+}
+
+void j288_robot_pace_restart(j288_robot_t *r)
+{
+    if (r != NULL)
+        j288_rt_pace_restart(&r->pacer);
+}
+
+/* Whether a run of duration_us from t0_ns is over before its next cycle. */
+static bool run_over(const j288_robot_t *r, uint32_t period_us, uint64_t t0_ns,
+                     uint32_t duration_us)
+{
+    uint64_t end = t0_ns + (uint64_t)duration_us * 1000u, due;
+    if (duration_us == 0u)
+        return false;
+    if (j288_rt_pace_next_due(&r->pacer, (uint64_t)period_us * 1000u, &due))
+        return due >= end;
+    return j288_rt_now_ns() >= end;
 }
 
 int j288_robot_run(j288_robot_t *r, uint32_t period_us, uint32_t ncycles, uint32_t duration_us)
 {
-    uint32_t t0, next, done = 0;
+    uint64_t t0;
+    uint32_t done = 0;
     if (r == NULL)
         return J288_ERR_NULL;
-    t0 = j288_serial_now_us();
-    next = t0;
+    t0 = j288_rt_now_ns();
     for (;;) {
-        uint32_t now;
         int rc;
-        if (ncycles != 0u && done >= ncycles)
+        if ((ncycles != 0u && done >= ncycles) || run_over(r, period_us, t0, duration_us))
             return J288_OK;
-        if (period_us != 0u) {
-            if (wait_until(r, next) != J288_OK) {
-                (void)j288_robot_stop(r);
-                return J288_ERR_ABORTED;
-            }
-            now = j288_serial_now_us();
-            next += period_us;
-            if (us_until(next, now) < 0)
-                next = now; /* late: start at once, do not catch up */
-        }
-        now = j288_serial_now_us();
-        if (duration_us != 0u && now - t0 >= duration_us)
-            return J288_OK;
+        rc = j288_robot_pace(r, period_us);
+        if (rc == J288_ERR_ABORTED)
+            (void)j288_robot_stop(r);
+        if (rc != J288_OK)
+            return rc;
         rc = j288_robot_cycle(r, 0, NULL);
         if (rc == J288_ERR_ABORTED || rc == J288_ERR_OFFLINE || rc == J288_ERR_NULL)
             return rc;
@@ -997,6 +1080,25 @@ int j288_robot_stats(const j288_robot_t *r, j288_robot_stats_t *out)
         return J288_ERR_NULL;
     *out = r->stats;
     return J288_OK;
+}
+
+int j288_robot_timing(const j288_robot_t *r, j288_rt_report_t *out)
+{
+    if (r == NULL || out == NULL)
+        return J288_ERR_NULL;
+    j288_rt_report(&r->timing, &r->rt, out);
+    return J288_OK;
+}
+
+void j288_robot_timing_reset(j288_robot_t *r)
+{
+    if (r != NULL)
+        j288_rt_timing_reset(&r->timing);
+}
+
+const char *j288_robot_rt_notice(const j288_robot_t *r)
+{
+    return (r == NULL) ? "" : r->rt.notice;
 }
 
 int j288_robot_bus_stats(const j288_robot_t *r, unsigned bus, j288_robot_bus_stats_t *out)

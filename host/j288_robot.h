@@ -44,6 +44,13 @@
  * set by a SIGINT handler installed without SA_RESTART) becomes non-zero, then return
  * J288_ERR_ABORTED. j288_robot_close() stops first if any target was sent since the last stop.
  *
+ * Pacing and real time (host/j288_rt.h, docs/realtime.md): j288_robot_pace() waits for the
+ * next cycle by absolute deadlines (a missed one skipped, never caught up) and
+ * j288_robot_run() paces with it; the options realtime, pin_cpu and cpu put the opening
+ * thread under SCHED_FIFO with memory locked, on one CPU; j288_robot_timing() reports the
+ * loop's wake-up lateness, cycle durations, misses, skips and cut cycles. A cycle allocates
+ * nothing and does no I/O but the ports' (non-blocking) reads and writes.
+ *
  * Joints: each joint of the config becomes a j288_joint_t (lib/joint.h) bound to its bus's
  * scheduler, in the config's order (joint index 0 .. njoints-1); a joint whose config gives no
  * kp (kd) gets J288_ROBOT_DEFAULT_KP (_KD). A joint's angle is unknown
@@ -74,6 +81,7 @@
 #include "j288/j288.h"
 #include "j288_serial.h"
 #include "j288_robot_config.h"
+#include "j288_rt.h"
 
 #if !J288_CONFIG_SI
 #error "the multi-bus runner needs the SI-unit API (J288_CONFIG_SI=1): it drives joints"
@@ -147,6 +155,14 @@ typedef struct {
                               robots where half the joints holding is worse than all locked */
     bool echo;             /* for buses that give none: the adapter hears its own transmit */
     uint8_t retries;       /* re-sends of a failed transaction (0-3; bus.h's retries) */
+    /* Real time (j288_rt.h), for the thread that opens the robot (the one that runs its loop)
+     * from j288_robot_open() until j288_robot_close(), which undoes it: */
+    uint8_t realtime;      /* 1-99: memory locked, stack pre-faulted, SCHED_FIFO at this
+                              priority (refused without the rights: j288_robot_rt_notice()
+                              says why and how to allow it, and the robot runs on); 0: none */
+    bool pin_cpu;          /* pin that thread to cpu (one it may run on, else the open fails
+                              with J288_ERR_BAD_ARG) */
+    uint16_t cpu;
 } j288_robot_options_t;
 
 typedef struct {
@@ -258,6 +274,9 @@ struct j288_robot {
     const volatile sig_atomic_t *stop_flag;
     j288_robot_stats_t stats;
     char err[J288_ROBOT_MSG_LEN];
+    j288_rt_status_t rt;      /* what the real-time set-up did (j288_rt.h) */
+    j288_rt_pacer_t pacer;    /* j288_robot_pace()'s schedule */
+    j288_rt_timing_t timing;  /* the loop's timing statistics */
 };
 
 /* sizeof(j288_robot_t), for callers that allocate it themselves (ctypes). */
@@ -271,10 +290,13 @@ const char *j288_robot_version(void);
  * Any thread. */
 uint32_t j288_robot_now_us(void);
 
-/* Open every bus of cfg (buses in cfg order; a config without buses: opt->port) and set up
- * its joints (every joint's slot enabled, at lock). Errors: J288_ERR_NULL, J288_ERR_BAD_CONFIG
- * (see the top), j288_serial_open()'s codes; the message in j288_robot_error(). r need not be
- * initialised before; after a failure j288_robot_error() stays valid and close is harmless. */
+/* Set up the calling thread's real time (opt->realtime, pin_cpu), then open every bus of cfg
+ * (buses in cfg order; a config without buses: opt->port) and set up its joints (every
+ * joint's slot enabled, at lock). Errors: J288_ERR_NULL, J288_ERR_BAD_CONFIG (see the top),
+ * J288_ERR_BAD_ARG (realtime above 99, a cpu this process may not run on: nothing opened),
+ * j288_serial_open()'s codes; the message in j288_robot_error(). r need not be initialised
+ * before; after a failure (the real-time set-up undone) j288_robot_error() stays valid and
+ * close is harmless. */
 int j288_robot_open(j288_robot_t *r, const j288_robot_config_t *cfg,
                     const j288_robot_options_t *opt);
 
@@ -284,8 +306,8 @@ int j288_robot_open_file(j288_robot_t *r, const char *path, const j288_robot_opt
 /* One bus on device port and no joints: servo-level use (j288_robot_exchange()). */
 int j288_robot_open_port(j288_robot_t *r, const char *port, const j288_robot_options_t *opt);
 
-/* Stop (if any target went out since the last stop) and close every bus. Safe on a closed
- * or failed robot, and twice. */
+/* Stop (if any target went out since the last stop) and close every bus; the real-time
+ * set-up undone. Safe on a closed or failed robot, and twice. */
 void j288_robot_close(j288_robot_t *r);
 
 /* Close without that stop: the servos keep their last command (with the watchdog bit 1 they
@@ -311,11 +333,33 @@ int j288_robot_cycle(j288_robot_t *r, uint32_t timeout_us, j288_robot_cycle_t *i
 
 /*
  * Cycles until ncycles are done (0: no limit) or duration_us has passed (0: no limit), one
- * every period_us (0: back to back; a late cycle starts at once, the schedule is not caught
- * up). Returns J288_OK, or J288_ERR_ABORTED (stop flag: every bus stopped), J288_ERR_OFFLINE
- * (every bus gone, or with stop_on_bus_loss one lost: every bus stopped), J288_ERR_NULL. Incomplete cycles do not end the run.
+ * every period_us (0: back to back), paced by j288_robot_pace(): absolute deadlines, a missed
+ * one skipped, never caught up (j288_rt.h). A run that follows another at the same period goes
+ * on with its schedule (a caller running in slices keeps one even rate), and ends before a
+ * cycle due at or after duration_us, which the next run then takes up. Returns J288_OK, or
+ * J288_ERR_ABORTED (stop flag: every bus stopped), J288_ERR_OFFLINE (every bus gone, or with
+ * stop_on_bus_loss one lost: every bus stopped), J288_ERR_NULL. Incomplete cycles do not end
+ * the run.
  */
 int j288_robot_run(j288_robot_t *r, uint32_t period_us, uint32_t ncycles, uint32_t duration_us);
+
+/*
+ * The loop's wait between cycles, by absolute deadlines: ends the cycle in progress (its
+ * duration into the timing statistics) and returns when the next is due, cycle k of a
+ * schedule at its first cycle's time + k * period_us, serving every bus meanwhile (sweeps
+ * running on in the background, a vanished device); with nothing in flight it sleeps in
+ * clock_nanosleep(TIMER_ABSTIME) as cyclictest does. The first call, or the first after the
+ * period changes or j288_robot_pace_restart(), starts a schedule and returns at once; so does
+ * period_us 0 (back to back: durations only). A deadline already past when it is called is
+ * missed: it returns at once, and whole periods behind are skipped, never run back to back
+ * (the rule, and why, in j288_rt.h). Returns J288_OK, J288_ERR_ABORTED (the stop flag: nothing
+ * is sent, the caller stops), J288_ERR_OFFLINE (every bus gone), J288_ERR_NULL. No allocation,
+ * no I/O but the ports' own.
+ */
+int j288_robot_pace(j288_robot_t *r, uint32_t period_us);
+/* The next j288_robot_pace() starts a new schedule (e.g. after a pause in the loop, whose
+ * deadlines would otherwise count as missed). Statistics are kept. */
+void j288_robot_pace_restart(j288_robot_t *r);
 
 /* Broadcast lock on every bus still there, every joint's slot at lock; returns once the stop
  * frames are out: after the transaction in flight on each bus (its reply budget) and any
@@ -381,6 +425,15 @@ int j288_robot_lock(j288_robot_t *r, unsigned joint);
 
 /* ---- statistics */
 int j288_robot_stats(const j288_robot_t *r, j288_robot_stats_t *out);
+/* The loop's timing (j288_rt.h): wake-up lateness and cycle duration percentiles, deadlines
+ * missed, periods skipped (j288_robot_pace()), cycles cut at their bound (j288_robot_cycle()),
+ * and what the real-time set-up put in effect. Errors: J288_ERR_NULL. */
+int j288_robot_timing(const j288_robot_t *r, j288_rt_report_t *out);
+/* Start the timing statistics afresh (e.g. after a front end's start-up cycles). */
+void j288_robot_timing_reset(j288_robot_t *r);
+/* What the real-time set-up refused, and how to allow it (j288_rt.h): "" when nothing was
+ * asked or all was done; lines each ending in '\n'. Never NULL. */
+const char *j288_robot_rt_notice(const j288_robot_t *r);
 int j288_robot_bus_stats(const j288_robot_t *r, unsigned bus, j288_robot_bus_stats_t *out);
 /* The bus engine's own counters (bus.h), or NULL for a bad index. */
 const j288_bus_stats_t *j288_robot_bus_wire_stats(const j288_robot_t *r, unsigned bus);

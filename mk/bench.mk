@@ -9,7 +9,12 @@
 #                           -icount)
 #   make bench-bus-target   instructions per engine transaction on Cortex-M0, M4F and RV32
 #                           (QEMU)
-.PHONY: bench bench-bus bench-codec bench-linux bench-target bench-bus-target
+#   make bench-rt           the robot loop's wake-up lateness against cyclictest's, side by
+#                           side, idle and beside stress-ng, with and without --realtime; the
+#                           bridge's command-to-wire latency the same way (scripts/bench-rt.sh:
+#                           its variables; needs rt-tests, stress-ng and the machine to itself:
+#                           not in CI)
+.PHONY: bench bench-bus bench-codec bench-linux bench-target bench-bus-target bench-rt
 bench: bench-bus bench-bus-target
 
 # ---- host ------------------------------------------------------------------------------------
@@ -43,6 +48,12 @@ bench-linux: $(LINUX_BENCH) $(SIM_BIN)
 	$(LINUX_BENCH) $(SIM_BIN) 5000
 
 ALL_TARGETS += $(ENGINE_BENCH) $(LINUX_BENCH)
+
+# (the bridge's part when Cyclone DDS is there: mk/dds.mk, read after this file)
+bench-rt: $(J288_BIN) $(SIM_BIN)
+	@$(MAKE) --no-print-directory $(if $(filter yes,$(DDS_FOUND)),$(DDS_BIN) $(DDS_TEST_PEER) \
+	    $(BUILD)/bench/write_stamp.so,$(J288_BIN)) >/dev/null
+	BUILD=$(BUILD) bash scripts/bench-rt.sh
 
 # ---- Cortex-M under QEMU -icount shift=0 (one instruction per ns) ----------------------------
 # $(call QEMU_BENCH,cpu,elf): run elf on the CPU's standard machine, instruction-counted.

@@ -12,7 +12,7 @@ SO_NAME := libj288.so.$(J288_VERSION_MAJOR)
 SO_LIB := $(BUILD)/lib/libj288.so
 SO_REAL := $(BUILD)/lib/libj288.so.$(J288_VERSION)
 SO_SRC := $(LIB_SRC) port/desktop/j288_serial.c port/linux/j288_linux.c host/j288_robot.c \
-    host/j288_robot_config.c host/j288_number.c
+    host/j288_rt.c host/j288_rt_linux.c host/j288_robot_config.c host/j288_number.c
 SO_OBJ := $(SO_SRC:%.c=$(OBJ)/pic/%.o)
 
 $(OBJ)/pic/%.o: CPPFLAGS_OBJ = -fPIC $(HOST_CPPFLAGS)

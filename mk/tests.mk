@@ -34,7 +34,7 @@ $(OBJ)/test/cli/test_cli_joint.o: $(YAML_ENV)
 
 $(CLI_JOINT_TEST): $(OBJ)/test/cli/test_cli_joint.o $(CLI_CAPTURE_OBJ) \
     $(addprefix $(OBJ)/tools/j288/,cli_joint.o cli_bus.o args.o json.o report.o) \
-    $(OBJ)/host/j288_robot.o $(CONFIG_OBJ) \
+    $(OBJ)/host/j288_robot.o $(OBJ)/host/j288_rt.o $(OBJ)/host/j288_rt_linux.o $(CONFIG_OBJ) \
     $(UNITY_OBJ) $(LINUX_A) $(LIB_A) $(YAML_ENV)
 	$(LINK)
 HOST_TESTS += $(CLI_JOINT_TEST)

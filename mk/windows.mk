@@ -63,7 +63,7 @@ WIN_TOOL_CPPFLAGS := $(WIN_CPPFLAGS) -Ihost -Itools/j288 -D__USE_MINGW_ANSI_STDI
 WIN_TOOL_CFLAGS := $(WIN_CFLAGS) -Wno-float-conversion
 WIN_YAML_ENV := $(WIN)/libyaml/libyaml.env
 WIN_HOST_OBJ := $(WIN_OBJ)/host/j288_robot.o $(WIN_OBJ)/host/j288_robot_config.o \
-    $(WIN_OBJ)/host/j288_number.o
+    $(WIN_OBJ)/host/j288_number.o $(WIN_OBJ)/host/j288_rt.o $(WIN_OBJ)/host/j288_rt_win32.o
 # j288 top and jog are POSIX terminal programs (their screen: live.c): tools/j288/windows/
 # says so instead.
 WIN_J288_OBJ := $(patsubst %.c,$(WIN_OBJ)/%.o,$(filter-out tools/j288/cmd_top.c \

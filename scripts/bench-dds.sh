@@ -203,34 +203,7 @@ for k in ('runner', 'quiet', 'subscribed'):
     spread = '%.0f-%.0f' % (min(r for r, _ in rows[k]), max(r for r, _ in rows[k]))
     print('%-40s %6.0f (%s) %7.0f%% %14.1f' % (label[k], rate, spread, 100 * rate / base, cpu))
 PY
-python3 - "$tmp/sent" "$tmp/stamps" "$tmp/log.0" <<'PY'
-import sys
-sent = [(int(t), float(p)) for _, t, p in (l.split() for l in open(sys.argv[1]) if l.startswith('sent '))]
-frames = [(int(t), h) for t, _, h in (l.split() for l in open(sys.argv[2]))]
-# the simulator of bus leg0 decodes every frame it got: hex -> (id, status, pos)
-dec = {}
-for l in open(sys.argv[3]):
-    f = l.split()
-    if len(f) >= 8 and f[2] == 'id=1' and f[3] == 'status=1':
-        dec[f[1]] = int(f[7].split('=')[1])
-raws = sorted(set(dec.values()))
-if len(raws) != 2:
-    sys.exit('bench-dds: expected two target positions on the wire, saw %d' % len(raws))
-raw_of = {0.30: raws[0], 0.35: raws[1]}   # direction 1: the larger angle, the larger count
-lat, j = [], 0
-for t, p in sent:
-    while j < len(frames) and frames[j][0] < t:
-        j += 1
-    k = j
-    while k < len(frames) and dec.get(frames[k][1]) != raw_of[round(p, 2)]:
-        k += 1
-    if k < len(frames):
-        lat.append((frames[k][0] - t) / 1000.0)
-lat.sort()
-q = lambda f: lat[min(len(lat) - 1, int(f * len(lat)))]
-print('command to wire at --rate 1000 (%d of %d commands): p50 %.0f us, p99 %.0f us, max %.0f us'
-      % (len(lat), len(sent), q(0.5), q(0.99), lat[-1]))
-PY
+python3 scripts/wire_latency.py "$tmp/sent" "$tmp/stamps" "$tmp/log.0"
 if [ "${CALLGRIND:-0}" = 1 ]; then
     echo "instructions per cycle (callgrind, all threads; start-up included in the totals):"
     # inclusive cost of a function: the first number on its line of callgrind_annotate

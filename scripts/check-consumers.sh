@@ -52,7 +52,7 @@ EOF
 # installed PREFIX LIBDIR: what an install must hold, then a find_package consumer against it.
 installed() {
     local p=$1 l=$2 f
-    for f in include/j288/j288.h include/j288/j288_robot.h include/j288/j288_serial.h \
+    for f in include/j288/j288.h include/j288/j288_robot.h include/j288/j288_serial.h include/j288/j288_rt.h \
         $l/libj288.a $l/libj288.so \
         $l/pkgconfig/j288.pc $l/cmake/j288/j288Config.cmake bin/j288 bin/j288-sim \
         share/man/man1/j288.1 share/man/man1/j288-sim.1 share/bash-completion/completions/j288; do

@@ -26,8 +26,8 @@ import os
 import signal
 import sys
 import threading
-from ctypes import (POINTER, Structure, c_bool, c_char_p, c_double, c_int, c_size_t, c_uint,
-                    c_uint8, c_uint32, c_void_p)
+from ctypes import (POINTER, Structure, c_bool, c_char_p, c_double, c_int, c_int32, c_size_t,
+                    c_uint, c_uint8, c_uint16, c_uint32, c_void_p)
 from typing import Optional, TypeVar
 
 MAX_SERVOS = 15
@@ -115,7 +115,25 @@ class Options(Structure):
     _fields_ = [("port", c_char_p), ("baud", c_uint32), ("margin_us", c_uint32),
                 ("down_after", c_uint8), ("no_low_latency", c_bool),
                 ("on_event", c_void_p), ("on_cycle", c_void_p), ("user", c_void_p),
-                ("stop_on_bus_loss", c_bool), ("echo", c_bool), ("retries", c_uint8)]
+                ("stop_on_bus_loss", c_bool), ("echo", c_bool), ("retries", c_uint8),
+                ("realtime", c_uint8), ("pin_cpu", c_bool), ("cpu", c_uint16)]
+
+
+class TimingSummary(Structure):
+    """j288_rt_summary_t (host/j288_rt.h): one histogram's percentiles, microseconds."""
+
+    _c_type_ = "j288_rt_summary_t"
+    _fields_ = [(n, c_uint32) for n in ("count", "p50_us", "p99_us", "p999_us", "max_us")]
+
+
+class TimingReport(Structure):
+    """j288_rt_report_t: the loop's timing."""
+
+    _c_type_ = "j288_rt_report_t"
+    _fields_ = [("cycles", c_uint32), ("period_us", c_uint32), ("missed", c_uint32),
+                ("skipped", c_uint32), ("cut", c_uint32), ("lateness", TimingSummary),
+                ("duration", TimingSummary), ("priority", c_int32), ("cpu", c_int32),
+                ("memory_locked", c_uint32)]
 
 
 # The shared library's file name on each platform (Windows: what `make windows` builds).
@@ -156,6 +174,11 @@ def _bind(lib: ctypes.CDLL) -> None:
         "j288_robot_close": (None, [robot]),
         "j288_robot_cycle": (c_int, [robot, c_uint32, P(CycleInfo)]),
         "j288_robot_run": (c_int, [robot, c_uint32, c_uint32, c_uint32]),
+        "j288_robot_pace": (c_int, [robot, c_uint32]),
+        "j288_robot_pace_restart": (None, [robot]),
+        "j288_robot_timing": (c_int, [robot, c_void_p]),
+        "j288_robot_timing_reset": (None, [robot]),
+        "j288_robot_rt_notice": (c_char_p, [robot]),
         "j288_robot_stop": (c_int, [robot]),
         "j288_robot_njoints": (c_uint, [robot]),
         "j288_robot_nbuses": (c_uint, [robot]),

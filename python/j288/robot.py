@@ -5,12 +5,14 @@ from __future__ import annotations
 import ctypes
 import os
 import time
+import warnings
 from dataclasses import dataclass
 from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
 
 from . import _native
 from ._native import (LIB, BusStats, CycleInfo, JointState, JointStats, RobotStats, Target,
-                      c_double, c_uint, c_uint8, int_arg, path_arg, real_arg)
+                      TimingReport, TimingSummary, c_double, c_uint, c_uint8, int_arg, path_arg,
+                      real_arg)
 from .errors import J288Error, error_for
 
 try:  # NumPy is optional: arrays where a loop wants them, lists without it.
@@ -21,6 +23,7 @@ except ImportError:  # pragma: no cover - depends on the machine
 Vector = Union[Sequence[float], Any]  # a sequence of floats or a NumPy array
 
 _RUN_SLICE_US = 100000  # run(): Python's signal handlers get their turn this often
+_REALTIME_DEFAULT = 80  # J288_RT_DEFAULT_PRIORITY
 _MAX_SECONDS = 4000     # a cycle's timeout, run()'s period: microseconds in 32 bits
 
 
@@ -100,6 +103,13 @@ class Robot(_native.Handle):
             for it (default 3; until then a silent bus slows every cycle).
         stop_on_bus_loss: a bus that goes down or vanishes stops every bus and the cycle
             raises OfflineError (a legged robot is better all locked than half held).
+        realtime: True (priority 80) or a SCHED_FIFO priority 1-99 for the thread that
+            creates the Robot (the one that must run its loop: run(), pace(), cycle()), with
+            the process's memory locked; close() undoes it. Without the rights a
+            RuntimeWarning says how to get them (ulimit -r, /etc/security/limits.d,
+            CAP_SYS_NICE) and the robot runs at normal priority (realtime_notice keeps the
+            text). docs/realtime.md.
+        cpu: pin that thread to this CPU (one the process may run on, else ValueError).
     Raises:
         J288Error: J288_ERR_BAD_CONFIG (file errors, with "FILE:LINE: ..." in detail), a
             device that cannot be opened (OfflineError), ...
@@ -109,17 +119,29 @@ class Robot(_native.Handle):
 
     def __init__(self, config: Union[str, "os.PathLike[str]"],
                  port: Union[str, "os.PathLike[str]", None] = None, margin_us: int = 0,
-                 down_after: int = 0, stop_on_bus_loss: bool = False) -> None:
+                 down_after: int = 0, stop_on_bus_loss: bool = False,
+                 realtime: Union[bool, int] = False, cpu: Optional[int] = None) -> None:
         path = path_arg(config, "config")
         dev = path_arg(port, "port") if port is not None else None
         margin_us = int_arg(margin_us, "margin_us", 0, 1000000)
         down_after = int_arg(down_after, "down_after", 0, 255)
+        if isinstance(realtime, bool):
+            prio = _REALTIME_DEFAULT if realtime else 0
+        else:
+            prio = int_arg(realtime, "realtime", 1, 99)
+        pin = cpu is not None
+        cpu = int_arg(cpu, "cpu", 0, 1023) if pin else 0
         self._r: Optional[ctypes.Array] = _native.new_robot()
         opt = _native.Options(port=dev, margin_us=margin_us, down_after=down_after,
-                              stop_on_bus_loss=bool(stop_on_bus_loss))
+                              stop_on_bus_loss=bool(stop_on_bus_loss), realtime=prio,
+                              pin_cpu=pin, cpu=cpu)
         rc = LIB.j288_robot_open_file(self._r, path, ctypes.byref(opt))
         self._open(rc, os.fsdecode(path))
         r = self._r
+        #: what the real-time set-up refused and how to allow it ("" when nothing was)
+        self.realtime_notice: str = LIB.j288_robot_rt_notice(r).decode(errors="replace")
+        if self.realtime_notice:
+            warnings.warn(self.realtime_notice.rstrip("\n"), RuntimeWarning, stacklevel=2)
         self.joints: List[str] = [LIB.j288_robot_joint_name(r, j).decode()
                                   for j in range(LIB.j288_robot_njoints(r))]
         self.buses: List[str] = [LIB.j288_robot_bus_name(r, b).decode()
@@ -166,10 +188,11 @@ class Robot(_native.Handle):
         """Cycles in C (no Python per cycle): `cycles` of them (0: no limit) or for `duration`
         seconds (0: no limit), at rate_hz (0: back to back), with the targets set before.
 
-        The C loop runs in slices of about 0.1 s (whole periods at rate_hz, so the schedule
-        goes on evenly): Ctrl-C (KeyboardInterrupt) and other signals reach Python between
-        them, and a with block around the loop then stops every bus. Raises OfflineError
-        when every bus is gone."""
+        The C loop runs in slices of about 0.1 s on one schedule of absolute deadlines (each
+        slice takes it up where the last left it: the rate holds): Ctrl-C (KeyboardInterrupt)
+        and other signals reach Python between them, and a with block around the loop then
+        stops every bus. A call starts a new schedule. A missed deadline is skipped, never
+        caught up (see pace()). Raises OfflineError when every bus is gone."""
         if not (0 <= cycles < 2**32 and (rate_hz == 0 or 1 / _MAX_SECONDS <= rate_hz)
                 and duration >= 0):
             raise ValueError(f"cycles 0 to 2**32 - 1, rate_hz 0 or from {1 / _MAX_SECONDS}, "
@@ -180,6 +203,7 @@ class Robot(_native.Handle):
         left_us = int(duration * 1e6) if duration > 0 else None
         left = cycles
         stats = RobotStats()
+        LIB.j288_robot_pace_restart(r)
         while left_us is None or left_us > 0:
             this_us = slice_us if left_us is None else min(slice_us, left_us)
             self._check(LIB.j288_robot_stats(r, ctypes.byref(stats)))
@@ -193,6 +217,26 @@ class Robot(_native.Handle):
                 left -= min(left, (stats.cycles - before) & 0xFFFFFFFF)
                 if left == 0:
                     return
+
+    def pace(self, rate_hz: float) -> None:
+        """Wait for the next cycle's deadline, for a loop of your own::
+
+            while running:
+                robot.pace(500)          # deadlines 2 ms apart, absolute
+                pos, *_ = robot.read()
+                robot.set_targets(...)
+                robot.cycle()
+
+        Cycle k is due at the first call's time + k / rate_hz (the first call, or the
+        first at another rate, starts the schedule and returns at once). The buses are
+        served meanwhile. A deadline already past when it is called (the loop overran) is
+        missed: it returns at once, and whole periods behind are skipped, never run back to
+        back. Each call ends a cycle: its duration, the wake-up's lateness, misses and
+        skips go into stats()["timing"]. Raises OfflineError when every bus is gone."""
+        rate_hz = real_arg(rate_hz, "rate_hz")
+        if not 1 / _MAX_SECONDS <= rate_hz <= 1e6:
+            raise ValueError(f"rate_hz {rate_hz} outside [{1 / _MAX_SECONDS}, 1e6]")
+        self._check(LIB.j288_robot_pace(self._robot(), int(round(1e6 / rate_hz))))
 
     def stop(self) -> None:
         """Broadcast lock on every bus; every joint at lock until new targets are set."""
@@ -257,11 +301,33 @@ class Robot(_native.Handle):
             self._check(LIB.j288_robot_lock(self._robot(), j), self.joints[j])
 
     # ---- statistics
-    def stats(self) -> Dict[str, int]:
-        """Cycles, complete cycles, last and worst cycle time (us)."""
+    def stats(self) -> Dict[str, Any]:
+        """Cycles, complete cycles, last and worst cycle time (us), and "timing": the loop's
+        timing as `j288 log --json` gives it: cycles (ended by a paced wait), period_us,
+        missed_deadlines, skipped_periods, cut_cycles (ended by their timeout),
+        lateness_us and duration_us (each count, p50, p99, p99_9, max: wake-up lateness at
+        each deadline, and each cycle's duration to the next wait), priority (SCHED_FIFO,
+        0: normal), cpu (-1: not pinned), memory_locked."""
         s = RobotStats()
-        self._check(LIB.j288_robot_stats(self._robot(), ctypes.byref(s)))
-        return {f: getattr(s, f) for f, _ in RobotStats._fields_}
+        r = self._robot()
+        self._check(LIB.j288_robot_stats(r, ctypes.byref(s)))
+        out: Dict[str, Any] = {f: getattr(s, f) for f, _ in RobotStats._fields_}
+        t = TimingReport()
+        self._check(LIB.j288_robot_timing(r, ctypes.byref(t)))
+
+        def summary(h: TimingSummary) -> Dict[str, int]:
+            return {"count": h.count, "p50": h.p50_us, "p99": h.p99_us, "p99_9": h.p999_us,
+                    "max": h.max_us}
+        out["timing"] = {"cycles": t.cycles, "period_us": t.period_us,
+                         "missed_deadlines": t.missed, "skipped_periods": t.skipped,
+                         "cut_cycles": t.cut, "lateness_us": summary(t.lateness),
+                         "duration_us": summary(t.duration), "priority": t.priority,
+                         "cpu": t.cpu, "memory_locked": bool(t.memory_locked)}
+        return out
+
+    def reset_timing(self) -> None:
+        """Start the timing statistics (stats()["timing"]) afresh, e.g. after start-up."""
+        LIB.j288_robot_timing_reset(self._robot())
 
     def bus_stats(self, bus: Union[int, str]) -> Dict[str, Any]:
         """One bus: sweeps, empty sweeps, down events, sweep times, up, gone."""

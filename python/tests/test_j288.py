@@ -14,6 +14,7 @@ import subprocess
 import sys
 import textwrap
 import time
+import warnings
 from pathlib import Path
 from typing import Iterator, List
 
@@ -528,3 +529,107 @@ def test_ctrl_c_stops_every_bus(sims, tmp_path: Path, loop: str) -> None:
     assert proc.returncode != 0 and "KeyboardInterrupt" in err
     for s in (s0, s1):
         assert s.logged(" id=15 status=0 wd=0")
+
+
+# ---- the loop's real time and timing (host/j288_rt.h, docs/realtime.md) ----------------------
+
+def timing_consistent(t: dict) -> None:
+    """What any timing report must satisfy: every cycle ended by a wait either slept to its
+    deadline or missed it, and the percentiles are ordered."""
+    assert t["lateness_us"]["count"] + t["missed_deadlines"] == t["cycles"], t
+    assert t["duration_us"]["count"] == t["cycles"], t
+    for h in (t["lateness_us"], t["duration_us"]):
+        assert h["p50"] <= h["p99"] <= h["p99_9"] <= h["max"], t
+
+
+def test_robot_timing_counts_a_forced_miss(sims, tmp_path: Path) -> None:
+    """Robot.pace() paces by absolute deadlines and stats()["timing"] reports it: a loop
+    paused for ten periods misses one deadline and skips the periods it covered (no burst);
+    run() keeps one schedule across its slices."""
+    cfg = write_config(tmp_path, [sims("1,2,3").pty])
+    with j288.Robot(cfg) as robot:
+        cycle_until_known(robot)
+        robot.reset_timing()
+        for i in range(30):
+            if i == 10:
+                time.sleep(0.05)  # the provocation: ten periods of 5 ms
+            robot.pace(200)
+            robot.cycle()
+        t = robot.stats()["timing"]
+        assert t["cycles"] == 29 and t["period_us"] == 5000, t  # the first call starts it
+        assert t["missed_deadlines"] >= 1 and t["skipped_periods"] >= 8, t
+        assert t["duration_us"]["max"] >= 50000, t
+        assert t["priority"] == 0 and t["cpu"] == -1 and t["cut_cycles"] == 0, t
+        timing_consistent(t)
+        robot.run(cycles=60, rate_hz=400)  # more than one slice of run(): one schedule
+        t = robot.stats()["timing"]
+        assert t["cycles"] == 29 + 59 and t["period_us"] == 2500, t
+        timing_consistent(t)
+
+
+def test_robot_realtime(sims, tmp_path: Path) -> None:
+    """Robot(realtime=True, cpu=N): the creating thread under SCHED_FIFO 80 on CPU N with
+    memory locked, put back at close; a CPU the process may not use is refused. Without the
+    rights (not root) a RuntimeWarning says how to get them and the robot runs."""
+    cfg = write_config(tmp_path, [sims("1").pty])
+    cpus = os.sched_getaffinity(0)
+    cpu = min(cpus)
+    policy = os.sched_getscheduler(0)
+    with warnings.catch_warnings(record=True) as seen:
+        warnings.simplefilter("always")
+        robot = j288.Robot(cfg, realtime=True, cpu=cpu)
+    try:
+        t = robot.stats()["timing"]
+        assert t["cpu"] == cpu and os.sched_getaffinity(0) == {cpu}, t
+        if robot.realtime_notice == "":
+            assert t["priority"] == 80 and t["memory_locked"], t
+            assert os.sched_getscheduler(0) == os.SCHED_FIFO
+            assert not seen
+        else:
+            assert "ulimit -r" in robot.realtime_notice and t["priority"] == 0, t
+            assert any("ulimit -r" in str(w.message) for w in seen)
+        robot.cycle()
+    finally:
+        robot.close()
+    assert os.sched_getscheduler(0) == policy and os.sched_getaffinity(0) == cpus
+    with pytest.raises(j288.J288Error, match="J288_ERR_BAD_ARG.*CPU 1023 is not one"):
+        j288.Robot(cfg, cpu=1023)
+    for bad in (0, 100):
+        with pytest.raises(ValueError, match="realtime"):
+            j288.Robot(cfg, realtime=bad)
+    with pytest.raises(TypeError, match="realtime must be an int"):
+        j288.Robot(cfg, realtime="80")  # type: ignore[arg-type]
+
+
+def without_rt_rights() -> List[str]:
+    """A command prefix that takes away the rights to real time: RLIMIT_RTPRIO and
+    RLIMIT_MEMLOCK to 0, and for root CAP_SYS_NICE and CAP_IPC_LOCK (it stays root, so that
+    it can open the simulator's pseudo-terminal)."""
+    prefix = ["prlimit", "--rtprio=0:0", "--memlock=0:0"]
+    if os.geteuid() == 0:
+        prefix += ["setpriv", "--bounding-set=-sys_nice,-ipc_lock",
+                   "--inh-caps=-sys_nice,-ipc_lock"]
+    return prefix
+
+
+def test_robot_realtime_refused_runs_on(sims, tmp_path: Path) -> None:
+    """Without the rights (EPERM from the kernel): a RuntimeWarning naming the fix (ulimit -r,
+    /etc/security/limits.d, CAP_SYS_NICE), and the robot cycles at normal priority."""
+    cfg = write_config(tmp_path, [sims("1").pty])
+    script = textwrap.dedent(f"""\
+        import os, warnings, j288
+        warnings.simplefilter("always")
+        with j288.Robot({str(cfg)!r}, realtime=70) as robot:
+            robot.cycle()
+            t = robot.stats()["timing"]
+            print("priority", t["priority"], "fifo", os.sched_getscheduler(0) == os.SCHED_FIFO)
+        """)
+    proc = subprocess.run(without_rt_rights() + [sys.executable, "-c", script],
+                          env=dict(os.environ, PYTHONPATH=PKG_PATH), capture_output=True,
+                          text=True, timeout=60)
+    assert proc.returncode == 0, proc.stderr
+    assert "priority 0 fifo False" in proc.stdout
+    assert "RuntimeWarning" in proc.stderr
+    for fix in ("SCHED_FIFO priority 70 refused (Operation not permitted)", "ulimit -r 70",
+                "/etc/security/limits.d", "CAP_SYS_NICE"):
+        assert fix in proc.stderr, proc.stderr

@@ -58,6 +58,7 @@ dds_e2e_setup() {
     . test/e2e/lib_sim.sh
     PEER=$BUILD/test/dds_peer
     PEER_ARGS=()
+    BRIDGE_WRAP=()
     DDS=$BIN/j288-dds
     trap 'kill -CONT "${SIM_PID_1:-}" 2>/dev/null; sim_cleanup TERM' EXIT
     trap 'exit 130' INT TERM
@@ -93,12 +94,14 @@ truth() {
     return 1
 }
 
-# start_bridge OPTIONS...: j288-dds on $SIM_DIR/robot.yaml (stderr in $SIM_DIR/bridge.err), once
+# start_bridge OPTIONS...: j288-dds (after the command prefix BRIDGE_WRAP, none by default: it
+# must exec the bridge, as prlimit does) on $SIM_DIR/robot.yaml (stderr in $SIM_DIR/bridge.err), once
 # it publishes known angles (diagnostics in unitree mode: LowState_ cannot say) (up to 30 s; the peer reads with PEER_ARGS, e.g. --ns NS); sets
 # BRIDGE_PID. A bridge still running from a failed check is stopped first.
 start_bridge() {
     [ -n "${BRIDGE_PID:-}" ] && kill -0 "$BRIDGE_PID" 2>/dev/null && stop_bridge
-    "$DDS" --config "$SIM_DIR/robot.yaml" --domain "$DDS_DOMAIN" "$@" 2>"$SIM_DIR/bridge.err" &
+    "${BRIDGE_WRAP[@]}" "$DDS" --config "$SIM_DIR/robot.yaml" --domain "$DDS_DOMAIN" "$@" \
+        2>"$SIM_DIR/bridge.err" &
     BRIDGE_PID=$!
     BG_PIDS+=("$BRIDGE_PID")
     local i
@@ -191,10 +194,12 @@ comes_to_rest() {
 }
 
 # locked_all K...: simulator K's log got the broadcast lock (id 15, status 0) with the
-# watchdog bit 0 (a locked servo needs no watchdog; the runner's policy).
+# watchdog bit 0 (a locked servo needs no watchdog; the runner's policy), waiting (bounded) for
+# the simulator to read it: a broadcast has no reply, and the bridge may have exited before the
+# simulator ran again (lib_e2e.sh's logged).
 locked_all() {
     local k
     for k in "$@"; do
-        grep -q ' id=15 status=0 wd=0' "$SIM_DIR/log.$k" || { echo "no broadcast lock on bus $k"; return 1; }
+        logged "$SIM_DIR/log.$k" ' id=15 status=0 wd=0' || { echo "no broadcast lock on bus $k"; return 1; }
     done
 }

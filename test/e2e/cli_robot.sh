@@ -14,12 +14,6 @@ SIM_DIR=$E2E_TMP
 . test/e2e/lib_sim.sh
 trap 'sim_cleanup KILL' EXIT
 
-# logged FILE NEEDLE: wait (bounded, 20 s) until the simulator has logged it
-logged() {
-    for _ in $(seq 1 400); do grep -q -- "$2" "$1" 2>/dev/null && return 0; sleep 0.05; done
-    return 1
-}
-
 start_sims 3 --exit-after "$(e2e_scaled 120)" --log "$E2E_TMP/log.{k}"
 robot_config 3 "$E2E_TMP/robot.yaml" 250000 2 0.05
 

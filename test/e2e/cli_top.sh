@@ -74,9 +74,19 @@ start_top() {
 }
 cycle_now() { screen | sed -n 's/^j288 top .* cycle \([0-9]*\) .*/\1/p'; }
 LOG=$SIM_DIR/top.log
+skipped_now() { screen | sed -n 's/^timing: .* \([0-9]*\) periods skipped.*/\1/p'; }
+# top_stall: SIGSTOP j288 top (the pane's shell's child) for 0.5 s.
+top_stall() {
+    local pane pid
+    pane=$(tmux_do display -p -t "$TMUX_NAME" '#{pane_pid}')
+    pid=$(cat "/proc/$pane/task/$pane/children" 2>/dev/null)
+    pid=${pid%% *}
+    [ -n "$pid" ] || { echo "j288 top's pid not found"; return 1; }
+    kill -STOP "$pid"; sleep 0.5; kill -CONT "$pid"
+}
 
 t_live_screen_and_q() {
-    local c1 c2 before
+    local c1 c2 before skipped_before
     start_top
     wait_screen '^hip +left +1 \* +-?[0-9]+\.[0-9]{4} +-?[0-9.]+ +-?[0-9.]+ +25\.0 +[0-9]+\.[0-9] +24\.0 ' || return 1
     wait_screen '^knee +left +2 \* .* winding over-temperature$' || return 1
@@ -89,6 +99,18 @@ t_live_screen_and_q() {
     for _ in $(seq 1 600); do c2=$(cycle_now); [ -n "$c2" ] && [ "$c2" -gt "${c1:-0}" ] && break; sleep 0.05; done
     [ -n "$c2" ] && [ "$c2" -gt "${c1:-0}" ] || { echo "cycle $c1 -> $c2: not refreshed"; return 1; }
     screen | head -n1 | grep -q '^j288 top ' || { echo "header not on top"; screen; return 1; }
+    # The loop's timing (docs/realtime.md): on screen, and a stall provoked (the tool stopped
+    # for 0.5 s, 25 periods at 50 Hz) counted there: a deadline missed, periods skipped.
+    wait_screen '^timing: [0-9]+ cycles at 50 Hz \(normal priority\): ' || return 1
+    wait_screen '^timing: wake-up lateness p50 [0-9]+ us, p99 [0-9]+ us, p99.9 [0-9]+ us, max ' || return 1
+    wait_screen '^timing: cycle duration p50 [0-9]+ us, ' || return 1
+    skipped_before=$(skipped_now)
+    top_stall || return 1
+    for _ in $(seq 1 600); do
+        [ "$(skipped_now)" -ge $((${skipped_before:-0} + 10)) ] && break; sleep 0.05
+    done
+    [ "$(skipped_now)" -ge $((${skipped_before:-0} + 10)) ] ||
+        { echo "the stall's periods not skipped: ${skipped_before:-?} -> $(skipped_now)"; screen; return 1; }
     before=$(broadcasts "$LOG")
     press q
     wait_rc 0 && wait_broadcast "$LOG" "$before"

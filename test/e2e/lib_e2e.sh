@@ -32,6 +32,29 @@ e2e_scaled() { echo $(($1 * TEST_TIME_SCALE)); }
 # next command came; stalls of up to 1.6 s were seen beside stress-ng) still sees more than 1 s.
 E2E_TRIP_SILENCE=3
 
+# "${WITHOUT_RT_RIGHTS[@]}" CMD...: CMD without the rights to real time: RLIMIT_RTPRIO and
+# RLIMIT_MEMLOCK at 0 and, for root, CAP_SYS_NICE and CAP_IPC_LOCK taken away (it stays root,
+# so that it opens the simulator's pseudo-terminal): SCHED_FIFO and mlockall get EPERM. Each
+# program execs the next: CMD keeps the pid a background start gives ($!).
+WITHOUT_RT_RIGHTS=(prlimit --rtprio=0:0 --memlock=0:0)
+[ "$(id -u)" = 0 ] &&
+    WITHOUT_RT_RIGHTS+=(setpriv --bounding-set=-sys_nice,-ipc_lock --inh-caps=-sys_nice,-ipc_lock)
+
+# logged FILE NEEDLE [FROM_LINE [SECONDS]]: wait (bounded: SECONDS, default 20, scaled) until a
+# line of a simulator's log FILE after line FROM_LINE (default 0) contains NEEDLE; true as soon
+# as one does. A program that has exited (or sent a broadcast, which has no reply) left its
+# last frames in the pseudo-terminal: the simulator reads and logs them when it next runs,
+# which on a loaded machine is later. Every check of a simulator's log for a frame the program
+# sent waits here, never greps at once.
+logged() {
+    local i
+    for i in $(seq 1 "$(e2e_scaled $((${4:-20} * 20)))"); do
+        tail -n +"$((${3:-0} + 1))" "$1" 2>/dev/null | grep -q -- "$2" && return 0
+        sleep 0.05
+    done
+    return 1
+}
+
 # Run a command with a time bound (E2E_CMD_TIMEOUT seconds, default 20, scaled), capturing
 # stdout, stderr and status into E2E_OUT, E2E_ERR, E2E_RC.
 e2e_run() {

@@ -29,11 +29,6 @@ sim() {
     ln -sfn "$DEV" "$WINEPREFIX/dosdevices/$com"
 }
 j288() { e2e_run wine "$EXE" "$@"; E2E_OUT=${E2E_OUT//$'\r'/}; E2E_ERR=${E2E_ERR//$'\r'/}; }
-# logged FILE NEEDLE: wait (bounded, 20 s) until the simulator has logged it.
-logged() {
-    for _ in $(seq 1 400); do grep -q -- "$2" "$1" 2>/dev/null && return 0; sleep 0.05; done
-    return 1
-}
 jval() { python3 -c 'import json, sys; print(json.loads(sys.argv[1])[sys.argv[2]])' "$1" "$2"; }
 
 sim a com11 || exit 1

@@ -14,7 +14,9 @@
 #include "unity.h"
 
 #include <errno.h>
+#include <fcntl.h>
 #include <poll.h>
+#include <sched.h>
 #include <signal.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -22,8 +24,10 @@
 #include <string.h>
 #include <sys/ioctl.h>
 #include <sys/wait.h>
+#include <time.h>
 #include <unistd.h>
 
+#include "alloc_count.h"
 #include "j288/j288.h"
 #include "j288_robot.h"
 #include "sim_process.h"
@@ -835,6 +839,179 @@ static void test_stop_on_bus_loss(void)
     TEST_ASSERT_TRUE(log_wait(0, " id=15 status=0 wd=0"));
 }
 
+/* ---- the loop's real time and timing (j288_rt.h) ------------------------------------------ */
+
+#define ALLOC_CYCLES 10000u
+#define ALLOC_PERIOD_US 200u
+#define ALLOC_SLEEP_PERIOD_US 5000u
+
+static void pause_us(long us)
+{
+    struct timespec ts;
+    ts.tv_sec = 0;
+    ts.tv_nsec = us * 1000L;
+    while (nanosleep(&ts, &ts) != 0 && errno == EINTR) {
+    }
+}
+
+/* One round of a control loop: read, set targets, pace, cycle. Every 1000th round forces the
+ * pacing's sleep (a new schedule at a long period: its next deadline is 5 ms away), and every
+ * 1000th another one a missed deadline (a pause of two periods before the wait). */
+static void loop_round(unsigned i, double *pos)
+{
+    (void)j288_robot_read_all(&g_robot, 2, pos, NULL, NULL, NULL);
+    (void)j288_robot_set_targets(&g_robot, 2, pos, NULL, NULL, NULL, NULL, NULL);
+    if (i % 1000u == 500u) {
+        (void)j288_robot_pace(&g_robot, ALLOC_SLEEP_PERIOD_US);
+        (void)j288_robot_pace(&g_robot, ALLOC_SLEEP_PERIOD_US);
+    } else if (i % 1000u == 0u) {
+        pause_us(2 * (long)ALLOC_PERIOD_US);
+    }
+    (void)j288_robot_pace(&g_robot, ALLOC_PERIOD_US);
+    (void)j288_robot_cycle(&g_robot, LOADED_CYCLE_US, NULL);
+}
+
+/* The cycle and its pacing allocate nothing: 10,000 rounds of reading, targets, pacing (its
+ * sleep and its missed deadline each forced now and then) and cycles on two buses of one
+ * joint each (a servo more per bus only repeats the same code, and costs time) make no call
+ * to malloc or its family. The cycle's only I/O is the ports', on non-blocking descriptors. */
+static void test_cycles_allocate_nothing(void)
+{
+    double pos[2];
+    j288_rt_report_t rep;
+    void *volatile p;
+    unsigned long allocs;
+    unsigned i;
+    int fd;
+    if (getenv("LD_PRELOAD") != NULL && strstr(getenv("LD_PRELOAD"), "vgpreload") != NULL)
+        TEST_IGNORE_MESSAGE("valgrind owns malloc here: counted in the native and ASan runs");
+    alloc_count_start(); /* the counter counts */
+    p = malloc(16);
+    free(p);
+    TEST_ASSERT_EQUAL_UINT32(1, (uint32_t)alloc_count_stop());
+    sim_start(0, "1");
+    sim_start(1, "1");
+    make_config(2, LOADED_MARGIN_US);
+    g_cfg.joint[1] = g_cfg.joint[3]; /* leg0_1, leg1_1 */
+    g_cfg.njoints = 2;
+    TEST_ASSERT_EQUAL_INT_MESSAGE(J288_OK, j288_robot_open(&g_robot, &g_cfg, NULL),
+                                  j288_robot_error(&g_robot));
+    cycle_until_known();
+    for (i = 0; i < 2u; i++) {
+        TEST_ASSERT_EQUAL_INT(J288_OK, j288_robot_hold(&g_robot, i));
+        fd = fd_open_on(g_sim[i].pty);
+        TEST_ASSERT_TRUE_MESSAGE(fd >= 0, "a bus's port not found in /proc/self/fd");
+        TEST_ASSERT_TRUE_MESSAGE((fcntl(fd, F_GETFL) & O_NONBLOCK) != 0, "a blocking descriptor");
+    }
+    for (i = 0; i < 501u; i++) /* every path once first (the C library sets itself up lazily) */
+        loop_round(i, pos);
+    j288_robot_timing_reset(&g_robot);
+    alloc_count_start();
+    for (i = 0; i < ALLOC_CYCLES; i++)
+        loop_round(i, pos);
+    allocs = alloc_count_stop();
+    TEST_ASSERT_EQUAL_UINT32_MESSAGE(0, (uint32_t)allocs, "allocations in the cycles");
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_robot_timing(&g_robot, &rep));
+    TEST_ASSERT_TRUE_MESSAGE(rep.lateness.count >= 10u, "the pacing never slept");
+    TEST_ASSERT_TRUE_MESSAGE(rep.missed >= 10u, "no deadline was missed");
+}
+
+static unsigned g_stall_at; /* the cycle whose on_cycle stalls */
+#define STALL_US 7000L
+
+static void stalling_cycle(void *user, j288_robot_t *r, const j288_robot_cycle_t *c)
+{
+    (void)user;
+    (void)r;
+    if (c->cycle == g_stall_at)
+        pause_us(STALL_US);
+}
+
+static void assert_ordered(const j288_rt_summary_t *s)
+{
+    TEST_ASSERT_TRUE(s->p50_us <= s->p99_us);
+    TEST_ASSERT_TRUE(s->p99_us <= s->p999_us);
+    TEST_ASSERT_TRUE(s->p999_us <= s->max_us);
+}
+
+/* The statistics count what was provoked: a cycle stalled 3.5 periods misses the next
+ * deadline and skips the periods it covered (never a burst), every other cycle slept to its
+ * deadline, and a cycle bounded at 1 us ends at its bound. */
+static void test_timing_counts_a_forced_miss_and_a_cut(void)
+{
+    j288_robot_options_t o = counting_options();
+    j288_robot_stats_t rs;
+    j288_rt_report_t rep;
+    o.on_cycle = stalling_cycle;
+    sim_start(0, "1,2,3");
+    make_config(1, LOADED_MARGIN_US);
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_robot_open(&g_robot, &g_cfg, &o));
+    cycle_until_known();
+    j288_robot_timing_reset(&g_robot);
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_robot_stats(&g_robot, &rs));
+    g_stall_at = rs.cycles + 10u;
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_robot_run(&g_robot, 2000u, 30u, 0u));
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_robot_timing(&g_robot, &rep));
+    TEST_ASSERT_EQUAL_UINT32(29, rep.cycles); /* 30 waits: the first starts the schedule */
+    TEST_ASSERT_EQUAL_UINT32(rep.cycles, rep.lateness.count + rep.missed);
+    TEST_ASSERT_TRUE_MESSAGE(rep.missed >= 1u, "the stalled cycle's deadline not missed");
+    TEST_ASSERT_TRUE_MESSAGE(rep.skipped >= 2u, "the periods it covered not skipped");
+    TEST_ASSERT_TRUE(rep.duration.max_us >= (uint32_t)STALL_US);
+    TEST_ASSERT_EQUAL_UINT32(2000, rep.period_us);
+    assert_ordered(&rep.lateness);
+    assert_ordered(&rep.duration);
+    TEST_ASSERT_EQUAL_UINT32(0, rep.cut);
+    (void)j288_robot_cycle(&g_robot, 1u, NULL);
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_robot_timing(&g_robot, &rep));
+    TEST_ASSERT_EQUAL_UINT32(1, rep.cut);
+}
+
+/* The runner's options put the opening thread under SCHED_FIFO with its memory locked, on
+ * the CPU asked for, and close puts back what was there; without the rights (not root), the
+ * notice says how to get them and the robot runs. A CPU the process may not use is refused
+ * before anything is opened. */
+static void test_realtime_through_the_runner(void)
+{
+    j288_robot_options_t o;
+    j288_rt_report_t rep;
+    cpu_set_t before, during, after;
+    int cpu = 0;
+    memset(&o, 0, sizeof o);
+    CPU_ZERO(&before);
+    TEST_ASSERT_EQUAL_INT(0, sched_getaffinity(0, sizeof before, &before));
+    while (!CPU_ISSET((size_t)cpu, &before))
+        cpu++;
+    o.realtime = J288_RT_DEFAULT_PRIORITY;
+    o.pin_cpu = true;
+    o.cpu = (uint16_t)cpu;
+    sim_start(0, "1");
+    make_config(1, LOADED_MARGIN_US);
+    g_cfg.njoints = 1;
+    TEST_ASSERT_EQUAL_INT_MESSAGE(J288_OK, j288_robot_open(&g_robot, &g_cfg, &o),
+                                  j288_robot_error(&g_robot));
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_robot_timing(&g_robot, &rep));
+    TEST_ASSERT_EQUAL_INT(cpu, rep.cpu);
+    TEST_ASSERT_EQUAL_INT(0, sched_getaffinity(0, sizeof during, &during));
+    TEST_ASSERT_EQUAL_INT(1, CPU_COUNT(&during));
+    if (j288_robot_rt_notice(&g_robot)[0] == '\0') {
+        TEST_ASSERT_EQUAL_INT(J288_RT_DEFAULT_PRIORITY, rep.priority);
+        TEST_ASSERT_EQUAL_INT(SCHED_FIFO, sched_getscheduler(0));
+        TEST_ASSERT_EQUAL_UINT32(1, rep.memory_locked);
+    } else { /* no rights here: said so, and the robot runs */
+        TEST_ASSERT_NOT_NULL(strstr(j288_robot_rt_notice(&g_robot), "ulimit"));
+    }
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_robot_cycle(&g_robot, LOADED_CYCLE_US, NULL));
+    j288_robot_close(&g_robot);
+    TEST_ASSERT_EQUAL_INT(SCHED_OTHER, sched_getscheduler(0));
+    TEST_ASSERT_EQUAL_INT(0, sched_getaffinity(0, sizeof after, &after));
+    TEST_ASSERT_TRUE(CPU_EQUAL(&before, &after));
+
+    o.cpu = CPU_SETSIZE - 1;
+    TEST_ASSERT_EQUAL_INT(J288_ERR_BAD_ARG, j288_robot_open(&g_robot, &g_cfg, &o));
+    TEST_ASSERT_NOT_NULL(strstr(j288_robot_error(&g_robot), "CPU 1023 is not one this process"));
+    TEST_ASSERT_EQUAL_INT(SCHED_OTHER, sched_getscheduler(0));
+}
+
 int main(void)
 {
     UNITY_BEGIN();
@@ -854,5 +1031,8 @@ int main(void)
     RUN_TEST(test_transfer_after_a_long_silent_one);
     RUN_TEST(test_stop_on_bus_loss);
     RUN_TEST(test_a_cycle_at_its_bound_takes_the_replies_waiting);
+    RUN_TEST(test_cycles_allocate_nothing);
+    RUN_TEST(test_timing_counts_a_forced_miss_and_a_cut);
+    RUN_TEST(test_realtime_through_the_runner);
     return UNITY_END();
 }

@@ -6,7 +6,7 @@
 
 #include "bridge.h"
 
-#define DIAG_MAX_STATUS (1u + J288_ROBOT_MAX_BUSES + J288_ROBOT_MAX_JOINTS)
+#define DIAG_MAX_STATUS (2u + J288_ROBOT_MAX_BUSES + J288_ROBOT_MAX_JOINTS) /* bridge, loop */
 #define DIAG_MAX_VALUES 28u
 #define DIAG_POOL (64u * 1024u)
 
@@ -114,6 +114,39 @@ static void bus_status(bridge_t *b, unsigned bus, diagnostic_msgs_msg_dds__Diagn
     kv(s, "worst_sweep_us", str("%lu", (unsigned long)bs.worst_sweep_us));
 }
 
+/* The loop's timing (host/j288_rt.h): a warning while deadlines are being missed. */
+static void loop_status(bridge_t *b, diagnostic_msgs_msg_dds__DiagnosticArray_ *m)
+{
+    static uint32_t missed_reported; /* at the previous diagnostics */
+    j288_rt_report_t t;
+    uint32_t missed;
+    diagnostic_msgs_msg_dds__DiagnosticStatus_ *s;
+    (void)j288_robot_timing(b->robot, &t);
+    missed = t.missed - missed_reported;
+    missed_reported = t.missed;
+    s = status(m, missed != 0u ? LEVEL_WARN : LEVEL_OK, str("j288-dds: loop"), str("j288-dds"));
+    s->message = missed != 0u ? str("%lu deadline(s) missed since the last report",
+                                    (unsigned long)missed)
+                              : str("ok");
+    kv(s, "cycles", str("%lu", (unsigned long)t.cycles));
+    kv(s, "period_us", str("%lu", (unsigned long)t.period_us));
+    kv(s, "missed_deadlines", str("%lu", (unsigned long)t.missed));
+    kv(s, "skipped_periods", str("%lu", (unsigned long)t.skipped));
+    kv(s, "cut_cycles", str("%lu", (unsigned long)t.cut));
+    kv(s, "lateness_count", str("%lu", (unsigned long)t.lateness.count));
+    kv(s, "lateness_p50_us", str("%lu", (unsigned long)t.lateness.p50_us));
+    kv(s, "lateness_p99_us", str("%lu", (unsigned long)t.lateness.p99_us));
+    kv(s, "lateness_p99_9_us", str("%lu", (unsigned long)t.lateness.p999_us));
+    kv(s, "lateness_max_us", str("%lu", (unsigned long)t.lateness.max_us));
+    kv(s, "duration_p50_us", str("%lu", (unsigned long)t.duration.p50_us));
+    kv(s, "duration_p99_us", str("%lu", (unsigned long)t.duration.p99_us));
+    kv(s, "duration_p99_9_us", str("%lu", (unsigned long)t.duration.p999_us));
+    kv(s, "duration_max_us", str("%lu", (unsigned long)t.duration.max_us));
+    kv(s, "priority", str("%ld", (long)t.priority));
+    kv(s, "cpu", str("%ld", (long)t.cpu));
+    kv(s, "memory_locked", str("%s", t.memory_locked != 0u ? "true" : "false"));
+}
+
 static const char *mode_name(bridge_joint_mode_t mo)
 {
     switch (mo) {
@@ -176,6 +209,7 @@ void bridge_fill_diagnostics(bridge_t *b, diagnostic_msgs_msg_dds__DiagnosticArr
     bridge_stamp_now(&m->header.stamp); /* frame_id: empty */
     m->status._buffer = d.status;
     bridge_status(b, m);
+    loop_status(b, m);
     for (i = 0; i < j288_robot_nbuses(b->robot); i++)
         bus_status(b, i, m);
     for (i = 0; i < j288_robot_njoints(b->robot); i++)

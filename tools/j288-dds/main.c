@@ -53,8 +53,17 @@ static const char usage[] =
     "  --unitree-hg        the same with unitree_hg's messages (G1, H1-2)\n"
     "  --stop-on-bus-loss  a bus that stops answering or vanishes locks every bus, and\n"
     "                      commands are refused until restart\n"
+    "  --realtime[=PRIO]   lock memory and run the loop under SCHED_FIFO at PRIO (1-99,\n"
+    "                      default 80); without the rights a notice says how to get them\n"
+    "                      (ulimit -r, limits.d, CAP_SYS_NICE) and the loop runs on\n"
+    "  --cpu N             pin the loop to CPU N (docs/realtime.md)\n"
     "  --help, --version\n"
     "Gains: each joint's kp and kd from the config, else kp 20 N*m/rad, kd 2.5 N*m*s/rad.\n"
+    "Pacing: cycle k is due at the first cycle's time + k/HZ; a cycle that overruns makes\n"
+    "the next start at once (a missed deadline), periods wholly missed are skipped, never\n"
+    "sent back to back. rt/diagnostics' \"j288-dds: loop\" status: deadlines missed,\n"
+    "periods skipped, cycles cut at their bound, wake-up lateness and cycle duration\n"
+    "(p50, p99, p99.9, max).\n"
     "One commander per joint: the first writer whose command for a joint is applied owns it\n"
     "until it has been silent for the timeout; other writers' commands for it are refused.\n"
     "SIGINT / SIGTERM: every bus locked (broadcast lock, watchdog bit 0), then exit 0.\n"
@@ -72,6 +81,8 @@ typedef struct {
     bool per_joint;
     bool stop_on_bus_loss;
     char ns[NS_MAX + 1]; /* without the leading /; "" for none */
+    int realtime; /* SCHED_FIFO priority, 0: none */
+    int cpu;      /* -1: not pinned */
 } options_t;
 
 static volatile sig_atomic_t stop_signal;
@@ -139,6 +150,7 @@ static int parse(int argc, char **argv, options_t *o, bool *done)
     memset(o, 0, sizeof *o);
     o->rate_hz = DEFAULT_RATE_HZ;
     o->timeout_us = J288_DDS_DEFAULT_TIMEOUT_US;
+    o->cpu = -1;
     if (env != NULL && *env != '\0') {
         if (!number(env, 0, 232, &v))
             return bad_usage("ROS_DOMAIN_ID is not a domain id 0-232", env);
@@ -164,6 +176,13 @@ static int parse(int argc, char **argv, options_t *o, bool *done)
         } else if (strcmp(a, "--stop-on-bus-loss") == 0) {
             o->stop_on_bus_loss = true;
             takes = false;
+        } else if (strcmp(a, "--realtime") == 0 || strncmp(a, "--realtime=", 11) == 0) {
+            o->realtime = J288_RT_DEFAULT_PRIORITY;
+            if (a[10] == '=' && (!number(a + 11, 1, 99, &v) || v != (double)(int)v))
+                return bad_usage("--realtime takes a priority 1-99", a + 11);
+            if (a[10] == '=')
+                o->realtime = (int)v;
+            takes = false;
         } else if (val == NULL) {
             return bad_usage(strncmp(a, "--", 2) == 0 ? "missing value" : "unknown argument", a);
         } else if (strcmp(a, "--config") == 0) {
@@ -182,6 +201,10 @@ static int parse(int argc, char **argv, options_t *o, bool *done)
             if (!number(val, 0, 10000, &v) || (v > 0 && v < 0.1))
                 return bad_usage("--rate takes 0 (back to back) or 0.1-10000 Hz", val);
             o->rate_hz = v;
+        } else if (strcmp(a, "--cpu") == 0) {
+            if (!number(val, 0, 1023, &v) || v != (double)(int)v)
+                return bad_usage("--cpu takes a CPU number 0-1023", val);
+            o->cpu = (int)v;
         } else if (strcmp(a, "--timeout") == 0) {
             if (!number(val, 1, 60000, &v))
                 return bad_usage("--timeout takes 1-60000 ms", val);
@@ -545,24 +568,6 @@ static void publish_diagnostics(bridge_t *b, const dds_io_t *io)
     (void)dds_write(io->diag_w, &da);
 }
 
-/* Sleep until *next (CLOCK_MONOTONIC), then advance it by period; a late cycle starts at once
- * and the schedule restarts from now. Returns early on a signal. */
-static void wait_period(struct timespec *next, long period_ns)
-{
-    struct timespec now;
-    (void)clock_gettime(CLOCK_MONOTONIC, &now);
-    next->tv_nsec += period_ns;
-    while (next->tv_nsec >= 1000000000L) {
-        next->tv_nsec -= 1000000000L;
-        next->tv_sec++;
-    }
-    if (now.tv_sec > next->tv_sec || (now.tv_sec == next->tv_sec && now.tv_nsec >= next->tv_nsec)) {
-        *next = now;
-        return;
-    }
-    (void)clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, next, NULL);
-}
-
 /* One line at exit: cycles, their rate, and the process's CPU time (DDS's threads included). */
 static void print_summary(const j288_robot_t *r, double start_s)
 {
@@ -576,6 +581,12 @@ static void print_summary(const j288_robot_t *r, double start_s)
     fprintf(stderr, "j288-dds: %lu cycles (%lu complete) in %.2f s, %.0f cycles/s, cpu %.3f s\n",
             (unsigned long)rs.cycles, (unsigned long)rs.complete_cycles, secs,
             secs > 0 ? (double)rs.cycles / secs : 0.0, cpu);
+    {
+        j288_rt_report_t rep;
+        char text[640];
+        (void)j288_robot_timing(r, &rep);
+        fputs(j288_rt_format(&rep, text, sizeof text), stderr);
+    }
 }
 
 /* The STATUS= line systemd shows (systemctl status): the cycle rate since the previous one. */
@@ -617,8 +628,7 @@ static int run(const options_t *o)
     j288_robot_options_t ro;
     dds_io_t io;
     status_ctx_t sc;
-    struct timespec next;
-    long period_ns = o->rate_hz > 0 ? (long)(1e9 / o->rate_hz) : 0;
+    uint32_t period_us = o->rate_hz > 0 ? (uint32_t)(1e6 / o->rate_hz + 0.5) : 0u;
     unsigned slots = o->mode == MODE_UNITREE_GO ? J288_DDS_UNITREE_MOTORS : J288_DDS_HG_MOTORS;
     uint32_t last_diag;
     double start_s;
@@ -639,12 +649,16 @@ static int run(const options_t *o)
     ro.on_event = on_event;
     ro.user = &pending;
     ro.stop_on_bus_loss = o->stop_on_bus_loss; /* the runner stops every bus itself */
+    ro.realtime = (uint8_t)o->realtime;
+    ro.pin_cpu = o->cpu >= 0;
+    ro.cpu = (uint16_t)(o->cpu >= 0 ? o->cpu : 0);
     rc = j288_robot_open(&robot, &cfg, &ro);
     if (rc != J288_OK) {
         fprintf(stderr, "j288-dds: %s\n", j288_robot_error(&robot));
         j288_robot_close(&robot);
-        return 1;
+        return rc == J288_ERR_BAD_ARG ? 2 : 1;
     }
+    fputs(j288_robot_rt_notice(&robot), stderr);
     j288_robot_set_stop_flag(&robot, &stop_signal);
     dds_set_log_sink(log_sink, NULL);
     if (dds_open(&io, o) != 0) {
@@ -665,9 +679,10 @@ static int run(const options_t *o)
     sc.cycles = 0;
     sc.at_s = start_s;
     last_diag = j288_robot_now_us();
-    (void)clock_gettime(CLOCK_MONOTONIC, &next);
     publish_diagnostics(&b, &io);
     service_ready(line);
+    j288_robot_timing_reset(&robot);
+    (void)j288_robot_pace(&robot, period_us); /* the schedule starts with the first cycle */
     while (stop_signal == 0) {
         take_commands(&b, &io);
         collect_drops(&b);
@@ -689,8 +704,12 @@ static int run(const options_t *o)
             publish_diagnostics(&b, &io);
         }
         service_tick((uint64_t)(mono_s() * 1e6), service_status, &sc);
-        if (period_ns > 0)
-            wait_period(&next, period_ns);
+        rc = j288_robot_pace(&robot, period_us); /* absolute deadlines, j288_rt.h */
+        if (rc == J288_ERR_OFFLINE) {
+            fprintf(stderr, "j288-dds: every bus is gone: %s\n", j288_robot_error(&robot));
+            status = 1;
+            break;
+        }
     }
     if (stop_signal != 0) {
         service_stopping(stop_signal == SIGINT ? "SIGINT: locking every bus" : "SIGTERM: locking every bus");

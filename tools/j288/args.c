@@ -56,6 +56,10 @@ int cli_args_next(cli_args_t *a, const cli_opt_t *opts, const char **value)
         return CLI_ARG_ERROR;
     }
     a->opt_name = o->name;
+    if (o->has_value == CLI_VALUE_OPTIONAL) {
+        *value = eq != NULL ? eq + 1 : NULL;
+        return o->key;
+    }
     if (!o->has_value) {
         if (eq != NULL) {
             cli_error("option %s takes no value", o->name);

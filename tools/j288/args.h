@@ -17,10 +17,14 @@
 #include "j288_range.h"
 
 typedef struct {
-    const char *name; /* "--id" */
-    bool has_value;
-    int key; /* >= 0, returned by cli_args_next() */
+    const char *name;        /* "--id" */
+    unsigned char has_value; /* false, true, or CLI_VALUE_OPTIONAL */
+    int key;                 /* >= 0, returned by cli_args_next() */
 } cli_opt_t;
+
+/* has_value: "--opt" alone (*value NULL) or "--opt=VALUE", never the next argument
+ * ("--realtime[=PRIO]"). */
+#define CLI_VALUE_OPTIONAL 2
 
 #define CLI_ARG_END        (-1)
 #define CLI_ARG_POSITIONAL (-2)

@@ -32,6 +32,7 @@ void cli_bus_opts_init(cli_bus_opts_t *o, const cli_global_t *g)
     o->margin_us = g->margin_us;
     o->echo = g->echo;
     o->retries = g->has_retries ? (int)g->retries : -1;
+    o->cpu = -1;
 }
 
 int cli_bus_common_opt(cli_bus_opts_t *o, int key, const char *value)
@@ -68,6 +69,22 @@ int cli_bus_common_opt(cli_bus_opts_t *o, int key, const char *value)
     case CLI_OPT_CONFIG:
         o->config = value;
         return 0;
+    case CLI_OPT_REALTIME:
+    case CLI_OPT_CPU: {
+        long long n = J288_RT_DEFAULT_PRIORITY;
+        if (key == CLI_OPT_REALTIME) {
+            if (value != NULL && cli_parse_int("--realtime", value, 1, 99, &n) != 0) {
+                return -1;
+            }
+            o->realtime = (int)n;
+        } else {
+            if (cli_parse_int("--cpu", value, 0, 1023, &n) != 0) {
+                return -1;
+            }
+            o->cpu = (int)n;
+        }
+        return 0;
+    }
     default:
         return 1;
     }
@@ -192,15 +209,71 @@ int cli_bus_open(cli_bus_t *b, const cli_bus_opts_t *o, int default_retries)
     ro.margin_us =
         o->margin_us != 0u ? o->margin_us : (is_pseudo_terminal(dev) ? PTY_MARGIN_US : 0u);
     ro.retries = (uint8_t)(o->retries >= 0 ? o->retries : default_retries);
+    cli_bus_rt_options(o, &ro);
     rc = j288_robot_open_port(&robot, dev, &ro);
     if (rc != J288_OK) {
         cli_error("%s", cli_bus_error(b));
-        return CLI_EXIT_FAIL;
+        return rc == J288_ERR_BAD_ARG ? CLI_EXIT_USAGE : CLI_EXIT_FAIL;
     }
     cli_print_notices(j288_robot_notices(&robot, 0));
+    cli_print_rt_notice(&robot);
     j288_robot_set_stop_flag(&robot, &cli_stop_signal);
     b->open = true;
     return CLI_EXIT_OK;
+}
+
+void cli_bus_rt_options(const cli_bus_opts_t *o, j288_robot_options_t *ro)
+{
+    ro->realtime = (uint8_t)o->realtime;
+    ro->pin_cpu = o->cpu >= 0;
+    ro->cpu = (uint16_t)(o->cpu >= 0 ? o->cpu : 0);
+}
+
+void cli_print_rt_notice(const j288_robot_t *r)
+{
+    const char *quiet = getenv("J288_QUIET");
+    if (quiet == NULL || strcmp(quiet, "1") != 0) {
+        fputs(j288_robot_rt_notice(r), stderr);
+    }
+}
+
+void cli_print_timing(FILE *f, const j288_robot_t *r)
+{
+    j288_rt_report_t rep;
+    char text[640];
+    if (j288_robot_timing(r, &rep) != J288_OK)
+        return;
+    fputs(j288_rt_format(&rep, text, sizeof text), f);
+}
+
+static void json_summary(cli_json_t *j, const char *key, const j288_rt_summary_t *s)
+{
+    cli_json_begin_object(j, key);
+    cli_json_uint(j, "count", s->count);
+    cli_json_uint(j, "p50", s->p50_us);
+    cli_json_uint(j, "p99", s->p99_us);
+    cli_json_uint(j, "p99_9", s->p999_us);
+    cli_json_uint(j, "max", s->max_us);
+    cli_json_end_object(j);
+}
+
+void cli_json_timing(cli_json_t *j, const j288_robot_t *r)
+{
+    j288_rt_report_t rep;
+    if (j288_robot_timing(r, &rep) != J288_OK)
+        return;
+    cli_json_begin_object(j, "timing");
+    cli_json_uint(j, "cycles", rep.cycles);
+    cli_json_uint(j, "period_us", rep.period_us);
+    cli_json_uint(j, "missed_deadlines", rep.missed);
+    cli_json_uint(j, "skipped_periods", rep.skipped);
+    cli_json_uint(j, "cut_cycles", rep.cut);
+    json_summary(j, "lateness_us", &rep.lateness);
+    json_summary(j, "duration_us", &rep.duration);
+    cli_json_int(j, "priority", rep.priority);
+    cli_json_int(j, "cpu", rep.cpu);
+    cli_json_bool(j, "memory_locked", rep.memory_locked != 0u);
+    cli_json_end_object(j);
 }
 
 const char *cli_bus_error(const cli_bus_t *b)

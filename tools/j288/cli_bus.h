@@ -34,7 +34,9 @@ enum {
     CLI_OPT_ECHO,
     CLI_OPT_RETRIES,
     CLI_OPT_JSON,
-    CLI_OPT_CONFIG
+    CLI_OPT_CONFIG,
+    CLI_OPT_REALTIME,
+    CLI_OPT_CPU
 };
 #define CLI_BUS_COMMON_OPTS                                                                        \
     {"--port", true, CLI_OPT_PORT}, {"--baud", true, CLI_OPT_BAUD},                                \
@@ -56,6 +58,23 @@ enum {
     "  --config FILE    robot config (YAML): joints by name (--joint), their zero, direction,\n"  \
     "                   limits, gains and phase, and the bus port when --port is not given\n"
 
+/* The options of the commands that run a loop (log, hold, move, torque, top, the robot
+ * forms): the runner's real time (j288_rt.h), handled by cli_bus_common_opt(). */
+#define CLI_BUS_RT_OPTS                                                                            \
+    {"--realtime", CLI_VALUE_OPTIONAL, CLI_OPT_REALTIME}, { "--cpu", true, CLI_OPT_CPU }
+
+#define CLI_BUS_RT_HELP                                                                            \
+    "real time (docs/realtime.md):\n"                                                              \
+    "  --realtime[=PRIO] lock the process's memory and run the loop under SCHED_FIFO at\n"         \
+    "                   PRIO (1-99, default 80); without the rights a notice says how to\n"        \
+    "                   get them (ulimit -r, limits.d, CAP_SYS_NICE) and the loop runs on\n"      \
+    "  --cpu N          pin the loop to CPU N\n"                                                   \
+    "Pacing: cycle k is due at the first cycle's time + k/HZ. A cycle that overruns makes\n"       \
+    "the next start at once (a missed deadline); periods wholly missed are skipped, never\n"      \
+    "sent back to back. The summary's timing lines: cycles, deadlines missed, periods\n"          \
+    "skipped, cycles cut at their bound; wake-up lateness and cycle duration (p50, p99,\n"       \
+    "p99.9, max).\n"
+
 typedef struct {
     const char *port;
     uint32_t baud;      /* 0: default */
@@ -64,6 +83,8 @@ typedef struct {
     int retries; /* -1: the command's default */
     bool json;
     const char *config; /* --config FILE, or NULL */
+    int realtime;       /* --realtime[=PRIO]: the priority; 0: not asked */
+    int cpu;            /* --cpu N; -1: not asked */
 } cli_bus_opts_t;
 
 typedef struct {
@@ -114,6 +135,18 @@ int cli_bus_baud(uint32_t given, uint32_t *baud);
  * once (cli_print_notices()), and one error line on failure. Returns CLI_EXIT_OK or
  * CLI_EXIT_FAIL / CLI_EXIT_USAGE. */
 int cli_bus_open(cli_bus_t *b, const cli_bus_opts_t *o, int default_retries);
+/* The real-time part of the runner's options from o (--realtime, --cpu). */
+void cli_bus_rt_options(const cli_bus_opts_t *o, j288_robot_options_t *ro);
+
+/* What the runner's real-time set-up refused and how to allow it, on stderr (nothing under
+ * J288_QUIET=1). */
+void cli_print_rt_notice(const j288_robot_t *r);
+
+/* The loop's timing (j288_robot_timing()): its three "timing: " lines on f, or a "timing"
+ * object in a JSON object being written. */
+void cli_print_timing(FILE *f, const j288_robot_t *r);
+void cli_json_timing(cli_json_t *j, const j288_robot_t *r);
+
 /* Close; servos the command drove and did not lock are stopped by the runner. */
 void cli_bus_close(cli_bus_t *b);
 /* Close leaving the last command in force (--keep). */

@@ -673,6 +673,7 @@ static void joint_setpoint(const drive_args_t *d, const drive_plan_t *p, double 
 
 typedef struct {
     uint32_t sent, ok, failed, overruns;
+    const j288_robot_t *robot; /* for the loop's timing */
     j288_reply_raw_t last;
     bool have_last;
     j288_cmd_raw_t last_cmd;
@@ -731,6 +732,7 @@ static void drive_report_json(const drive_args_t *d, const drive_result_t *r, co
     cli_json_uint(&j, "replies", r->ok);
     cli_json_uint(&j, "failures", r->failed);
     cli_json_uint(&j, "overruns", r->overruns);
+    cli_json_timing(&j, r->robot);
     cli_json_bool(&j, "locked", !d->keep || cli_stop_signal != 0);
     if (d->side == SIDE_JOINT) {
         cli_json_str(&j, "side", "joint");
@@ -779,6 +781,7 @@ static void drive_report(const drive_args_t *d, const drive_result_t *r, const c
            (unsigned long)r->overruns,
            (d->keep && cli_stop_signal == 0) ? "last command left in force (--keep)"
                                              : "servo locked");
+    cli_print_timing(stdout, r->robot);
 }
 
 typedef enum {
@@ -921,9 +924,13 @@ static drive_end_t drive_loop_run(cli_bus_t *b, drive_args_t *d, const drive_pla
                               drive_result_t *res)
 {
     uint32_t period_us = (uint32_t)lround(1e6 / d->rate_hz);
-    uint32_t t0 = j288_robot_now_us(), next = t0, now;
+    uint32_t t0 = j288_robot_now_us();
     int fails = 0, rc;
+    res->robot = b->robot;
+    j288_robot_timing_reset(b->robot); /* the start's reads are not the loop's */
+    (void)j288_robot_pace(b->robot, period_us); /* the schedule starts with the first step */
     for (;;) {
+        j288_rt_report_t rep;
         double t = (double)(uint32_t)(j288_robot_now_us() - t0) / 1e6;
         if (cli_stop_signal != 0) {
             return DRIVE_END_SIGNAL;
@@ -954,13 +961,10 @@ static drive_end_t drive_loop_run(cli_bus_t *b, drive_args_t *d, const drive_pla
                       d->id, fails, j288_strerror(rc));
             return DRIVE_END_SILENT;
         }
-        next += period_us;
-        now = j288_robot_now_us();
-        if ((int32_t)(next - now) < 0) {
-            res->overruns++;
-            next = now;
-        }
-        if (cli_bus_sleep_until(b, next) == J288_ERR_OFFLINE) {
+        rc = j288_robot_pace(b->robot, period_us);
+        (void)j288_robot_timing(b->robot, &rep);
+        res->overruns = rep.missed;
+        if (rc == J288_ERR_OFFLINE) {
             drive_progress_end(res);
             cli_report_txn_failure(b, (uint8_t)d->id, J288_ERR_OFFLINE);
             return DRIVE_END_GONE;
@@ -1060,12 +1064,14 @@ static int run_drive(drive_args_t *d, cli_bus_opts_t *o)
     "locked and the command fails.\n"                                                             \
     "Ctrl-C or SIGTERM: the servo is sent lock before exiting (exit 130 / 143).\n"                 \
     "Exit status: 0 done; 1 no reply, servo stopped answering, joint angle unknown or lost,\n"     \
-    "or device error; 2 bad arguments or a target outside the limits.\n"
+    "or device error; 2 bad arguments or a target outside the limits.\n"                         \
+    "\n" CLI_BUS_RT_HELP
 
 #define DRIVE_OPTS                                                                                 \
     {"--id", true, OPT_ID}, {"--joint", true, OPT_JOINT}, {"--side", true, OPT_SIDE},              \
         {"--rate", true, OPT_RATE}, {"--duration", true, OPT_DURATION},                            \
-        {"--watchdog", true, OPT_WATCHDOG}, {"--keep", false, OPT_KEEP}, CLI_BUS_COMMON_OPTS
+        {"--watchdog", true, OPT_WATCHDOG}, {"--keep", false, OPT_KEEP}, CLI_BUS_RT_OPTS,         \
+        CLI_BUS_COMMON_OPTS
 
 static void drive_args_init(drive_args_t *d, drive_kind_t kind)
 {

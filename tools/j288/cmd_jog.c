@@ -59,6 +59,8 @@ static const char jog_help[] =
     "device or config error, every bus gone, a servo's watchdog had tripped; 2 bad\n"
     "arguments (and on Windows: not available there); 130/143 stopped by SIGINT/SIGTERM\n"
     "after the locks.\n"
+    "  --realtime[=PRIO], --cpu N  the loop under SCHED_FIFO (default 80) with memory locked,\n"
+    "                   on CPU N (docs/realtime.md; as `j288 log --help` says)\n"
     "\n" CLI_BUS_COMMON_HELP;
 
 #define JOG_ACQUIRE_CYCLES 200u /* the most cycles the start waits for the joint's angle */
@@ -560,7 +562,7 @@ int cli_cmd_jog(int argc, char **argv, const cli_global_t *gl)
     static const cli_opt_t opts[] = {
         {"--joint", true, OPT_JOINT}, {"--id", true, OPT_ID},   {"--step", true, OPT_STEP},
         {"--speed", true, OPT_SPEED}, {"--kp", true, OPT_KP},   {"--kd", true, OPT_KD},
-        {"--rate", true, OPT_RATE},   {"--csv", true, OPT_CSV}, CLI_BUS_COMMON_OPTS,
+        {"--rate", true, OPT_RATE},   {"--csv", true, OPT_CSV}, CLI_BUS_RT_OPTS, CLI_BUS_COMMON_OPTS,
         {NULL, false, 0}};
     static j288_robot_t robot; /* large: not on the stack */
     static jog_t g;
@@ -615,6 +617,7 @@ int cli_cmd_jog(int argc, char **argv, const cli_global_t *gl)
     ro.on_cycle = on_cycle;
     ro.on_event = on_event;
     ro.user = &g;
+    cli_bus_rt_options(&o, &ro);
     if (a.csv != NULL) {
         g.csv = fopen(a.csv, "w");
         if (g.csv == NULL) {
@@ -643,6 +646,7 @@ int cli_cmd_jog(int argc, char **argv, const cli_global_t *gl)
         return rc == J288_ERR_BAD_ARG ? CLI_EXIT_USAGE : CLI_EXIT_FAIL;
     }
     j288_robot_set_stop_flag(&robot, &cli_stop_signal);
+    cli_print_rt_notice(&robot); /* (before the screen: what --realtime could not get) */
     for (k = 0; k < j288_robot_njoints(&robot); k++) { /* --kp, --kd, else the config's */
         j288_joint_config_t jc;
         (void)j288_robot_joint_config(&robot, k, &jc);

@@ -18,6 +18,7 @@ static const char log_help[] =
     "usage: j288 [--port DEV] log --id N[,M..] --rate HZ --duration S [--csv FILE]\n"
     "                [--hold | --swing AMP [--period S]] [--kp NM_RAD] [--kd NMS_RAD]\n"
     "                [--side joint|rotor|output] [--config FILE] [--json]\n"
+    "                [--realtime[=PRIO]] [--cpu N]\n"
     "\n"
     "Run the cycle scheduler: every 1/HZ seconds one sweep sends each listed servo its\n"
     "command and takes its reply. Without --hold or --swing each servo is sent lock\n"
@@ -45,10 +46,11 @@ static const char log_help[] =
     "                 beyond them holds or swings from the nearest limit), phase\n"
     "Prints the achieved rate, missed deadlines (sweeps that ended after the next tick was\n"
     "due: that tick starts late; ticks a whole period behind are skipped, never bunched),\n"
-    "bus statistics and, when driving, the tracking error. Ctrl-C or SIGTERM: every driven\n"
-    "servo is sent lock before exiting (exit 130 / 143).\n"
+    "the loop's timing, bus statistics and, when driving, the tracking error. --csv is\n"
+    "written from the loop (buffered, 64 KiB at a time): the tightest timing logs without\n"
+    "it. Ctrl-C or SIGTERM: every driven servo is sent lock before exiting (exit 130 / 143).\n"
     "Exit status: 0 done; 1 a servo never answered, device error; 2 bad arguments.\n"
-    "\n" CLI_BUS_COMMON_HELP;
+    "\n" CLI_BUS_RT_HELP "\n" CLI_BUS_COMMON_HELP;
 
 enum {
     OPT_IDS = 0,
@@ -166,6 +168,7 @@ static int parse_args(int argc, char **argv, log_args_t *a, cli_bus_opts_t *o, i
                                      {"--side", true, OPT_SIDE},
                                      {"--watchdog", true, OPT_WATCHDOG},
                                      {"--joint", true, OPT_JOINTS},
+                                     CLI_BUS_RT_OPTS,
                                      CLI_BUS_COMMON_OPTS,
                                      {NULL, false, 0}};
     cli_args_t args;
@@ -401,6 +404,7 @@ static void print_summary_json(const log_run_t *r, double achieved)
     }
     cli_json_end_array(&j);
     cli_json_str(&j, "side", r->a.side == SIDE_ROTOR ? "rotor" : (r->a.side == SIDE_OUTPUT ? "output" : "joint"));
+    cli_json_timing(&j, r->b.robot);
     cli_json_end_object(&j);
     cli_json_newline(&j);
 }
@@ -414,6 +418,7 @@ static void print_summary_text(const log_run_t *r, double achieved)
            "deadlines, %lu ticks skipped\n",
            (unsigned long)r->rs.cycles, r->rs.elapsed_s, achieved, r->a.rate_hz,
            (unsigned long)r->rs.missed, (unsigned long)r->rs.skipped);
+    cli_print_timing(stdout, r->b.robot);
     printf("bus: %lu transactions, %lu ok, %lu timeouts, %lu CRC errors, %lu wrong id, "
            "%lu collisions, %lu line errors, %lu stale bytes, %lu garbage bytes\n",
            (unsigned long)bs->transactions, (unsigned long)bs->ok, (unsigned long)bs->timeouts,
@@ -785,21 +790,17 @@ static void account_cycle(log_run_t *r, double t)
     }
 }
 
-/* Sleep until the next tick. A sweep that ran past it makes that tick start late, at once;
- * ticks a whole period or more behind are skipped rather than sent in a burst. */
-static int wait_tick(log_run_t *r, uint32_t *next, uint32_t period_us)
+/* Sleep until the next tick: the runner's pacing (absolute deadlines; a sweep that ran past
+ * the tick makes it start late, at once; ticks a whole period behind are skipped, never
+ * bunched). */
+static int wait_tick(log_run_t *r, uint32_t period_us)
 {
-    uint32_t now;
-    *next += period_us;
-    now = j288_robot_now_us();
-    if ((int32_t)(*next - now) < 0) {
-        r->rs.missed++;
-        while ((int32_t)(*next + period_us - now) <= 0) {
-            *next += period_us;
-            r->rs.skipped++;
-        }
-    }
-    return cli_bus_sleep_until(&r->b, *next);
+    j288_rt_report_t rep;
+    int rc = j288_robot_pace(r->b.robot, period_us);
+    (void)j288_robot_timing(r->b.robot, &rep);
+    r->rs.missed = rep.missed;
+    r->rs.skipped = rep.skipped;
+    return rc;
 }
 
 /* Whether a sweep's or a sleep's result ends the run: a stop signal or a vanished device. */
@@ -821,10 +822,10 @@ static bool run_ends(const log_run_t *r, int rc, log_end_t *end)
 static log_end_t log_cycles(log_run_t *r)
 {
     uint32_t period_us = (uint32_t)lround(1e6 / r->a.rate_hz);
-    uint32_t next;
     log_end_t end = LOG_DONE;
     r->t0 = j288_robot_now_us();
-    next = r->t0;
+    j288_robot_timing_reset(r->b.robot); /* the probe's sweeps are not the log's */
+    (void)j288_robot_pace(r->b.robot, period_us); /* the schedule starts with the first tick */
     for (;;) {
         double t = (double)(uint32_t)(j288_robot_now_us() - r->t0) / 1e6;
         if (t >= r->a.duration_s) {
@@ -836,7 +837,7 @@ static log_end_t log_cycles(log_run_t *r)
         }
         r->rs.cycles++;
         account_cycle(r, t);
-        if (run_ends(r, wait_tick(r, &next, period_us), &end)) {
+        if (run_ends(r, wait_tick(r, period_us), &end)) {
             break;
         }
     }

@@ -38,6 +38,15 @@ static const char robot_help[] =
     "  --json         (status, log, hold, stop) machine-readable output\n"
     "  --stop-on-bus-loss  (log, hold) a bus that stops answering or vanishes stops every\n"
     "                 bus and ends the command (exit 1): no half-held robot\n"
+    "  --realtime[=PRIO]  (log, hold) memory locked, the loop under SCHED_FIFO at PRIO\n"
+    "                 (1-99, default 80); refused without the rights: a notice says how to\n"
+    "                 get them (ulimit -r, limits.d, CAP_SYS_NICE), and the loop runs on\n"
+    "  --cpu N        (log, hold) pin the loop to CPU N\n"
+    "Pacing (log, hold): cycle k is due at the first cycle's time + k/HZ; a cycle that\n"
+    "overruns makes the next start at once (a missed deadline), periods wholly missed are\n"
+    "skipped, never sent back to back. The summary's timing lines: deadlines missed,\n"
+    "periods skipped, cycles cut at their bound, wake-up lateness and cycle duration (p50,\n"
+    "p99, p99.9, max); docs/realtime.md.\n"
     "A bus that stops answering is left behind (its joints go stale, reported at the end);\n"
     "a servo found with its watchdog tripped is cleared and reported (exit 1);\n"
     "Ctrl-C or SIGTERM sends the broadcast lock on every bus before exiting (130 / 143).\n"
@@ -56,14 +65,17 @@ enum {
     OPT_STOP_ON_LOSS,
     OPT_BAUD,
     OPT_ECHO,
-    OPT_RETRIES
+    OPT_RETRIES,
+    OPT_REALTIME,
+    OPT_CPU
 };
 static const cli_opt_t robot_opts[] = {
     {"--config", true, OPT_CONFIG}, {"--port", true, OPT_PORT},   {"--margin-us", true, OPT_MARGIN},
     {"--rate", true, OPT_RATE},     {"--duration", true, OPT_DURATION}, {"--csv", true, OPT_CSV},
     {"--hold", false, OPT_HOLD},    {"--json", false, OPT_JSON},
     {"--stop-on-bus-loss", false, OPT_STOP_ON_LOSS}, {"--baud", true, OPT_BAUD},
-    {"--echo", false, OPT_ECHO}, {"--retries", true, OPT_RETRIES}, {NULL, false, 0}};
+    {"--echo", false, OPT_ECHO}, {"--retries", true, OPT_RETRIES},
+    {"--realtime", CLI_VALUE_OPTIONAL, OPT_REALTIME}, {"--cpu", true, OPT_CPU}, {NULL, false, 0}};
 
 typedef struct {
     const char *config, *port, *csv;
@@ -71,6 +83,7 @@ typedef struct {
     double rate_hz, duration_s;
     bool have_duration, hold, json, stop_on_loss, echo;
     int retries;
+    int realtime, cpu; /* --realtime[=PRIO] (0: not asked), --cpu N (-1: not asked) */
 } robot_args_t;
 
 typedef struct {
@@ -119,6 +132,7 @@ static int parse_robot_args(int argc, char **argv, const cli_global_t *g, robot_
     a->retries = g->has_retries ? (int)g->retries : -1;
     a->rate_hz = 500.0;
     a->duration_s = 1.0;
+    a->cpu = -1;
     cli_args_init(&p, argc, argv);
     while ((key = cli_args_next(&p, robot_opts, &v)) != CLI_ARG_END) {
         int rc = 0;
@@ -171,6 +185,19 @@ static int parse_robot_args(int argc, char **argv, const cli_global_t *g, robot_
         case OPT_STOP_ON_LOSS:
             a->stop_on_loss = true;
             break;
+        case OPT_REALTIME:
+        case OPT_CPU: {
+            long long k = J288_RT_DEFAULT_PRIORITY;
+            if (key == OPT_CPU)
+                rc = cli_parse_int("--cpu", v, 0, 1023, &k);
+            else if (v != NULL)
+                rc = cli_parse_int("--realtime", v, 1, 99, &k);
+            if (key == OPT_CPU)
+                a->cpu = (int)k;
+            else
+                a->realtime = (int)k;
+            break;
+        }
         default: /* OPT_JSON */
             a->json = true;
             break;
@@ -317,6 +344,7 @@ static void print_summary(j288_robot_t *r, double seconds, uint32_t cycles, uint
     fprintf(f, "robot: %u cycles in %.3f s: %.1f cycles/s, %u complete, worst cycle %u us\n",
             (unsigned)cycles, seconds, seconds > 0 ? (double)cycles / seconds : 0.0,
             (unsigned)complete, (unsigned)rs.worst_cycle_us);
+    cli_print_timing(f, r);
     for (b = 0; b < j288_robot_nbuses(r); b++) {
         j288_robot_bus_stats_t bs;
         const j288_bus_stats_t *ws = j288_robot_bus_wire_stats(r, b);
@@ -457,6 +485,11 @@ int cli_cmd_robot(int argc, char **argv, const cli_global_t *g)
     o.on_cycle = on_cycle;
     o.user = &run;
     o.stop_on_bus_loss = a.stop_on_loss;
+    if (strcmp(cmd, "log") == 0 || strcmp(cmd, "hold") == 0) {
+        o.realtime = (uint8_t)a.realtime;
+        o.pin_cpu = a.cpu >= 0;
+        o.cpu = (uint16_t)(a.cpu >= 0 ? a.cpu : 0);
+    }
     if (a.csv != NULL && strcmp(cmd, "log") == 0) {
         csv = fopen(a.csv, "w");
         if (csv == NULL) {
@@ -476,10 +509,11 @@ int cli_cmd_robot(int argc, char **argv, const cli_global_t *g)
         cli_error("%s", j288_robot_error(&robot));
         if (csv != NULL)
             fclose(csv);
-        return CLI_EXIT_FAIL;
+        return rc == J288_ERR_BAD_ARG ? CLI_EXIT_USAGE : CLI_EXIT_FAIL;
     }
     j288_robot_set_stop_flag(&robot, &cli_stop_signal);
     print_notices(&robot);
+    cli_print_rt_notice(&robot);
 
     {
         unsigned unknown = acquire(&robot);
@@ -510,6 +544,7 @@ int cli_cmd_robot(int argc, char **argv, const cli_global_t *g)
         uint32_t t0 = j288_robot_now_us(), dur_us;
         bool forever = strcmp(cmd, "hold") == 0 && !a.have_duration;
         (void)j288_robot_stats(&robot, &before);
+        j288_robot_timing_reset(&robot);
         run.t0 = t0;
         run.csv = csv; /* from the first cycle after the start */
         g_csv_open = NULL;
@@ -540,6 +575,7 @@ int cli_cmd_robot(int argc, char **argv, const cli_global_t *g)
                 cli_json_real(&jw, "cycles_per_s", (double)(after.cycles - before.cycles) / secs);
                 cli_json_uint(&jw, "joints", j288_robot_njoints(&robot));
                 cli_json_uint(&jw, "buses", j288_robot_nbuses(&robot));
+                cli_json_timing(&jw, &robot);
                 cli_json_end_object(&jw);
                 cli_json_newline(&jw);
             } else {

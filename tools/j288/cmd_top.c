@@ -13,7 +13,7 @@
 
 static const char top_help[] =
     "usage: j288 top (--config FILE | --port DEV [--ids LIST]) [--once] [--rate HZ]\n"
-    "                [--interval S] [--plot JOINTS]\n"
+    "                [--interval S] [--plot JOINTS] [--realtime[=PRIO]] [--cpu N]\n"
     "\n"
     "A live view: every joint's angle (rad, joint frame), speed (rad/s), torque (N*m), case\n"
     "and winding temperatures, voltage and faults, and each bus's counters, redrawn every\n"
@@ -38,7 +38,7 @@ static const char top_help[] =
     "means.\n"
     "Exit status: 0 quit with q, or one frame printed; 1 no servo answered, a device or\n"
     "config error, every bus gone; 2 bad arguments; 130/143 stopped by SIGINT/SIGTERM.\n"
-    "\n" CLI_BUS_COMMON_HELP;
+    "\n" CLI_BUS_RT_HELP "\n" CLI_BUS_COMMON_HELP;
 
 #define TOP_ACQUIRE_CYCLES 200u /* the most cycles --once waits for every angle */
 #define TOP_SCAN_CYCLES    5u   /* cycles that tell which of --ids answer */
@@ -93,9 +93,10 @@ static void print_notices(FILE *f, const j288_robot_t *r, const char *eol)
     unsigned b;
     if (quiet != NULL && strcmp(quiet, "1") == 0)
         return;
-    for (b = 0; b < j288_robot_nbuses(r); b++) {
+    for (b = 0; b <= j288_robot_nbuses(r); b++) { /* and last, the real-time set-up's */
         const char *n;
-        for (n = j288_robot_notices(r, b); *n != '\0'; n++) {
+        for (n = b < j288_robot_nbuses(r) ? j288_robot_notices(r, b) : j288_robot_rt_notice(r);
+             *n != '\0'; n++) {
             if (*n == '\n')
                 fputs(eol, f);
             else
@@ -162,7 +163,8 @@ static void print_buses(FILE *f, const j288_robot_t *r, const char *eol)
     }
 }
 
-/* One frame: the header, the port's notices (on a terminal), the joints, the buses. */
+/* One frame: the header, the port's notices (on a terminal), the loop's timing, the joints,
+ * the buses. */
 static void print_frame(FILE *f, const j288_robot_t *r, const char *source, bool ansi)
 {
     j288_robot_stats_t rs;
@@ -172,6 +174,7 @@ static void print_frame(FILE *f, const j288_robot_t *r, const char *source, bool
             (unsigned long)rs.last_cycle_us, ansi ? "  q or Ctrl-C quits" : "");
     if (ansi)
         print_notices(f, r, "\n");
+    cli_print_timing(f, r);
     fputs("\n", f);
     print_joints(f, r, "\n");
     fputs("\n", f);
@@ -209,7 +212,7 @@ static void draw_live(const j288_robot_t *r, const char *source, const top_plot_
         return;
     print_frame(fr.f, r, source, true);
     if (pl->n != 0u) {
-        unsigned used = 6u + j288_robot_njoints(r) + j288_robot_nbuses(r);
+        unsigned used = 9u + j288_robot_njoints(r) + j288_robot_nbuses(r); /* (3: timing) */
         print_plot(fr.f, r, pl, a, cols, rows > used ? rows - used : 0u);
     }
     cli_live_frame_show(&fr, cols, rows);
@@ -358,6 +361,7 @@ int cli_cmd_top(int argc, char **argv, const cli_global_t *g)
                                      {"--interval", true, OPT_INTERVAL},
                                      {"--ids", true, OPT_IDS},
                                      {"--plot", true, OPT_PLOT},
+                                     CLI_BUS_RT_OPTS,
                                      CLI_BUS_COMMON_OPTS,
                                      {NULL, false, 0}};
     static j288_robot_t robot; /* large: not on the stack */
@@ -396,6 +400,7 @@ int cli_cmd_top(int argc, char **argv, const cli_global_t *g)
     ro.margin_us = o.margin_us;
     ro.echo = o.echo;
     ro.retries = (uint8_t)(o.retries > 0 ? o.retries : 0);
+    cli_bus_rt_options(&o, &ro);
     cli_signals_install();
     rc = (o.config != NULL) ? j288_robot_open_file(&robot, o.config, &ro)
                             : open_bus_ids(&robot, &o, &a, &ro);
@@ -403,7 +408,8 @@ int cli_cmd_top(int argc, char **argv, const cli_global_t *g)
         if (rc != J288_ERR_TIMEOUT && rc != J288_ERR_ABORTED)
             cli_error("%s", j288_robot_error(&robot));
         j288_robot_close(&robot);
-        return cli_stop_signal != 0 ? cli_signal_exit_code() : CLI_EXIT_FAIL;
+        return cli_stop_signal != 0 ? cli_signal_exit_code()
+                                    : (rc == J288_ERR_BAD_ARG ? CLI_EXIT_USAGE : CLI_EXIT_FAIL);
     }
     j288_robot_set_stop_flag(&robot, &cli_stop_signal);
     if (plot_joints(&robot, a.plot, &a, &plot) != 0) {
