@@ -72,7 +72,7 @@ class CycleInfo(Structure):
     _c_type_ = "j288_robot_cycle_t"
     _fields_ = [("cycle", c_uint32), ("start_us", c_uint32), ("duration_us", c_uint32),
                 ("fresh", c_uint), ("joints", c_uint), ("complete", c_bool),
-                ("watchdog", c_uint)]
+                ("watchdog", c_uint), ("lost", c_uint), ("back", c_uint)]
 
 
 class RobotStats(Structure):
@@ -80,7 +80,8 @@ class RobotStats(Structure):
 
     _c_type_ = "j288_robot_stats_t"
     _fields_ = [("cycles", c_uint32), ("complete_cycles", c_uint32),
-                ("last_cycle_us", c_uint32), ("worst_cycle_us", c_uint32)]
+                ("last_cycle_us", c_uint32), ("worst_cycle_us", c_uint32),
+                ("bus_losses", c_uint32), ("bus_returns", c_uint32)]
 
 
 class BusStats(Structure):
@@ -89,7 +90,9 @@ class BusStats(Structure):
     _c_type_ = "j288_robot_bus_stats_t"
     _fields_ = [("sweeps", c_uint32), ("empty_sweeps", c_uint32), ("down_events", c_uint32),
                 ("last_sweep_us", c_uint32), ("worst_sweep_us", c_uint32),
-                ("up", c_bool), ("gone", c_bool)]
+                ("up", c_bool), ("gone", c_bool), ("gone_events", c_uint32),
+                ("reopens", c_uint32), ("reopen_attempts", c_uint32),
+                ("lost_at_us", c_uint32), ("back_at_us", c_uint32)]
 
 
 class SlotStats(Structure):
@@ -115,7 +118,8 @@ class Options(Structure):
     _fields_ = [("port", c_char_p), ("baud", c_uint32), ("margin_us", c_uint32),
                 ("down_after", c_uint8), ("no_low_latency", c_bool),
                 ("on_event", c_void_p), ("on_cycle", c_void_p), ("user", c_void_p),
-                ("stop_on_bus_loss", c_bool), ("echo", c_bool), ("retries", c_uint8)]
+                ("stop_on_bus_loss", c_bool), ("echo", c_bool), ("retries", c_uint8),
+                ("no_reopen", c_bool)]
 
 
 # The shared library's file name on each platform (Windows: what `make windows` builds).
