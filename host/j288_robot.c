@@ -177,6 +177,7 @@ static void on_sweep(void *user, uint32_t sweep, uint32_t now_us)
         b->empty_run = 0;
         if (!b->stats.up) {
             b->stats.up = true;
+            b->stats.up_events++;
             emit_bus(r, J288_ROBOT_EV_BUS_UP, b->index);
         }
         return;

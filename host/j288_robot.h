@@ -195,6 +195,7 @@ typedef struct {
     bool up;                  /* cycles wait for it */
     bool gone;                /* its device vanished (and is not back) */
     uint32_t gone_events;     /* times its device vanished */
+    uint32_t up_events;       /* times it answered again after being down */
     uint32_t reopens;         /* times it was opened again (J288_ROBOT_EV_BUS_BACK) */
     uint32_t reopen_attempts; /* opens tried while it was gone */
     uint32_t lost_at_us;      /* j288_robot_now_us() when it was last lost (went down or

@@ -11,7 +11,7 @@ from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
 from . import _native
 from ._native import (LIB, BusStats, CycleInfo, JointState, JointStats, RobotStats, Target,
                       c_double, c_uint, c_uint8, int_arg, path_arg, real_arg)
-from .errors import J288Error, error_for
+from .errors import BusLostError, J288Error, error_for
 
 try:  # NumPy is optional: arrays where a loop wants them, lists without it.
     import numpy as _np
@@ -35,6 +35,10 @@ class Cycle:
     complete: bool     #: every joint fresh
     watchdog: int = 0  #: servos found with their watchdog tripped in this cycle (cleared by
     #: the host layer: their next command went out with the watchdog bit 0); never silent
+    lost: Tuple[str, ...] = ()  #: buses lost since the previous cycle (stopped answering or
+    #: vanished; cycle() raises BusLostError for them unless tolerate_bus_loss)
+    back: Tuple[str, ...] = ()  #: buses back since then (answering again, or reopened: then
+    #: their joints restart at lock and their angles are found again; set targets anew)
 
 
 @dataclass(frozen=True)
@@ -86,10 +90,16 @@ class Robot(_native.Handle):
                 robot.set_targets(pos0 + 0.1)    # NumPy arrays, joint frame, rad
                 robot.cycle()
 
-    On exit from the with block (an exception or Ctrl-C included) every bus gets the
-    broadcast lock. A bus that stops answering is left behind by the cycles (its joints go
-    stale, bus_stats() says "down") and picked up again when it answers; a vanished device
-    is left out.
+    On exit from the with block (an exception, Ctrl-C, SIGTERM, SIGHUP or SIGQUIT included)
+    every bus gets the broadcast lock (watchdog bit 0: the servos stay locked).
+
+    A lost bus is never silent: cycle() (and run()) raises BusLostError when a bus stops
+    answering or its device vanishes, naming the buses and their joints (the others go on;
+    catch it to go on too, or make the Robot with tolerate_bus_loss=True and read Cycle.lost).
+    Its joints read not known (read()[3], state().known) until they are back. A bus that
+    stops answering is picked up again when it answers; a vanished device is opened again
+    when it reappears at the same path (a udev symlink), its joints restarted at lock and
+    their angles found again (Cycle.back names it; hold() or set targets anew once known).
 
     Args:
         config: path of the robot config file (str or os.PathLike).
@@ -98,7 +108,11 @@ class Robot(_native.Handle):
         down_after: sweeps without any reply before a bus is down and cycles stop waiting
             for it (default 3; until then a silent bus slows every cycle).
         stop_on_bus_loss: a bus that goes down or vanishes stops every bus and the cycle
-            raises OfflineError (a legged robot is better all locked than half held).
+            raises BusLostError (a legged robot is better all locked than half held).
+        tolerate_bus_loss: a lost bus raises nothing (Cycle.lost names it), and a cycle
+            that finds every bus gone returns a Cycle with nothing fresh instead of raising
+            OfflineError: for robots that ride out an unplugged adapter.
+        reopen: open a vanished device again when it reappears (default True).
     Raises:
         J288Error: J288_ERR_BAD_CONFIG (file errors, with "FILE:LINE: ..." in detail), a
             device that cannot be opened (OfflineError), ...
@@ -108,14 +122,17 @@ class Robot(_native.Handle):
 
     def __init__(self, config: Union[str, "os.PathLike[str]"],
                  port: Union[str, "os.PathLike[str]", None] = None, margin_us: int = 0,
-                 down_after: int = 0, stop_on_bus_loss: bool = False) -> None:
+                 down_after: int = 0, stop_on_bus_loss: bool = False,
+                 tolerate_bus_loss: bool = False, reopen: bool = True) -> None:
         path = path_arg(config, "config")
         dev = path_arg(port, "port") if port is not None else None
         margin_us = int_arg(margin_us, "margin_us", 0, 1000000)
         down_after = int_arg(down_after, "down_after", 0, 255)
+        self._tolerate = bool(tolerate_bus_loss)
+        self._stop_on_loss = bool(stop_on_bus_loss)
         self._r: Optional[ctypes.Array] = _native.new_robot()
         opt = _native.Options(port=dev, margin_us=margin_us, down_after=down_after,
-                              stop_on_bus_loss=bool(stop_on_bus_loss))
+                              stop_on_bus_loss=bool(stop_on_bus_loss), no_reopen=not reopen)
         rc = LIB.j288_robot_open_file(self._r, path, ctypes.byref(opt))
         self._open(rc, os.fsdecode(path))
         r = self._r
@@ -128,6 +145,9 @@ class Robot(_native.Handle):
         self._speed = (c_double * self._n)()
         self._torque = (c_double * self._n)()
         self._known = (c_uint8 * self._n)()
+        # Each bus's (down, gone, back) counts so far: which buses a cycle's counts are about.
+        self._seen: List[Tuple[int, int, int]] = [(0, 0, 0)] * len(self.buses)
+        self._run_losses = 0
 
     # ---- plumbing
     def _check(self, rc: int, what: str = "") -> None:
@@ -146,20 +166,55 @@ class Robot(_native.Handle):
             raise IndexError(f"joint index {joint} outside 0-{self._n - 1}") from None
 
     # ---- the loop
+    def _bus_changes(self) -> Tuple[List[str], List[str], List[str]]:
+        """(lost, gone, back): the buses lost, of them those whose device vanished, and the
+        buses back, since the previous call (from each bus's counters)."""
+        lost, gone, back = [], [], []
+        s = BusStats()
+        for b, name in enumerate(self.buses):
+            self._check(LIB.j288_robot_bus_stats(self._robot(), b, ctypes.byref(s)))
+            seen = (s.down_events, s.gone_events, s.up_events + s.reopens)
+            if seen[0] + seen[1] != sum(self._seen[b][:2]):
+                lost.append(name)
+            if seen[1] != self._seen[b][1]:
+                gone.append(name)
+            if seen[2] != self._seen[b][2]:
+                back.append(name)
+            self._seen[b] = seen
+        return lost, gone, back
+
+    def _lost_error(self, lost: List[str], gone: List[str], cycle: Optional[Cycle]) -> BusLostError:
+        joints = [self.joints[j] for j in range(self._n)
+                  if self.buses[LIB.j288_robot_joint_bus(self._robot(), j)] in lost]
+        return BusLostError(lost, gone, joints, cycle, _native.error_text(self._r))
+
     def cycle(self, timeout: float = 1.0) -> Cycle:
         """Sweep every bus once. Returns the cycle's outcome, also when some joint got no
-        reply (complete False; watchdog > 0: servos found tripped, cleared). timeout: seconds,
-        (0, 4000]. Raises OfflineError when every bus is gone (with stop_on_bus_loss: when
-        one was lost; every bus was stopped)."""
+        reply (complete False; watchdog > 0: servos found tripped, cleared; back: buses back).
+        timeout: seconds, (0, 4000]. Raises BusLostError when a bus was lost since the
+        previous cycle (unless tolerate_bus_loss; with stop_on_bus_loss every bus was
+        stopped), OfflineError when every bus is gone (unless tolerate_bus_loss: then a
+        Cycle with nothing fresh, after waiting for the next reopen attempt)."""
         timeout = real_arg(timeout, "timeout")
         if not 0 < timeout <= _MAX_SECONDS:
             raise ValueError(f"timeout {timeout} s outside (0, {_MAX_SECONDS}]")
         info = CycleInfo()
         rc = LIB.j288_robot_cycle(self._robot(), int(timeout * 1e6), ctypes.byref(info))
+        lost: List[str] = []
+        gone: List[str] = []
+        back: List[str] = []
+        if info.lost or info.back or rc == -39:
+            lost, gone, back = self._bus_changes()
+        c = Cycle(info.cycle, info.duration_us, info.fresh, self._n, bool(info.complete),
+                  info.watchdog, tuple(lost), tuple(back))
+        stopped = rc == -39 and self._stop_on_loss  # the runner stopped every bus
+        if lost and (not self._tolerate or stopped):
+            raise self._lost_error(lost, gone, c)
+        if rc == -39 and self._tolerate and not stopped:
+            return c  # every bus gone: nothing fresh, nothing raised
         if rc not in (0, -31):
             self._check(rc)
-        return Cycle(info.cycle, info.duration_us, info.fresh, info.joints, bool(info.complete),
-                     info.watchdog)
+        return c
 
     def run(self, cycles: int = 0, rate_hz: float = 0.0, duration: float = 0.0) -> None:
         """Cycles in C (no Python per cycle): `cycles` of them (0: no limit) or for `duration`
@@ -167,8 +222,9 @@ class Robot(_native.Handle):
 
         The C loop runs in slices of about 0.1 s (whole periods at rate_hz, so the schedule
         goes on evenly): Ctrl-C (KeyboardInterrupt) and other signals reach Python between
-        them, and a with block around the loop then stops every bus. Raises OfflineError
-        when every bus is gone."""
+        them, and a with block around the loop then stops every bus. Raises BusLostError
+        at the end of the slice in which a bus was lost (unless tolerate_bus_loss: then a
+        run rides out even every bus gone, waiting for the devices to come back)."""
         if not (0 <= cycles < 2**32 and (rate_hz == 0 or 1 / _MAX_SECONDS <= rate_hz)
                 and duration >= 0):
             raise ValueError(f"cycles 0 to 2**32 - 1, rate_hz 0 or from {1 / _MAX_SECONDS}, "
@@ -184,7 +240,14 @@ class Robot(_native.Handle):
             self._check(LIB.j288_robot_stats(r, ctypes.byref(stats)))
             before = stats.cycles
             start = time.monotonic()
-            self._check(LIB.j288_robot_run(r, period, left, this_us))
+            rc = LIB.j288_robot_run(r, period, left, this_us)
+            self._check(LIB.j288_robot_stats(r, ctypes.byref(stats)))
+            if stats.bus_losses != self._run_losses or rc == -39:
+                self._run_losses = stats.bus_losses
+                lost, gone, _ = self._bus_changes()
+                if lost and (not self._tolerate or rc == -39):
+                    raise self._lost_error(lost, gone, None)
+            self._check(rc)
             if left_us is not None:
                 left_us -= max(this_us, int((time.monotonic() - start) * 1e6))
             if cycles:

@@ -105,11 +105,21 @@ void cli_signals_install(void)
     sa.sa_flags = 0; /* no SA_RESTART: a blocking call returns EINTR at once */
     sigaction(SIGINT, &sa, NULL);
     sigaction(SIGTERM, &sa, NULL);
+    /* A closed terminal or SSH session (SIGHUP) and Ctrl-\ (SIGQUIT, whose default would
+     * dump core) stop as SIGTERM does: their default actions leave the servos driven. */
+    sigaction(SIGHUP, &sa, NULL);
+    sigaction(SIGQUIT, &sa, NULL);
 }
 #endif
 
 int cli_signal_exit_code(void)
 {
+#ifndef _WIN32
+    if (cli_stop_signal == SIGHUP)
+        return CLI_EXIT_SIGHUP;
+    if (cli_stop_signal == SIGQUIT)
+        return CLI_EXIT_SIGQUIT;
+#endif
     return cli_stop_signal == SIGTERM ? CLI_EXIT_SIGTERM : CLI_EXIT_SIGINT;
 }
 

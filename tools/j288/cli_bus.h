@@ -99,10 +99,12 @@ int cli_parse_bus_args(int argc, char **argv, const cli_opt_t *opts, const char 
  * CLI_BUS_OPT_BASE are not common: returns 1 (not handled). */
 int cli_bus_common_opt(cli_bus_opts_t *o, int key, const char *value);
 
-/* SIGINT/SIGTERM record the signal in cli_stop_signal (the first one wins). */
+/* SIGINT, SIGTERM, SIGHUP (a closed terminal or SSH session) and SIGQUIT record the signal
+ * in cli_stop_signal (the first one wins): each stops a command the same way. */
 void cli_signals_install(void);
 
-/* Exit code for a command stopped by a signal (130 or 143). */
+/* Exit code for a command stopped by a signal, 128 + its number as a shell reports a process
+ * killed by it: 130 SIGINT, 143 SIGTERM, 129 SIGHUP, 131 SIGQUIT. */
 int cli_signal_exit_code(void);
 
 /* Open the device through the runner (j288_robot_open_port()). Prints the port's notices

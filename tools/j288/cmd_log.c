@@ -45,8 +45,8 @@ static const char log_help[] =
     "                 beyond them holds or swings from the nearest limit), phase\n"
     "Prints the achieved rate, missed deadlines (sweeps that ended after the next tick was\n"
     "due: that tick starts late; ticks a whole period behind are skipped, never bunched),\n"
-    "bus statistics and, when driving, the tracking error. Ctrl-C or SIGTERM: every driven\n"
-    "servo is sent lock before exiting (exit 130 / 143).\n"
+    "bus statistics and, when driving, the tracking error. Ctrl-C, SIGTERM, SIGHUP or SIGQUIT:\n"
+    "every driven servo is sent lock before exiting (exit 130, 143, 129, 131).\n"
     "Exit status: 0 done; 1 a servo never answered, device error; 2 bad arguments.\n"
     "\n" CLI_BUS_COMMON_HELP;
 

@@ -33,7 +33,7 @@ static const char top_help[] =
     "known yet, - when it never answered. Counters: docs/troubleshooting.md says what each\n"
     "means.\n"
     "Exit status: 0 quit with q, or one frame printed; 1 no servo answered, a device or\n"
-    "config error, every bus gone; 2 bad arguments; 130/143 stopped by SIGINT/SIGTERM.\n"
+    "config error; 2 bad arguments; 130/143/129/131 stopped by SIGINT/SIGTERM/SIGHUP/SIGQUIT.\n"
     "\n" CLI_BUS_COMMON_HELP;
 
 #define TOP_ACQUIRE_CYCLES 200u /* the most cycles --once waits for every angle */
