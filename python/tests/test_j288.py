@@ -424,8 +424,11 @@ def test_hangup_stops_every_bus(sims, tmp_path: Path, sig: str) -> None:
     s0 = sims("1,2,3")
     cfg = write_config(tmp_path, [s0.pty])
     ready = tmp_path / "ready"
+    # (the child restores the signal's default: a test run started in the background
+    # inherits SIGQUIT ignored, which a with block leaves so, as nohup's SIGHUP)
     script = textwrap.dedent(f"""\
-        import pathlib, j288
+        import pathlib, signal, j288
+        signal.signal(signal.{sig}, signal.SIG_DFL)
         with j288.Robot({str(cfg)!r}) as robot:
             while not all(robot.read()[3]):
                 robot.cycle()

@@ -87,11 +87,13 @@ t_restart_is_held_again_and_sighup_locks() {
     logged "$E2E_TMP/log.0" ' id=15 status=0 wd=0' && logged "$E2E_TMP/log.1" ' id=15 status=0 wd=0'
 }
 
-# A one-servo loop (hold --id): SIGQUIT locks the servo (2af1ea0: a core dump's 131, no lock).
+# A one-servo loop (hold --id): SIGQUIT locks the servo (2af1ea0: a core dump, no lock). (A
+# background job starts with SIGQUIT ignored, which the tool leaves so: env restores it, as
+# in a terminal's foreground.)
 t_sigquit_single_servo() {
     local rc
     clear_logs
-    run_bg "$J288" hold --id 1 --port "$SIM_DIR/bus.0" --margin-us 1000000
+    run_bg env --default-signal=QUIT "$J288" hold --id 1 --port "$SIM_DIR/bus.0" --margin-us 1000000
     logged "$E2E_TMP/log.0" ' id=1 status=1 wd=1' || return 1
     clear_logs
     kill -QUIT "$BG_PID"

@@ -96,6 +96,16 @@ void cli_signals_install(void)
     (void)SetConsoleCtrlHandler(on_console_event, TRUE);
 }
 #else
+/* A signal the tool was started ignoring stays ignored: nohup's SIGHUP, a background job's
+ * SIGQUIT (the command then runs on, driving its servos as before: nothing is left loose). */
+static void install_unless_ignored(int sig, const struct sigaction *sa)
+{
+    struct sigaction old;
+    if (sigaction(sig, NULL, &old) == 0 && old.sa_handler == SIG_IGN)
+        return;
+    sigaction(sig, sa, NULL);
+}
+
 void cli_signals_install(void)
 {
     struct sigaction sa;
@@ -107,8 +117,8 @@ void cli_signals_install(void)
     sigaction(SIGTERM, &sa, NULL);
     /* A closed terminal or SSH session (SIGHUP) and Ctrl-\ (SIGQUIT, whose default would
      * dump core) stop as SIGTERM does: their default actions leave the servos driven. */
-    sigaction(SIGHUP, &sa, NULL);
-    sigaction(SIGQUIT, &sa, NULL);
+    install_unless_ignored(SIGHUP, &sa);
+    install_unless_ignored(SIGQUIT, &sa);
 }
 #endif
 

@@ -100,7 +100,8 @@ int cli_parse_bus_args(int argc, char **argv, const cli_opt_t *opts, const char 
 int cli_bus_common_opt(cli_bus_opts_t *o, int key, const char *value);
 
 /* SIGINT, SIGTERM, SIGHUP (a closed terminal or SSH session) and SIGQUIT record the signal
- * in cli_stop_signal (the first one wins): each stops a command the same way. */
+ * in cli_stop_signal (the first one wins): each stops a command the same way. A SIGHUP or
+ * SIGQUIT the process was started ignoring (nohup, a background job) stays ignored. */
 void cli_signals_install(void);
 
 /* Exit code for a command stopped by a signal, 128 + its number as a shell reports a process
