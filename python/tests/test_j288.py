@@ -417,44 +417,6 @@ def test_robot_tolerating_bus_loss(sims, tmp_path: Path) -> None:
         assert cycles[-1].fresh == 0 and not cycles[-1].complete
 
 
-@pytest.mark.parametrize("sig", ["SIGHUP", "SIGQUIT"])
-def test_hangup_stops_every_bus(sims, tmp_path: Path, sig: str) -> None:
-    """Issue 29: SIGHUP (a closed terminal or SSH session) and SIGQUIT in a with block stop
-    every bus as SIGTERM does (broadcast lock, watchdog bit 0), exit 128 + the signal."""
-    s0 = sims("1,2,3")
-    cfg = write_config(tmp_path, [s0.pty])
-    ready = tmp_path / "ready"
-    # (the child restores the signal's default: a test run started in the background
-    # inherits SIGQUIT ignored, which a with block leaves so, as nohup's SIGHUP)
-    script = textwrap.dedent(f"""\
-        import pathlib, signal, j288
-        signal.signal(signal.{sig}, signal.SIG_DFL)
-        with j288.Robot({str(cfg)!r}) as robot:
-            while not all(robot.read()[3]):
-                robot.cycle()
-            robot.hold()
-            robot.cycle()
-            pathlib.Path({str(ready)!r}).write_text("1")
-            robot.run(rate_hz=200)
-        """)
-    proc = subprocess.Popen([sys.executable, "-c", script],
-                            env=dict(os.environ, PYTHONPATH=PKG_PATH))
-    try:
-        for _ in range(600):
-            if ready.exists() or proc.poll() is not None:
-                break
-            time.sleep(0.05)
-        assert ready.exists(), "the controller did not start"
-        proc.send_signal(getattr(signal, sig))
-        proc.wait(timeout=60)
-    finally:
-        if proc.poll() is None:
-            proc.kill()
-            proc.wait()
-    assert proc.returncode == 128 + getattr(signal, sig)
-    assert s0.logged(" id=15 status=0 wd=0")
-
-
 def test_robot_without_numpy(sims, tmp_path: Path, monkeypatch) -> None:
     s0 = sims("1,2,3")
     cfg = write_config(tmp_path, [s0.pty])
@@ -556,20 +518,16 @@ def test_sigterm_stops_the_servos(sims) -> None:
     assert sim.logged(" id=15 status=0 wd=0")
 
 
-@pytest.mark.parametrize("loop", ["while True:\n        robot.cycle()",
-                                  "robot.run()", "robot.run(rate_hz=500, duration=3600)"],
-                         ids=["cycle", "run", "run_rate"])
-def test_ctrl_c_stops_every_bus(sims, tmp_path: Path, loop: str) -> None:
-    """KeyboardInterrupt in a controller's loop, or in a run() in C that has no end (near):
-    it reaches Python, and the with block sends the broadcast lock."""
-    s0, s1 = sims("1,2,3"), sims("1,2,3")
-    cfg = write_config(tmp_path, [s0.pty, s1.pty])
+def _controller(tmp_path: Path, cfg: Path, sig: str, loop: str) -> subprocess.Popen:
+    """A child controller holding every joint of cfg, then in `loop`, once it has written
+    tmp_path/ready; sig's handler set as a terminal's foreground has it (a test run started
+    in the background inherits SIGINT and SIGQUIT ignored, and a with block leaves an
+    ignored signal so, as nohup's SIGHUP)."""
     ready = tmp_path / "ready"
-    # (the child restores Ctrl-C's default: a test run started in the background inherits
-    # SIGINT ignored, and Python then never raises KeyboardInterrupt)
+    handler = "default_int_handler" if sig == "SIGINT" else "SIG_DFL"
     script = textwrap.dedent(f"""\
         import pathlib, signal, j288
-        signal.signal(signal.SIGINT, signal.default_int_handler)
+        signal.signal(signal.{sig}, signal.{handler})
         with j288.Robot({str(cfg)!r}) as robot:
             while not all(robot.read()[3]):
                 robot.cycle()
@@ -581,18 +539,36 @@ def test_ctrl_c_stops_every_bus(sims, tmp_path: Path, loop: str) -> None:
     proc = subprocess.Popen([sys.executable, "-c", script],
                             env=dict(os.environ, PYTHONPATH=PKG_PATH),
                             stderr=subprocess.PIPE, text=True)
+    for _ in range(600):
+        if ready.exists() or proc.poll() is not None:
+            break
+        time.sleep(0.05)
+    return proc
+
+
+@pytest.mark.parametrize("sig,loop", [
+    ("SIGINT", "while True:\n        robot.cycle()"), ("SIGINT", "robot.run()"),
+    ("SIGINT", "robot.run(rate_hz=500, duration=3600)"),
+    ("SIGHUP", "robot.run(rate_hz=200)"), ("SIGQUIT", "while True:\n        robot.cycle()")],
+    ids=["cycle", "run", "run_rate", "sighup_run", "sigquit_cycle"])
+def test_signals_stop_every_bus(sims, tmp_path: Path, sig: str, loop: str) -> None:
+    """KeyboardInterrupt in a controller's loop, or in a run() in C that has no end (near):
+    it reaches Python, and the with block sends the broadcast lock. SIGHUP (a closed terminal
+    or SSH session) and SIGQUIT the same, then exit 128 + the signal (issue 29)."""
+    s0, s1 = sims("1,2,3"), sims("1,2,3")
+    cfg = write_config(tmp_path, [s0.pty, s1.pty])
+    proc = _controller(tmp_path, cfg, sig, loop)
     try:
-        for _ in range(600):
-            if ready.exists() or proc.poll() is not None:
-                break
-            time.sleep(0.05)
-        assert ready.exists(), "the controller did not start"
-        proc.send_signal(signal.SIGINT)
+        assert (tmp_path / "ready").exists(), "the controller did not start"
+        proc.send_signal(getattr(signal, sig))
         _, err = proc.communicate(timeout=60)
     finally:
         if proc.poll() is None:
             proc.kill()
             proc.wait()
-    assert proc.returncode != 0 and "KeyboardInterrupt" in err
+    if sig == "SIGINT":
+        assert proc.returncode != 0 and "KeyboardInterrupt" in err
+    else:
+        assert proc.returncode == 128 + getattr(signal, sig), err
     for s in (s0, s1):
         assert s.logged(" id=15 status=0 wd=0")
