@@ -94,14 +94,26 @@ foreach(t j288_linux j288_robot j288_shared ${_j288_tools})
 endforeach()
 
 # Man pages from the tools' --help and --version (Debian's help2man), when it is there.
+# j288's page also has every command's own --help (scripts/man-include.sh, help2man --include).
 find_program(J288_HELP2MAN help2man)
 function(j288_man target name what)
+    set(_include "")
+    set(_deps ${target})
+    if(ARGC GREATER 3)
+        set(_h2m "${PROJECT_BINARY_DIR}/${name}.h2m")
+        add_custom_command(OUTPUT "${name}.h2m" COMMAND bash "${ARGV3}" "$<TARGET_FILE:${target}>"
+            "${_h2m}" DEPENDS ${target} "${ARGV3}" VERBATIM)
+        set(_include --include "${_h2m}")
+        list(APPEND _deps "${name}.h2m")
+    endif()
     add_custom_command(OUTPUT "${name}.1" COMMAND "${J288_HELP2MAN}" --no-info --name "${what}"
-        --output "${PROJECT_BINARY_DIR}/${name}.1" "$<TARGET_FILE:${target}>" DEPENDS ${target} VERBATIM)
+        ${_include} --output "${PROJECT_BINARY_DIR}/${name}.1" "$<TARGET_FILE:${target}>"
+        DEPENDS ${_deps} VERBATIM)
     add_custom_target(${target}_man ALL DEPENDS "${name}.1")
 endfunction()
 if(J288_HELP2MAN)
-    j288_man(j288_cli j288 "Unitree J288/S288 servo bus tool")
+    j288_man(j288_cli j288 "Unitree J288/S288 servo bus tool"
+             "${PROJECT_SOURCE_DIR}/scripts/man-include.sh")
     j288_man(j288_sim j288-sim "simulated J288 servo bus")
     set(J288_MAN_PAGES "${PROJECT_BINARY_DIR}/j288.1" "${PROJECT_BINARY_DIR}/j288-sim.1")
     if(TARGET j288_dds)

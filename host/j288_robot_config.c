@@ -4,6 +4,7 @@
 #include "j288_robot_config.h"
 
 #include "j288_number.h"
+#include "j288_range.h"
 
 #include <dirent.h>
 #include <errno.h>
@@ -538,13 +539,15 @@ static int parse_bus(ctx_t *x, yaml_node_t *m, size_t i)
             return fail(x, line_of(v), "port: %s is already bus '%s' (line %u)", b->port,
                         x->cfg->bus[j].name, x->cfg->bus[j].line);
     if ((v = value_of(x, m, "baud")) != NULL) {
-        if (get_long(x, v, "baud", 1, 100000000, &n) != 0)
+        if (get_long(x, v, "baud", (long)j288_range(J288_QTY_BAUD)->lo,
+                     (long)j288_range(J288_QTY_BAUD)->hi, &n) != 0)
             return -1;
         b->has_baud = true;
         b->baud = (uint32_t)n;
     }
     if ((v = value_of(x, m, "margin_us")) != NULL) {
-        if (get_long(x, v, "margin_us", 0, 10000000, &n) != 0)
+        if (get_long(x, v, "margin_us", (long)j288_range(J288_QTY_MARGIN_US)->lo,
+                     (long)j288_range(J288_QTY_MARGIN_US)->hi, &n) != 0)
             return -1;
         b->has_margin_us = true;
         b->margin_us = (uint32_t)n;
@@ -564,13 +567,23 @@ typedef struct {
 } range_t;
 
 /* The library's own bounds (j288_joint_init()), so that what the file takes the runner's
- * joints take too: angles within J288_JOINT_MAX_ANGLE, the phase within 2 pi, speeds,
- * torques and gains up to 1e30 (beyond that a float build would hold infinities). */
+ * joints take too: angles within J288_JOINT_MAX_ANGLE, the phase within 2 pi, speeds and
+ * torques up to 1e30 (beyond that a float build would hold infinities). The gains have the
+ * command line's range (shared_range()): the wire's. */
 #define GAIN_MAX 1e30
 static const range_t k_angle = {-J288_JOINT_MAX_ANGLE, J288_JOINT_MAX_ANGLE, false};
 static const range_t k_phase = {-TWO_PI, TWO_PI, false};
-static const range_t k_at_least_0 = {0.0, GAIN_MAX, false};
 static const range_t k_above_0 = {0.0, GAIN_MAX, true};
+
+/* The range of quantity q (j288_range.h: the command line's too). */
+static range_t shared_range(j288_quantity_t q)
+{
+    range_t r;
+    r.lo = j288_range(q)->lo;
+    r.hi = j288_range(q)->hi;
+    r.lo_open = false;
+    return r;
+}
 
 /* v's number d within r, else an error naming key, the value as written and the range. */
 static int check_range(ctx_t *x, const yaml_node_t *v, const char *key, double d, const range_t *r)
@@ -627,13 +640,14 @@ static int opt_number(ctx_t *x, const yaml_node_t *m, const char *key, const ran
 static int parse_joint_numbers(ctx_t *x, const yaml_node_t *m, j288_robot_config_joint_t *jt)
 {
     yaml_node_t *v;
+    range_t kp = shared_range(J288_QTY_KP), kd = shared_range(J288_QTY_KD);
     if ((v = value_of(x, m, "limits")) != NULL && get_limits(x, v, jt) != 0)
         return -1;
     if (opt_number(x, m, "zero", &k_angle, NULL, &jt->zero) != 0 ||
         opt_number(x, m, "max_speed", &k_above_0, &jt->has_max_speed, &jt->max_speed) != 0 ||
         opt_number(x, m, "max_torque", &k_above_0, &jt->has_max_torque, &jt->max_torque) != 0 ||
-        opt_number(x, m, "kp", &k_at_least_0, &jt->has_kp, &jt->kp) != 0 ||
-        opt_number(x, m, "kd", &k_at_least_0, &jt->has_kd, &jt->kd) != 0 ||
+        opt_number(x, m, "kp", &kp, &jt->has_kp, &jt->kp) != 0 ||
+        opt_number(x, m, "kd", &kd, &jt->has_kd, &jt->kd) != 0 ||
         opt_number(x, m, "phase", &k_phase, &jt->has_phase, &jt->phase) != 0)
         return -1;
     return 0;

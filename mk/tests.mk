@@ -22,6 +22,12 @@ $(CLI_TEST): $(OBJ)/test/cli/test_cli_helpers.o $(CLI_CAPTURE_OBJ) \
     $(UNITY_OBJ) $(LIB_A)
 	$(LINK)
 
+# The live plot of jog and top (tools/j288/tplot.c) against series worked out by hand.
+CLI_TPLOT_TEST := $(BUILD)/test/test_cli_tplot
+$(CLI_TPLOT_TEST): $(OBJ)/test/cli/test_cli_tplot.o $(OBJ)/tools/j288/tplot.o $(UNITY_OBJ) $(LIB_A)
+	$(LINK)
+HOST_TESTS += $(CLI_TPLOT_TEST)
+
 # The tool's robot config and joint selection (cli_joint.c), with the bus plumbing it calls.
 CLI_JOINT_TEST := $(BUILD)/test/test_cli_joint
 $(OBJ)/test/cli/test_cli_joint.o: $(YAML_ENV)
@@ -140,13 +146,26 @@ TEST_SCRIPTS += test/e2e/cli_offline.sh test/e2e/cli_bus.sh test/e2e/cli_bus_fau
 # The joint frame end to end against the simulator's truth (the tool, the config, the sim),
 # in three scripts that run side by side (test/e2e/lib_joint.sh).
 TEST_SCRIPTS += test/e2e/joint_seed.sh test/e2e/joint_range.sh test/e2e/joint_refuse.sh
-# j288 top on a terminal (tmux: capture-pane, send-keys) and through a pipe.
-TEST_SCRIPTS += test/e2e/cli_top.sh
+# j288 top on a terminal (tmux: capture-pane, send-keys) and through a pipe; j288 jog's every
+# key and its live plot against the CSV it logged.
+TEST_SCRIPTS += test/e2e/cli_top.sh test/e2e/cli_jog.sh
+# What a new user tripped on: options before the command, one range per quantity named by
+# its source, $J288_BAUD for config buses, stop naming its bus, duplicate ids, the man page.
+TEST_SCRIPTS += test/e2e/cli_usability.sh
+
 # The scripts' own process helpers (whom they signal, what their cleanup removes).
 TEST_SCRIPTS += test/e2e/lib_sim_check.sh
 # The bash completion (tools/completion/j288.bash) against the tools' --help.
 TEST_SCRIPTS += test/e2e/completion.sh
 TEST_DEPS += $(J288_BIN) $(SIM_BIN) $(EXAMPLE_LINUX) $(LIB_A)
+
+# make docs-check: every j288 and j288-sim command the docs show, run against the simulator
+# (docs/architecture.md, "Commands in the docs"), and the READMEs' make demo output against
+# make demo. A CI step of its own (once, about 20 s), not in `make test`, which CI runs five
+# times over (compilers, sanitizers, valgrind) for what is a check of the docs.
+.PHONY: docs-check
+docs-check: $(J288_BIN) $(SIM_BIN)
+	$(call RUN_TESTS,test/e2e/docs_run.sh)
 
 .PHONY: check-abi vectors-check
 check-abi: $(LIB_A)

@@ -64,9 +64,11 @@ WIN_TOOL_CFLAGS := $(WIN_CFLAGS) -Wno-float-conversion
 WIN_YAML_ENV := $(WIN)/libyaml/libyaml.env
 WIN_HOST_OBJ := $(WIN_OBJ)/host/j288_robot.o $(WIN_OBJ)/host/j288_robot_config.o \
     $(WIN_OBJ)/host/j288_number.o
-# j288 top is a POSIX terminal program: tools/j288/windows/cmd_top.c says so instead.
-WIN_J288_OBJ := $(patsubst %.c,$(WIN_OBJ)/%.o,$(filter-out tools/j288/cmd_top.c,$(J288_SRC)) \
-    tools/j288/windows/cmd_top.c)
+# j288 top and jog are POSIX terminal programs (their screen: live.c): tools/j288/windows/
+# says so instead.
+WIN_J288_OBJ := $(patsubst %.c,$(WIN_OBJ)/%.o,$(filter-out tools/j288/cmd_top.c \
+    tools/j288/cmd_jog.c tools/j288/live.c,$(J288_SRC)) tools/j288/windows/cmd_top.c \
+    tools/j288/windows/cmd_jog.c)
 WIN_J288 := $(WIN)/j288.exe
 
 $(WIN_YAML_ENV):

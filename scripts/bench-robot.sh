@@ -12,7 +12,9 @@ BUILD=${BUILD:-build}
 BIN=$BUILD/bin
 DURATION=${DURATION:-3}
 PYTHON=${PYTHON:-python3}
-tmp=$(mktemp -d)
+# lib_sim.sh's waits use lib_e2e.sh's e2e_scaled (its scratch folder is ours, removed at exit)
+. test/e2e/lib_e2e.sh
+tmp=$E2E_TMP
 SIM_DIR=$tmp
 . test/e2e/lib_sim.sh
 trap 'sim_cleanup TERM' EXIT

@@ -180,6 +180,49 @@ static void test_real_in_range_message(void)
     cli_expect_one_error("j288 test: --rate: 49.9 is out of range 50..5000");
 }
 
+/* One range per quantity (host/j288_range.h): the option's message names it and the range
+ * the robot config file checks too; the gains' bounds are the wire's. */
+static void test_quantity_ranges(void)
+{
+    double v = -1.0;
+    TEST_ASSERT_EQUAL_INT(0, cli_parse_qty(J288_QTY_MARGIN_US, "--margin-us", "10000000", &v));
+    TEST_ASSERT_EQUAL_DOUBLE(10000000.0, v);
+    TEST_ASSERT_EQUAL_INT(0, cli_parse_qty(J288_QTY_KP, "--kp", "2128.4", &v));
+    TEST_ASSERT_EQUAL_INT(0, cli_parse_qty(J288_QTY_RETRIES, "--retries", "0x3", &v));
+    TEST_ASSERT_EQUAL_DOUBLE(3.0, v);
+    assert_no_error();
+    TEST_ASSERT_EQUAL_INT(-1, cli_parse_qty(J288_QTY_MARGIN_US, "--margin-us", "0", &v));
+    cli_expect_one_error("test: --margin-us: 0 is out of range 1..10000000");
+}
+
+static void test_quantity_refusals_name_their_source(void)
+{
+    double v = -1.0;
+    TEST_ASSERT_EQUAL_INT(-1, cli_parse_qty(J288_QTY_BAUD, "$J288_BAUD", "fast", &v));
+    cli_expect_one_error("test: $J288_BAUD: 'fast' is not a whole number");
+    TEST_ASSERT_EQUAL_DOUBLE(-1.0, v);
+}
+
+static void test_quantity_gain_is_not_whole(void)
+{
+    double v = -1.0;
+    TEST_ASSERT_EQUAL_INT(-1, cli_parse_qty(J288_QTY_KD, "--kd", "21.3", &v));
+    cli_expect_one_error("test: --kd: 21.3 is out of range 0..21.284");
+}
+
+/* Every gain in range encodes; just beyond the table's bound the wire refuses. */
+static void test_quantity_gains_fit_the_wire(void)
+{
+    int16_t raw;
+    double kp = j288_range(J288_QTY_KP)->hi, kd = j288_range(J288_QTY_KD)->hi;
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_kp_to_raw((j288_real_t)kp, J288_SIDE_OUTPUT, &raw));
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_kd_to_raw((j288_real_t)kd, J288_SIDE_OUTPUT, &raw));
+    TEST_ASSERT_EQUAL_INT(J288_ERR_RANGE_KP,
+                          j288_kp_to_raw((j288_real_t)(kp * 1.0001), J288_SIDE_OUTPUT, &raw));
+    TEST_ASSERT_EQUAL_INT(J288_ERR_RANGE_KD,
+                          j288_kd_to_raw((j288_real_t)(kd * 1.0001), J288_SIDE_OUTPUT, &raw));
+}
+
 static void test_choice(void)
 {
     static const char *const modes[] = {"lock", "foc", NULL};
@@ -338,6 +381,10 @@ int main(void)
     RUN_TEST(test_real_refusals);
     RUN_TEST(test_real_in_range);
     RUN_TEST(test_real_in_range_message);
+    RUN_TEST(test_quantity_ranges);
+    RUN_TEST(test_quantity_refusals_name_their_source);
+    RUN_TEST(test_quantity_gain_is_not_whole);
+    RUN_TEST(test_quantity_gains_fit_the_wire);
     RUN_TEST(test_choice);
     RUN_TEST(test_id_list);
     RUN_TEST(test_id_list_refusals);

@@ -30,7 +30,8 @@ void tearDown(void)
 
 static void opts(cli_bus_opts_t *o)
 {
-    cli_global_t g = {NULL, 0, NULL};
+    cli_global_t g;
+    memset(&g, 0, sizeof g);
     cli_bus_opts_init(o, &g);
 }
 

@@ -143,7 +143,7 @@ t_one_bus_gone() {
     for k in 0 2; do : >"$E2E_TMP/log.$k"; done
     "$J288" --config "$E2E_TMP/robot.yaml" stop >"$E2E_TMP/out" 2>"$E2E_TMP/err"
     [ $? -eq 1 ] && grep -q 'broadcast lock sent on 2 of 3 buses' "$E2E_TMP/out" &&
-        grep -q '^j288 stop: bus leg1: ' "$E2E_TMP/err" || { echo "stop: $(cat "$E2E_TMP/out" "$E2E_TMP/err")"; return 1; }
+        grep -q "^j288 stop: bus 'leg1': " "$E2E_TMP/err" || { echo "stop: $(cat "$E2E_TMP/out" "$E2E_TMP/err")"; return 1; }
     for k in 0 2; do logged "$E2E_TMP/log.$k" ' id=15 status=0 wd=0' || { echo "no lock on leg$k"; return 1; }; done
 }
 

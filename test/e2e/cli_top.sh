@@ -4,46 +4,27 @@
 # every joint's row (angle, temperatures, a fault by name, a silent joint), the bus counters,
 # the screen refreshing (the cycle count grows), q and Ctrl-C ending it (exit 0 / 130) with
 # the broadcast lock logged by the simulator after the key, one plain frame without a terminal
-# (a pipe, --once), the bus form (--port: the servos that answer), and bad arguments.
-# tmux missing: the checks that need it are skipped with a notice, unless CI=true (then they
-# fail: scripts/ci-install.sh installs tmux). Run from the repo root with BIN set (make test
-# does). Waits poll, bounded; nothing depends on the machine's speed.
+# (a pipe, --once), the bus form (--port or $J288_PORT: the servos that answer), a 40-column
+# terminal (lines cut, never wrapped), --plot (braille on screen, v switching it), and bad
+# arguments. The tmux plumbing is lib_tmux.sh's (tmux missing: those checks are skipped with a
+# notice, unless CI=true). Run from the repo root with BIN set (make test does).
 set -u
 cd "$(dirname "$0")/../.."
 . test/e2e/lib_e2e.sh
 SIM_DIR=$E2E_TMP
 . test/e2e/lib_sim.sh
-# Each session gets a server of its own (socket j288-top-PID-N): a session started while the
-# last one's server was still exiting met "server exited unexpectedly" on a loaded machine.
-TOP_N=0
-TMUX_SOCK=j288-top-$$-$TOP_N
-tmux_do() { tmux -L "$TMUX_SOCK" -f /dev/null "$@"; }
-cleanup() {
-    local n
-    [ "$BASHPID" = "$$" ] || return 0
-    if command -v tmux >/dev/null; then
-        for n in $(seq 0 "$TOP_N"); do
-            tmux -L "j288-top-$$-$n" kill-server 2>/dev/null
-            rm -f "${TMUX_TMPDIR:-/tmp}/tmux-$(id -u)/j288-top-$$-$n"
-        done
-    fi
-    sim_cleanup TERM
-}
-trap cleanup EXIT
+TMUX_NAME=top
+. test/e2e/lib_tmux.sh
+trap 'tmux_cleanup; sim_cleanup TERM' EXIT
 need_built "$J288" "$SIM"
 
 sim_start_linked top --ids 1,2 --quiet --exit-after "$(e2e_scaled 120)" --fault 2:0x200 || exit 1
 CFG=$E2E_TMP/robot.yaml
 printf 'buses:\n  - {name: left, port: %s, margin_us: 250000}\njoints:\n  - {name: hip, id: 1}\n  - {name: knee, id: 2}\n  - {name: ankle, id: 7}\n' \
     "$DEV" >"$CFG"
-
-# broadcasts: the simulator's count of broadcast locks so far.
-broadcasts() { grep -c ' id=15 status=0 ' "$SIM_DIR/top.log"; }
-# wait_broadcast N: up to 20 s for more than N broadcast locks.
-wait_broadcast() {
-    for _ in $(seq 1 400); do [ "$(broadcasts)" -gt "$1" ] && return 0; sleep 0.05; done
-    echo "no broadcast lock after the key"; return 1
-}
+# (the same without the silent ankle, whose reply deadline would slow every cycle down)
+CFG2=$E2E_TMP/robot2.yaml
+head -n 5 "$CFG" >"$CFG2"
 
 # ---- without a terminal -----------------------------------------------------------------------
 t_pipe_one_frame() {
@@ -68,45 +49,31 @@ t_port_form() {
     [ "$(grep -Ec '^id[0-9]+ ' "$E2E_TMP/out")" -eq 2 ] && grep -Eq '^id1 +bus +1 \* ' "$E2E_TMP/out" &&
         grep -Eq '^id2 +bus +2 \* ' "$E2E_TMP/out" || { cat "$E2E_TMP/out"; return 1; }
 }
+t_port_from_env() {
+    # $J288_PORT, as its own error says (2af1ea0 said "no bus" with it set)
+    J288_PORT=$DEV "$J288" top --ids 1,2 --once --margin-us 1000000 >"$E2E_TMP/out" 2>"$E2E_TMP/err" ||
+        { cat "$E2E_TMP/err"; return 1; }
+    grep -Eq '^id1 +bus +1 \* ' "$E2E_TMP/out" || { cat "$E2E_TMP/out"; return 1; }
+}
 run_t() { if "$2" >"$E2E_TMP/t.out" 2>&1; then e2e_pass "$1"; else e2e_fail "$1" "$(head -c 1500 "$E2E_TMP/t.out")"; fi; }
 run_t pipe_one_frame t_pipe_one_frame
 run_t port_form t_port_form
+run_t port_from_env t_port_from_env
 expect_bad no_bus 2 '^j288 top: no bus: give --config FILE or --port DEV' env -u J288_PORT "$J288" top
 expect_bad json_refused 2 '^j288 top: --json: top draws a screen' "$J288" top --config "$CFG" --json
 expect_bad bad_rate 2 '^j288 top: --rate: 0 is out of range' "$J288" top --config "$CFG" --rate 0
 expect_bad no_servo 1 '^j288 top: no servo answered on ' "$J288" top --port "$DEV" --ids 9 --once --margin-us 20000
 
 # ---- on a terminal (tmux) ---------------------------------------------------------------------
-if ! command -v tmux >/dev/null; then
-    if [ "${CI:-}" = true ]; then
-        e2e_fail tmux "tmux is not installed (scripts/ci-install.sh installs it)"
-    else
-        echo "cli_top: tmux not installed: the terminal checks are skipped (apt-get install tmux)"
-    fi
-    e2e_summary
-    exit $?
-fi
+tmux_need
 
-# start_top: j288 top in a fresh tmux session; its exit status goes to top.rc.
+# start_top [COLS [CONFIG [ARGS]]]: j288 top in a fresh tmux session (150 columns, or COLS) on
+# CONFIG (default $CFG), with ARGS.
 start_top() {
-    rm -f "$E2E_TMP/top.rc"
-    TOP_N=$((TOP_N + 1))
-    TMUX_SOCK=j288-top-$$-$TOP_N
-    tmux_do new-session -d -s top -x 150 -y 30 \
-        "env -u J288_QUIET '$J288' top --config '$CFG' --interval 0.1 --rate 50; echo \$? >'$E2E_TMP/top.rc'"
-}
-screen() { tmux_do capture-pane -p -t top 2>/dev/null; }
-# wait_screen REGEX: up to 30 s for the screen to show a line matching REGEX.
-wait_screen() {
-    for _ in $(seq 1 600); do screen | grep -Eq -- "$1" && return 0; sleep 0.05; done
-    echo "never on screen: /$1/"; screen; return 1
+    tmux_start "${1:-150}" 30 "env -u J288_QUIET '$J288' top --config '${2:-$CFG}' --interval 0.1 --rate 50 ${3:-}"
 }
 cycle_now() { screen | sed -n 's/^j288 top .* cycle \([0-9]*\) .*/\1/p'; }
-# wait_rc WANT: up to 30 s for top to exit, with status WANT.
-wait_rc() {
-    for _ in $(seq 1 600); do [ -s "$E2E_TMP/top.rc" ] && break; sleep 0.05; done
-    [ "$(cat "$E2E_TMP/top.rc" 2>/dev/null)" = "$1" ] || { echo "exit '$(cat "$E2E_TMP/top.rc" 2>/dev/null)', want $1"; return 1; }
-}
+LOG=$SIM_DIR/top.log
 
 t_live_screen_and_q() {
     local c1 c2 before
@@ -122,18 +89,43 @@ t_live_screen_and_q() {
     for _ in $(seq 1 600); do c2=$(cycle_now); [ -n "$c2" ] && [ "$c2" -gt "${c1:-0}" ] && break; sleep 0.05; done
     [ -n "$c2" ] && [ "$c2" -gt "${c1:-0}" ] || { echo "cycle $c1 -> $c2: not refreshed"; return 1; }
     screen | head -n1 | grep -q '^j288 top ' || { echo "header not on top"; screen; return 1; }
-    before=$(broadcasts)
-    tmux_do send-keys -t top q
-    wait_rc 0 && wait_broadcast "$before"
+    before=$(broadcasts "$LOG")
+    press q
+    wait_rc 0 && wait_broadcast "$LOG" "$before"
 }
 t_ctrl_c() {
     local before
     start_top
     wait_screen '^hip +left +1 \* ' || return 1
-    before=$(broadcasts)
-    tmux_do send-keys -t top C-c
-    wait_rc 130 && wait_broadcast "$before"
+    before=$(broadcasts "$LOG")
+    press C-c
+    wait_rc 130 && wait_broadcast "$LOG" "$before"
+}
+t_narrow_terminal() {
+    # 40 columns: every line cut there, never wrapped (2af1ea0 wrapped each row over three
+    # lines, pushing the header off the screen)
+    start_top 40 "$CFG2"
+    wait_screen '^hip +left +1 \* ' || return 1
+    narrow_screen_ok 40 'j288 top ' 'hip ' 'knee ' || return 1
+    press q
+    wait_rc 0
+}
+t_live_plot() {
+    # --plot: the joints' angles in braille below the table; v: speed, torque, angle
+    start_top 150 "$CFG2" "--plot hip,knee"
+    wait_screen '^plot: angle, rad of hip knee' || return 1
+    # (a braille cell, U+2801-U+28FF, is e2 a0-a3 xx in UTF-8: matched as bytes)
+    LC_ALL=C wait_screen $'^ +-?[0-9]+\\.[0-9]{4} \\|.*\xe2[\xa0-\xa3]' || return 1
+    press v
+    wait_screen '^plot: speed, rad/s of hip knee' || return 1
+    press v
+    wait_screen '^plot: torque, N\*m of hip knee' || return 1
+    press q
+    wait_rc 0
 }
 run_t live_screen_and_q t_live_screen_and_q
 run_t ctrl_c t_ctrl_c
+run_t narrow_terminal t_narrow_terminal
+run_t live_plot t_live_plot
+expect_bad plot_unknown_joint 2 "^j288 top: --plot: no joint 'elbow'" "$J288" top --config "$CFG" --once --plot elbow
 e2e_summary

@@ -47,6 +47,9 @@ offers global_options "j288 --" --port --baud --config --version
 offers_exactly global_option_prefix "j288 --con" --config
 offers move_options "j288 move --" --pos --speed --side --id --joint --config --duration --arrive
 offers move_options_after_port "j288 --port /dev/ttyUSB0 move --po" --port --pos
+# the bus options before the command take values too: 3000 is not the command
+offers_exactly options_after_global_margin "j288 --margin-us 3000 --retries 1 jog --st" --step
+offers global_bus_options "j288 --" --margin-us --echo --retries
 offers_exactly side_values "j288 move --side " "joint output rotor"
 cfg=$E2E_TMP/robot.yaml
 cat >"$cfg" <<'YAML'

@@ -2,9 +2,9 @@
 # j288.exe (the CLI cross-built for Windows) under Wine against j288-sim, checked against the
 # simulator's truth: scan, status --json, move (where the servo really ended), log --csv,
 # Ctrl-C during a move (every driven servo locked, exit 130), a robot config with two buses,
-# what is Linux-only (zero/calibrate writing the config back, top) refused with the reason,
-# $J288_BAUD, and 6 Mbps refused with a clear error (Wine leaves a pseudo-terminal at 38400
-# above 4 Mbps). COM11 and COM12 (names above COM9 take the \\.\ form) are the prefix's
+# what is Linux-only (zero/calibrate writing the config back, top, jog) refused with the reason,
+# $J288_BAUD (for --port and for a config's buses), and 6 Mbps refused with a clear error
+# (Wine leaves a pseudo-terminal at 38400 above 4 Mbps). COM11 and COM12 (names above COM9 take the \\.\ form) are the prefix's
 # dosdevices symlinks to the simulators' ptys.
 # Run by scripts/windows-test.sh (WINEPREFIX set, a wineserver running; it stops it) as
 #   test/e2e/windows_cli.sh J288_EXE
@@ -124,7 +124,19 @@ t_robot_two_buses() {
     [ "$E2E_RC" -eq 1 ] && [[ "$E2E_ERR" == *"same device"* ]] || { echo "exit $E2E_RC: $E2E_ERR"; return 1; }
 }
 
+t_config_takes_env_baud() {
+    # A config whose buses give no baud takes $J288_BAUD (4000000 here, Wine's most), as --port
+    # does (2af1ea0 opened them at 6000000: "cannot do 6000000 baud"); jog says it is POSIX-only.
+    local cfg=$E2E_TMP/nobaud.yaml
+    printf 'buses:\n  - {name: left, port: COM11, margin_us: 250000}\njoints:\n  - {name: hip, id: 1}\n' >"$cfg"
+    j288 --config "$(winepath -w "$cfg")" status
+    [ "$E2E_RC" -eq 0 ] && [[ "$E2E_OUT" == *"hip "*" known "* ]] || { echo "exit $E2E_RC: $E2E_OUT $E2E_ERR"; return 1; }
+    j288 jog --config "$(winepath -w "$cfg")"
+    [ "$E2E_RC" -eq 2 ] && [[ "$E2E_ERR" == *"not available on Windows"* ]] || { echo "jog: exit $E2E_RC: $E2E_ERR"; return 1; }
+}
+
 e2e_check 6mbps_refused_clearly t_6mbps_refused
+e2e_check config_takes_env_baud t_config_takes_env_baud
 e2e_check scan t_scan
 e2e_check status_json_against_truth t_status_json
 e2e_check move_reaches_target t_move_reaches_target

@@ -22,6 +22,7 @@
  */
 #include "fuzz_common.h"
 
+#include "j288_range.h"
 #include "j288_robot_config.h"
 
 #include <math.h>
@@ -78,7 +79,9 @@ static void check_config(const j288_robot_config_t *c)
     for (i = 0; i < c->nbuses; i++) {
         check_text(c->bus[i].name, sizeof c->bus[i].name, true);
         check_text(c->bus[i].port, sizeof c->bus[i].port, false);
-        FUZZ_CHECK(!c->bus[i].has_baud || (c->bus[i].baud >= 1u && c->bus[i].baud <= 100000000u));
+        FUZZ_CHECK(!c->bus[i].has_baud || j288_range_has(J288_QTY_BAUD, (double)c->bus[i].baud));
+        FUZZ_CHECK(!c->bus[i].has_margin_us ||
+                   j288_range_has(J288_QTY_MARGIN_US, (double)c->bus[i].margin_us));
         for (k = 0; k < i; k++)
             FUZZ_CHECK(strcmp(c->bus[k].name, c->bus[i].name) != 0);
     }
@@ -97,8 +100,8 @@ static void check_config(const j288_robot_config_t *c)
         FUZZ_CHECK(j->pos_min < j->pos_max && j->pos_max - j->pos_min <= TWO_PI + 1e-9);
         FUZZ_CHECK(!j->has_max_speed || (j->max_speed > 0.0 && j->max_speed <= 1e30));
         FUZZ_CHECK(!j->has_max_torque || (j->max_torque > 0.0 && j->max_torque <= 1e30));
-        FUZZ_CHECK(!j->has_kp || finite_within(j->kp, 0.0, 1e30));
-        FUZZ_CHECK(!j->has_kd || finite_within(j->kd, 0.0, 1e30));
+        FUZZ_CHECK(!j->has_kp || j288_range_has(J288_QTY_KP, j->kp));
+        FUZZ_CHECK(!j->has_kd || j288_range_has(J288_QTY_KD, j->kd));
         FUZZ_CHECK(!j->has_phase || finite_within(j->phase, -TWO_PI, TWO_PI));
         for (k = 0; k < i; k++) {
             FUZZ_CHECK(strcmp(c->joint[k].name, j->name) != 0);

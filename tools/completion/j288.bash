@@ -27,7 +27,7 @@ _j288() {
     for ((i = 1; i < cword; i++)); do
         case ${words[i]} in
             --config) config=${words[i + 1]}; ((i++)) ;;
-            --port | --baud) ((i++)) ;;
+            --port | --baud | --margin-us | --retries) ((i++)) ;;
             -*) ;;
             *) [ -z "$cmd" ] && cmd=${words[i]} ;;
         esac

@@ -118,6 +118,29 @@ int cli_parse_real_in(const char *opt, const char *text, double lo, double hi, d
     return 0;
 }
 
+int cli_parse_qty(j288_quantity_t q, const char *from, const char *text, double *out)
+{
+    const j288_range_t *r = j288_range(q);
+    long long n;
+    if (!r->whole) {
+        return cli_parse_real_in(from, text, r->lo, r->hi, out);
+    }
+    if (cli_parse_int(from, text, (long long)r->lo, (long long)r->hi, &n) != 0) {
+        return -1;
+    }
+    *out = (double)n;
+    return 0;
+}
+
+int cli_parse_gain(j288_quantity_t q, const char *text, bool *given, double *out)
+{
+    if (cli_parse_qty(q, j288_range(q)->option, text, out) != 0) {
+        return -1;
+    }
+    *given = true;
+    return 0;
+}
+
 int cli_parse_choice(const char *opt, const char *text, const char *const *choices, int *out)
 {
     int i;

@@ -14,6 +14,8 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "j288_range.h"
+
 typedef struct {
     const char *name; /* "--id" */
     bool has_value;
@@ -53,6 +55,16 @@ int cli_parse_real(const char *opt, const char *text, double *out);
 
 /* Finite real number in [lo, hi] ("OPT: TEXT is out of range LO..HI" otherwise). */
 int cli_parse_real_in(const char *opt, const char *text, double lo, double hi, double *out);
+
+/* A value of quantity q (host/j288_range.h: the range the robot config checks too), given
+ * as text by from (the option, or e.g. "$J288_BAUD", for the message): a whole number for the
+ * whole quantities, else a real one, in the entry's range ("FROM: TEXT is out of range
+ * LO..HI" otherwise). */
+int cli_parse_qty(j288_quantity_t q, const char *from, const char *text, double *out);
+
+/* A gain option (q J288_QTY_KP or _KD, named as the table names it): cli_parse_qty(), and
+ * *given set when it parsed. */
+int cli_parse_gain(j288_quantity_t q, const char *text, bool *given, double *out);
 
 /* One of choices (NULL-terminated); *out is its index. */
 int cli_parse_choice(const char *opt, const char *text, const char *const *choices, int *out);

@@ -30,11 +30,17 @@
 #define CLI_EXIT_SIGQUIT 131 /* Ctrl-\: handled as SIGTERM */
 
 /* Global options given before the command (`j288 --port DEV --baud N COMMAND`). Commands
- * that talk to a bus may override them with their own --port/--baud. */
+ * that talk to a bus take the same options after the command too, which override them. */
 typedef struct {
     const char *port; /* NULL: $J288_PORT, else an error for bus commands */
     uint32_t baud;    /* 0: J288_DEFAULT_BAUD */
     const char *config; /* --config FILE before the command, or NULL */
+    /* The bus commands' other common options, accepted before the command too. All-zero:
+     * none given. */
+    uint32_t margin_us; /* 0: by device kind */
+    bool echo;
+    bool has_retries;
+    uint8_t retries;
 } cli_global_t;
 
 /* Watchdog trips the host layer found and cleared in this process (cli_bus.c): main() turns
@@ -70,6 +76,7 @@ int cli_cmd_plot(int argc, char **argv, const cli_global_t *g);
 int cli_cmd_zero(int argc, char **argv, const cli_global_t *g);
 int cli_cmd_calibrate(int argc, char **argv, const cli_global_t *g);
 int cli_cmd_top(int argc, char **argv, const cli_global_t *g);
+int cli_cmd_jog(int argc, char **argv, const cli_global_t *g);
 /* log, status, hold, stop over every bus of a robot config (cmd_robot.c): taken instead of
  * the one-servo command when cli_robot_takes() says so (a --config, no --id or --joint). */
 int cli_cmd_robot(int argc, char **argv, const cli_global_t *g);

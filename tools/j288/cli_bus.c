@@ -29,24 +29,26 @@ void cli_bus_opts_init(cli_bus_opts_t *o, const cli_global_t *g)
     o->port = g->port;
     o->baud = g->baud;
     o->config = g->config; /* `j288 --config F status --joint hip` as well */
-    o->retries = -1;
+    o->margin_us = g->margin_us;
+    o->echo = g->echo;
+    o->retries = g->has_retries ? (int)g->retries : -1;
 }
 
 int cli_bus_common_opt(cli_bus_opts_t *o, int key, const char *value)
 {
-    long long v;
+    double v;
     switch (key) {
     case CLI_OPT_PORT:
         o->port = value;
         return 0;
     case CLI_OPT_BAUD:
-        if (cli_parse_int("--baud", value, 9600, 100000000, &v) != 0) {
+        if (cli_parse_qty(J288_QTY_BAUD, "--baud", value, &v) != 0) {
             return -1;
         }
         o->baud = (uint32_t)v;
         return 0;
     case CLI_OPT_MARGIN:
-        if (cli_parse_int("--margin-us", value, 1, 1000000, &v) != 0) {
+        if (cli_parse_qty(J288_QTY_MARGIN_US, "--margin-us", value, &v) != 0) {
             return -1;
         }
         o->margin_us = (uint32_t)v;
@@ -55,7 +57,7 @@ int cli_bus_common_opt(cli_bus_opts_t *o, int key, const char *value)
         o->echo = true;
         return 0;
     case CLI_OPT_RETRIES:
-        if (cli_parse_int("--retries", value, 0, J288_CONFIG_MAX_RETRIES, &v) != 0) {
+        if (cli_parse_qty(J288_QTY_RETRIES, "--retries", value, &v) != 0) {
             return -1;
         }
         o->retries = (int)v;
@@ -171,13 +173,25 @@ void cli_report_watchdog(const char *what)
               what);
 }
 
+int cli_bus_baud(uint32_t given, uint32_t *baud)
+{
+    const char *env = getenv("J288_BAUD");
+    double v;
+    *baud = given;
+    if (given != 0u || env == NULL || env[0] == '\0')
+        return 0;
+    if (cli_parse_qty(J288_QTY_BAUD, "$J288_BAUD", env, &v) != 0)
+        return -1;
+    *baud = (uint32_t)v;
+    return 0;
+}
+
 int cli_bus_open(cli_bus_t *b, const cli_bus_opts_t *o, int default_retries)
 {
     static j288_robot_t robot; /* large, and one bus per process */
     j288_robot_options_t ro;
     const char *dev = o->port;
-    uint32_t baud = o->baud;
-    long long env_baud;
+    uint32_t baud;
     int rc;
 
     memset(b, 0, sizeof *b);
@@ -189,11 +203,8 @@ int cli_bus_open(cli_bus_t *b, const cli_bus_opts_t *o, int default_retries)
         return CLI_EXIT_USAGE;
     }
     b->dev = dev;
-    if (baud == 0u && getenv("J288_BAUD") != NULL && getenv("J288_BAUD")[0] != '\0') {
-        if (cli_parse_int("$J288_BAUD", getenv("J288_BAUD"), 9600, 100000000, &env_baud) != 0)
-            return CLI_EXIT_USAGE;
-        baud = (uint32_t)env_baud;
-    }
+    if (cli_bus_baud(o->baud, &baud) != 0)
+        return CLI_EXIT_USAGE;
     b->robot = &robot;
     memset(&ro, 0, sizeof ro);
     ro.baud = baud;

@@ -108,6 +108,11 @@ void cli_signals_install(void);
  * killed by it: 130 SIGINT, 143 SIGTERM, 129 SIGHUP, 131 SIGQUIT. */
 int cli_signal_exit_code(void);
 
+/* The line rate: given (a --baud, or 0), else $J288_BAUD when set, else 0 (the default). 0, or
+ * -1 after one error line ($J288_BAUD out of range or not a number). For every bus a command
+ * opens whose config entry gives no baud. */
+int cli_bus_baud(uint32_t given, uint32_t *baud);
+
 /* Open the device through the runner (j288_robot_open_port()). Prints the port's notices
  * once (cli_print_notices()), and one error line on failure. Returns CLI_EXIT_OK or
  * CLI_EXIT_FAIL / CLI_EXIT_USAGE. */

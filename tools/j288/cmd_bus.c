@@ -28,10 +28,14 @@ static const char scan_help[] =
     "temperatures, voltage and faults. The protocol has no read-only query, so each id\n"
     "receives a lock command (watchdog bit 0): a servo that was moving stops.\n"
     "--json prints one array of objects with the keys of `j288 decode --json` (id, mode,\n"
-    "case_temp_c, voltage_v, faults, ...) plus latency_us.\n"
+    "case_temp_c, voltage_v, faults, ...) plus latency_us and possible_duplicate.\n"
     "  --ids LIST       the ids to address, e.g. 1,2,3 (default 0-14): each absent id costs\n"
     "                   a reply margin and its retries, so a scan with a long --margin-us\n"
     "                   stays short\n"
+    "More bytes within 10 ms of a servo's reply (two servos answering one id) are reported as\n"
+    "\"possible duplicate ids\" (JSON: possible_duplicate). The protocol has no command that\n"
+    "sets a servo's id: give each servo its own id with the vendor's tool, one servo on the\n"
+    "bus at a time (docs/troubleshooting.md).\n"
     "Exit status: 0 at least one servo answered; 1 silent bus or device error.\n"
     "\n" CLI_BUS_COMMON_HELP;
 
@@ -40,6 +44,31 @@ enum { OPT_SCAN_IDS = 0 };
 static int parse_scan_opt(void *ctx, int key, const char *v)
 {
     return key == OPT_SCAN_IDS ? cli_parse_id_list("--ids", v, J288_MAX_ID, ctx) : 1;
+}
+
+/* Bytes the bus took that were no reply of a transaction: late or extra replies, replies from
+ * another id, corrupt frames. */
+static uint32_t extra_bytes(const cli_bus_t *b)
+{
+    const j288_bus_stats_t *s = j288_robot_bus_wire_stats(b->robot, 0);
+    return s == NULL ? 0u : s->stale_bytes + s->wrong_id + s->crc_errors;
+}
+
+/* How long scan listens after a good reply for a second one: a second servo on the id answers
+ * the same command at once, so its bytes follow the first reply's at the wire's pace (two
+ * replies at the same moment garble each other: a CRC error, noted as such). */
+#define SCAN_SECOND_REPLY_US 10000u
+
+/* After id's good reply, up to SCAN_SECOND_REPLY_US more (or the reply budget, when shorter):
+ * any byte that comes then is a second answer. */
+static bool answered_twice(cli_bus_t *b, uint32_t extra_before)
+{
+    const j288_bus_t *bus = j288_robot_bus_engine(b->robot, 0);
+    uint32_t wait_us = bus != NULL ? j288_bus_reply_budget_us(bus) : 0u;
+    if (wait_us > SCAN_SECOND_REPLY_US)
+        wait_us = SCAN_SECOND_REPLY_US;
+    (void)cli_bus_sleep_until(b, j288_robot_now_us() + wait_us);
+    return extra_bytes(b) != extra_before;
 }
 
 int cli_cmd_scan(int argc, char **argv, const cli_global_t *g)
@@ -51,6 +80,7 @@ int cli_cmd_scan(int argc, char **argv, const cli_global_t *g)
     cli_bus_t b;
     j288_txn_t txn[J288_MAX_ID + 1u];
     int result[J288_MAX_ID + 1u];
+    bool twice[J288_MAX_ID + 1u];
     j288_cmd_raw_t cmd;
     unsigned found = 0;
     int ec;
@@ -72,12 +102,17 @@ int cli_cmd_scan(int argc, char **argv, const cli_global_t *g)
         return ec;
     }
     for (id = 0; id <= J288_MAX_ID; id++) {
+        uint32_t extra = extra_bytes(&b);
         result[id] = J288_ERR_TIMEOUT; /* not addressed: not listed */
+        twice[id] = false;
         if ((ids & (1ul << id)) == 0u) {
             continue;
         }
         cli_lock_cmd(id, &cmd);
         result[id] = cli_bus_transfer(&b, &cmd, &txn[id]);
+        if (result[id] == J288_OK && txn[id].attempts == 1u) { /* (a re-send invites late replies) */
+            twice[id] = answered_twice(&b, extra);
+        }
         if (result[id] == J288_ERR_OFFLINE) {
             cli_report_txn_failure(&b, id, result[id]);
             cli_bus_close(&b);
@@ -106,6 +141,7 @@ int cli_cmd_scan(int argc, char **argv, const cli_global_t *g)
                 cli_json_begin_object(&j, NULL);
                 cli_json_reply_members(&j, &txn[id].reply);
                 cli_json_uint(&j, "latency_us", txn[id].latency_us);
+                cli_json_bool(&j, "possible_duplicate", twice[id]);
                 cli_json_end_object(&j);
             }
         }
@@ -119,18 +155,27 @@ int cli_cmd_scan(int argc, char **argv, const cli_global_t *g)
             if (result[id] != J288_OK) {
                 continue;
             }
-            printf("%-3u %-5s %7d C %7u C %6.1f V  %s%s\n", (unsigned)id, cli_mode_name(r->status),
+            printf("%-3u %-5s %7d C %7u C %6.1f V  %s%s%s\n", (unsigned)id, cli_mode_name(r->status),
                    (int)r->case_temp_c, (unsigned)r->winding_temp_c,
                    (double)r->voltage_raw * J288_SCALE_VOLTAGE,
                    cli_fault_list(r->faults, list, sizeof list),
-                   r->watchdog_tripped ? " (watchdog had tripped)" : "");
+                   r->watchdog_tripped ? " (watchdog had tripped)" : "",
+                   twice[id] ? "  (possible duplicate ids)" : "");
         }
         printf("%u servo%s answered on %s\n", found, found == 1u ? "" : "s", b.dev);
     }
     for (id = 0; id <= J288_MAX_ID; id++) {
         if (result[id] != J288_OK && result[id] != J288_ERR_TIMEOUT) {
-            fprintf(stderr, "note: id %u: %s (a servo may be there; the line is noisy)\n",
+            fprintf(stderr, "note: id %u: %s (a servo may be there; the line is noisy, or two "
+                            "servos answer to this id)\n",
                     (unsigned)id, j288_strerror(result[id]));
+        }
+        if (twice[id]) {
+            fprintf(stderr, "note: id %u: more bytes came after its reply: possible duplicate "
+                            "ids (two servos answering to %u). The protocol cannot set an id: "
+                            "give each servo its own with the vendor's tool, one servo on the "
+                            "bus at a time\n",
+                    (unsigned)id, (unsigned)id);
         }
     }
     cli_bus_close(&b);

@@ -41,11 +41,9 @@ static int parse_joint_opt(void *ctx, int key, const char *v)
     case OPT_RATE:
         return cli_parse_real_in("--rate", v, 50.0, 5000.0, &a->rate_hz);
     case OPT_KP:
-        a->have_kp = true;
-        return cli_parse_real_in("--kp", v, 0.0, 2000.0, &a->kp);
+        return cli_parse_gain(J288_QTY_KP, v, &a->have_kp, &a->kp);
     case OPT_KD:
-        a->have_kd = true;
-        return cli_parse_real_in("--kd", v, 0.0, 20.0, &a->kd);
+        return cli_parse_gain(J288_QTY_KD, v, &a->have_kd, &a->kd);
     default:
         return 1;
     }

@@ -29,6 +29,8 @@ static const char robot_help[] =
     "  --config FILE  the robot config (also accepted before the command)\n"
     "  --port DEV     the device when the file names no bus\n"
     "  --margin-us N  reply margin for buses whose entry gives none (default 20000)\n"
+    "  --baud N, --echo, --retries N  for buses whose entry gives none (--baud: default\n"
+    "                 $J288_BAUD, else 6000000); each also accepted before the command\n"
     "  --rate HZ      cycles per second (log, hold; default 500; 0: back to back)\n"
     "  --duration S   seconds (log: default 1; hold: default until Ctrl-C)\n"
     "  --csv FILE     (log) per-joint rows\n"
@@ -56,19 +58,24 @@ enum {
     OPT_CSV,
     OPT_HOLD,
     OPT_JSON,
-    OPT_STOP_ON_LOSS
+    OPT_STOP_ON_LOSS,
+    OPT_BAUD,
+    OPT_ECHO,
+    OPT_RETRIES
 };
 static const cli_opt_t robot_opts[] = {
     {"--config", true, OPT_CONFIG}, {"--port", true, OPT_PORT},   {"--margin-us", true, OPT_MARGIN},
     {"--rate", true, OPT_RATE},     {"--duration", true, OPT_DURATION}, {"--csv", true, OPT_CSV},
     {"--hold", false, OPT_HOLD},    {"--json", false, OPT_JSON},
-    {"--stop-on-bus-loss", false, OPT_STOP_ON_LOSS}, {NULL, false, 0}};
+    {"--stop-on-bus-loss", false, OPT_STOP_ON_LOSS}, {"--baud", true, OPT_BAUD},
+    {"--echo", false, OPT_ECHO}, {"--retries", true, OPT_RETRIES}, {NULL, false, 0}};
 
 typedef struct {
     const char *config, *port, *csv;
-    uint32_t margin_us;
+    uint32_t margin_us, baud;
     double rate_hz, duration_s;
-    bool have_duration, hold, json, stop_on_loss;
+    bool have_duration, hold, json, stop_on_loss, echo;
+    int retries;
 } robot_args_t;
 
 typedef struct {
@@ -107,11 +114,15 @@ static int parse_robot_args(int argc, char **argv, const cli_global_t *g, robot_
 {
     cli_args_t p;
     const char *v;
-    long long n;
+    double n;
     int key;
     memset(a, 0, sizeof *a);
     a->config = g->config;
     a->port = g->port;
+    a->margin_us = g->margin_us;
+    a->baud = g->baud;
+    a->echo = g->echo;
+    a->retries = g->has_retries ? (int)g->retries : -1;
     a->rate_hz = 500.0;
     a->duration_s = 1.0;
     cli_args_init(&p, argc, argv);
@@ -136,8 +147,19 @@ static int parse_robot_args(int argc, char **argv, const cli_global_t *g, robot_
             a->port = v;
             break;
         case OPT_MARGIN:
-            rc = cli_parse_int("--margin-us", v, 1, 1000000, &n);
+            rc = cli_parse_qty(J288_QTY_MARGIN_US, "--margin-us", v, &n);
             a->margin_us = (uint32_t)n;
+            break;
+        case OPT_BAUD:
+            rc = cli_parse_qty(J288_QTY_BAUD, "--baud", v, &n);
+            a->baud = (uint32_t)n;
+            break;
+        case OPT_ECHO:
+            a->echo = true;
+            break;
+        case OPT_RETRIES:
+            rc = cli_parse_qty(J288_QTY_RETRIES, "--retries", v, &n);
+            a->retries = (int)n;
             break;
         case OPT_RATE:
             rc = cli_parse_real_in("--rate", v, 0.0, 100000.0, &a->rate_hz);
@@ -379,7 +401,7 @@ static int hold_all(j288_robot_t *r, robot_run_t *run)
  * broadcast lock from the others. */
 static int stop_each_bus(const robot_args_t *a, const j288_robot_options_t *o)
 {
-    static j288_robot_config_t cfg;
+    static j288_robot_config_t cfg, one_bus;
     static j288_robot_t one;
     char err[J288_ROBOT_CONFIG_ERROR_MAX];
     size_t i, n, failed = 0;
@@ -390,27 +412,23 @@ static int stop_each_bus(const robot_args_t *a, const j288_robot_options_t *o)
     n = (cfg.nbuses == 0u) ? 1u : cfg.nbuses;
     for (i = 0; i < n; i++) {
         j288_robot_options_t bo = *o;
-        const char *port = o->port;
         int rc;
         bo.on_event = NULL;
         bo.on_cycle = NULL;
+        /* The bus's own entry, without joints: the runner's messages name it as the file does. */
+        memset(&one_bus, 0, sizeof one_bus);
         if (cfg.nbuses != 0u) {
-            port = cfg.bus[i].port;
-            if (cfg.bus[i].has_baud)
-                bo.baud = cfg.bus[i].baud;
-            if (cfg.bus[i].has_margin_us)
-                bo.margin_us = cfg.bus[i].margin_us;
-        }
-        if (port == NULL) {
+            one_bus.nbuses = 1;
+            one_bus.bus[0] = cfg.bus[i];
+        } else if (o->port == NULL) {
             cli_error("the config names no bus and no --port was given");
             return CLI_EXIT_USAGE;
         }
-        rc = j288_robot_open_port(&one, port, &bo);
+        rc = j288_robot_open(&one, &one_bus, &bo);
         if (rc == J288_OK)
             rc = j288_robot_stop(&one);
         if (rc != J288_OK) {
-            cli_error("bus %s: %s", cfg.nbuses != 0u ? cfg.bus[i].name : port,
-                      j288_robot_error(&one));
+            cli_error("%s", j288_robot_error(&one));
             failed++;
         }
         j288_robot_close(&one);
@@ -485,6 +503,10 @@ int cli_cmd_robot(int argc, char **argv, const cli_global_t *g)
     memset(&o, 0, sizeof o);
     o.port = a.port != NULL ? a.port : getenv("J288_PORT");
     o.margin_us = a.margin_us;
+    o.echo = a.echo;
+    o.retries = (uint8_t)(a.retries > 0 ? a.retries : 0);
+    if (cli_bus_baud(a.baud, &o.baud) != 0)
+        return CLI_EXIT_USAGE;
     o.on_event = on_event;
     o.on_cycle = on_cycle;
     o.user = &run;

@@ -1,18 +1,19 @@
 /* `j288 top`: a live view of every joint of a bus or a robot config and of the bus counters,
  * built on the runner (host/j288_robot.h): its cycles, its joint states, its statistics. */
-#include <poll.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <termios.h>
 #include <unistd.h>
 
 #include "cli_bus.h"
 #include "frameview.h"
+#include "live.h"
+#include "tplot.h"
 
 static const char top_help[] =
     "usage: j288 top (--config FILE | --port DEV [--ids LIST]) [--once] [--rate HZ]\n"
-    "                [--interval S]\n"
+    "                [--interval S] [--plot JOINTS]\n"
     "\n"
     "A live view: every joint's angle (rad, joint frame), speed (rad/s), torque (N*m), case\n"
     "and winding temperatures, voltage and faults, and each bus's counters, redrawn every\n"
@@ -29,6 +30,9 @@ static const char top_help[] =
     "  --rate HZ        bus cycles per second, 1-2000 (default 100)\n"
     "  --interval S     seconds between redraws, 0.05-10 (default 0.2)\n"
     "  --ids LIST       (without --config) the ids to look for, e.g. 1,2,3 (default 0-14)\n"
+    "  --plot JOINTS    plot these joints (up to 4, by name: idN without --config) live\n"
+    "                   below the table, in braille characters (a UTF-8 terminal, SSH too):\n"
+    "                   v switches between angle, speed and torque\n"
     "Columns: fresh is * when the joint answered in the latest cycle, ? when its angle is not\n"
     "known yet, - when it never answered. Counters: docs/troubleshooting.md says what each\n"
     "means.\n"
@@ -39,13 +43,24 @@ static const char top_help[] =
 #define TOP_ACQUIRE_CYCLES 200u /* the most cycles --once waits for every angle */
 #define TOP_SCAN_CYCLES    5u   /* cycles that tell which of --ids answer */
 
-enum { OPT_ONCE = 0, OPT_RATE, OPT_INTERVAL, OPT_IDS };
+enum { OPT_ONCE = 0, OPT_RATE, OPT_INTERVAL, OPT_IDS, OPT_PLOT };
+
+#define TOP_PLOT_MAX 4u /* joints plotted */
 
 typedef struct {
     bool once;
     double rate_hz, interval_s;
     uint32_t ids; /* bit per id to look for (--port without --config) */
+    const char *plot; /* --plot: joint names, comma-separated */
 } top_args_t;
+
+/* The live plot: for each plotted joint its angle, speed and torque (series 3 k + 0, 1, 2). */
+typedef struct {
+    unsigned n;
+    unsigned joint[TOP_PLOT_MAX];
+    unsigned view; /* 0 angle, 1 speed, 2 torque */
+    cli_tplot_t tp;
+} top_plot_t;
 
 static int parse_top_opt(void *ctx, int key, const char *v)
 {
@@ -60,48 +75,12 @@ static int parse_top_opt(void *ctx, int key, const char *v)
         return cli_parse_real_in("--interval", v, 0.05, 10.0, &a->interval_s);
     case OPT_IDS:
         return cli_parse_id_list("--ids", v, J288_MAX_ID, &a->ids);
+    case OPT_PLOT:
+        a->plot = v;
+        return 0;
     default:
         return 1;
     }
-}
-
-/* ---- the terminal ---------------------------------------------------------------------------- */
-
-static struct termios g_saved_tty;
-static bool g_tty_raw;
-
-/* Keys without Enter and without echo; Ctrl-C stays a signal (ISIG). */
-static void tty_raw(void)
-{
-    struct termios t;
-    if (!isatty(STDIN_FILENO) || tcgetattr(STDIN_FILENO, &g_saved_tty) != 0)
-        return;
-    t = g_saved_tty;
-    t.c_lflag &= ~(tcflag_t)(ICANON | ECHO);
-    t.c_cc[VMIN] = 0;
-    t.c_cc[VTIME] = 0;
-    g_tty_raw = tcsetattr(STDIN_FILENO, TCSANOW, &t) == 0;
-}
-
-static void tty_restore(void)
-{
-    if (g_tty_raw)
-        (void)tcsetattr(STDIN_FILENO, TCSANOW, &g_saved_tty);
-    g_tty_raw = false;
-}
-
-/* True when q (or Q) is waiting on stdin; other keys are dropped. */
-static bool quit_pressed(void)
-{
-    struct pollfd p;
-    char c;
-    p.fd = STDIN_FILENO;
-    p.events = POLLIN;
-    p.revents = 0;
-    while (g_tty_raw && poll(&p, 1, 0) == 1 && read(STDIN_FILENO, &c, 1) == 1)
-        if (c == 'q' || c == 'Q')
-            return true;
-    return false;
 }
 
 /* ---- one frame ------------------------------------------------------------------------------- */
@@ -183,53 +162,60 @@ static void print_buses(FILE *f, const j288_robot_t *r, const char *eol)
     }
 }
 
-/* One frame. On a terminal each line ends by clearing the rest of it and the frame by
- * clearing below it, drawn from the top left: no flicker, no scrolling. */
-static void draw(const j288_robot_t *r, const char *source, bool ansi)
+/* One frame: the header, the port's notices (on a terminal), the joints, the buses. */
+static void print_frame(FILE *f, const j288_robot_t *r, const char *source, bool ansi)
 {
-    const char *eol = ansi ? "\033[K\n" : "\n";
     j288_robot_stats_t rs;
     (void)j288_robot_stats(r, &rs);
+    fprintf(f, "j288 top  %s  cycle %lu (%lu complete), last %lu us%s\n", source,
+            (unsigned long)rs.cycles, (unsigned long)rs.complete_cycles,
+            (unsigned long)rs.last_cycle_us, ansi ? "  q or Ctrl-C quits" : "");
     if (ansi)
-        fputs("\033[H", stdout);
-    printf("j288 top  %s  cycle %lu (%lu complete), last %lu us%s%s", source,
-           (unsigned long)rs.cycles, (unsigned long)rs.complete_cycles,
-           (unsigned long)rs.last_cycle_us, ansi ? "  q or Ctrl-C quits" : "", eol);
-    if (ansi)
-        print_notices(stdout, r, eol);
-    fputs(eol, stdout);
-    print_joints(stdout, r, eol);
-    fputs(eol, stdout);
-    print_buses(stdout, r, eol);
-    if (ansi)
-        fputs("\033[J", stdout);
-    (void)fflush(stdout);
+        print_notices(f, r, "\n");
+    fputs("\n", f);
+    print_joints(f, r, "\n");
+    fputs("\n", f);
+    print_buses(f, r, "\n");
+}
+
+/* The plotted joints' names and the view, then the plot in the rows left. */
+static void print_plot(FILE *f, const j288_robot_t *r, const top_plot_t *pl, const top_args_t *a,
+                       unsigned cols, unsigned rows_left)
+{
+    static const char *const views[] = {"angle, rad", "speed, rad/s", "torque, N*m"};
+    static const double min_span[] = {0.01, 0.1, 0.01};
+    uint32_t mask = 0;
+    unsigned k;
+    fprintf(f, "\nplot: %s of", views[pl->view]);
+    for (k = 0; k < pl->n; k++) {
+        mask |= 1ul << (3u * k + pl->view);
+        fprintf(f, " %s", j288_robot_joint_name(r, pl->joint[k]));
+    }
+    fputs("  (v: angle, speed, torque)\n", f);
+    if (rows_left > 3u)
+        cli_live_plot(f, &pl->tp, mask, cols, rows_left - 3u > 16u ? 16u : rows_left - 3u,
+                      min_span[pl->view],
+                      (double)(2u * (cols - 11u) * pl->tp.per_column) / a->rate_hz, true);
+}
+
+/* On a terminal: the frame drawn in place, cut to the terminal (no wrapping, no scrolling). */
+static void draw_live(const j288_robot_t *r, const char *source, const top_plot_t *pl,
+                      const top_args_t *a)
+{
+    cli_live_frame_t fr;
+    unsigned cols, rows;
+    cli_live_size(&cols, &rows);
+    if (!cli_live_frame_begin(&fr))
+        return;
+    print_frame(fr.f, r, source, true);
+    if (pl->n != 0u) {
+        unsigned used = 6u + j288_robot_njoints(r) + j288_robot_nbuses(r);
+        print_plot(fr.f, r, pl, a, cols, rows > used ? rows - used : 0u);
+    }
+    cli_live_frame_show(&fr, cols, rows);
 }
 
 /* ---- the bus without a config ---------------------------------------------------------------- */
-
-/* A config with one bus on the common options' port (its baud, margin and echo come with the
- * runner's options) and a joint "idN" for every id in ids, at the defaults: the joint angle
- * is the output encoder's, wrapped. */
-static void bus_config(const cli_bus_opts_t *o, uint32_t ids, j288_robot_config_t *cfg)
-{
-    j288_robot_config_bus_t *b = &cfg->bus[0];
-    unsigned id;
-    memset(cfg, 0, sizeof *cfg);
-    cfg->nbuses = 1;
-    (void)snprintf(b->name, sizeof b->name, "bus");
-    (void)snprintf(b->port, sizeof b->port, "%s", o->port);
-    for (id = 0; id <= J288_MAX_ID; id++) {
-        j288_robot_config_joint_t *jt = &cfg->joint[cfg->njoints];
-        if ((ids & (1ul << id)) == 0u)
-            continue;
-        (void)snprintf(jt->name, sizeof jt->name, "id%u", id);
-        jt->bus = 0;
-        jt->id = (uint8_t)id;
-        jt->direction = 1;
-        cfg->njoints++;
-    }
-}
 
 /* Open the bus with every id of a->ids, see which answer in a few cycles, and reopen it with
  * those only (an absent id would cost its reply deadline in every cycle). */
@@ -240,7 +226,7 @@ static int open_bus_ids(j288_robot_t *r, const cli_bus_opts_t *o, const top_args
     uint32_t answered = 0;
     unsigned j, k;
     int rc;
-    bus_config(o, a->ids, &cfg);
+    cli_live_bus_config(o->port, a->ids, &cfg);
     if ((rc = j288_robot_open(r, &cfg, ro)) != J288_OK)
         return rc;
     for (k = 0; k < TOP_SCAN_CYCLES && cli_stop_signal == 0; k++)
@@ -258,7 +244,7 @@ static int open_bus_ids(j288_robot_t *r, const cli_bus_opts_t *o, const top_args
         cli_error("no servo answered on %s", o->port);
         return J288_ERR_TIMEOUT;
     }
-    bus_config(o, answered, &cfg);
+    cli_live_bus_config(o->port, answered, &cfg);
     return j288_robot_open(r, &cfg, ro);
 }
 
@@ -288,19 +274,80 @@ static int acquire_angles(j288_robot_t *r)
     return rc;
 }
 
-/* Redraw every interval until q, a signal or the loss of every bus. */
-static int live(j288_robot_t *r, const top_args_t *a, const char *source)
+/* Every cycle: the plotted joints' angle, speed and torque (NaN while unknown). */
+static void plot_cycle(void *user, j288_robot_t *r, const j288_robot_cycle_t *c)
+{
+    top_plot_t *pl = user;
+    double v[CLI_TPLOT_MAX_SERIES];
+    unsigned k;
+    (void)c;
+    if (pl->n == 0u)
+        return;
+    for (k = 0; k < CLI_TPLOT_MAX_SERIES; k++)
+        v[k] = NAN;
+    for (k = 0; k < pl->n; k++) {
+        j288_robot_state_t st;
+        (void)j288_robot_read(r, pl->joint[k], &st);
+        if (st.known && st.fresh) {
+            v[3u * k] = st.pos;
+            v[3u * k + 1u] = st.speed;
+            v[3u * k + 2u] = st.torque;
+        }
+    }
+    cli_tplot_add(&pl->tp, v);
+}
+
+/* --plot's names into joint indices (the runner's); 0, or -1 after an error line. */
+static int plot_joints(const j288_robot_t *r, const char *names, const top_args_t *a,
+                       top_plot_t *pl)
+{
+    char buf[256];
+    char *name, *save = NULL;
+    memset(pl, 0, sizeof *pl);
+    if (names == NULL)
+        return 0;
+    (void)snprintf(buf, sizeof buf, "%s", names);
+    for (name = strtok_r(buf, ",", &save); name != NULL; name = strtok_r(NULL, ",", &save)) {
+        int j = j288_robot_find_joint(r, name);
+        if (j < 0) {
+            cli_error("--plot: no joint '%s'%s", name,
+                      j288_robot_njoints(r) != 0u && strncmp(j288_robot_joint_name(r, 0), "id", 2) == 0
+                          ? " among the servos that answered (names are idN)"
+                          : "");
+            return -1;
+        }
+        if (pl->n == TOP_PLOT_MAX) {
+            cli_error("--plot: at most %u joints", TOP_PLOT_MAX);
+            return -1;
+        }
+        pl->joint[pl->n++] = (unsigned)j;
+    }
+    /* 20 columns a second: a screen 80 cells wide spans about 7 s */
+    cli_tplot_init(&pl->tp, 3u * pl->n, (unsigned)(a->rate_hz / 20.0 + 0.5));
+    return 0;
+}
+
+/* Redraw every interval until q, a signal or the loss of every bus; v cycles the plot. */
+static int live(j288_robot_t *r, const top_args_t *a, const char *source, top_plot_t *pl)
 {
     uint32_t period_us = (uint32_t)(1e6 / a->rate_hz + 0.5);
     uint32_t interval_us = (uint32_t)(a->interval_s * 1e6 + 0.5);
+    bool quit = false;
     int rc;
-    tty_raw();
+    (void)cli_live_raw();
     fputs("\033[H\033[2J", stdout);
     do {
+        int key;
         rc = j288_robot_run(r, period_us, 0, interval_us);
-        draw(r, source, true);
-    } while (rc == J288_OK && !quit_pressed());
-    tty_restore();
+        while ((key = cli_live_key()) != CLI_KEY_NONE) {
+            if (key == 'q' || key == 'Q')
+                quit = true;
+            else if (key == 'v')
+                pl->view = (pl->view + 1u) % 3u;
+        }
+        draw_live(r, source, pl, a);
+    } while (rc == J288_OK && !quit);
+    cli_live_restore();
     return rc;
 }
 
@@ -310,9 +357,11 @@ int cli_cmd_top(int argc, char **argv, const cli_global_t *g)
                                      {"--rate", true, OPT_RATE},
                                      {"--interval", true, OPT_INTERVAL},
                                      {"--ids", true, OPT_IDS},
+                                     {"--plot", true, OPT_PLOT},
                                      CLI_BUS_COMMON_OPTS,
                                      {NULL, false, 0}};
     static j288_robot_t robot; /* large: not on the stack */
+    static top_plot_t plot;
     top_args_t a;
     cli_bus_opts_t o;
     j288_robot_options_t ro;
@@ -331,13 +380,19 @@ int cli_cmd_top(int argc, char **argv, const cli_global_t *g)
                   "--config FILE status --json` print a result");
         return CLI_EXIT_USAGE;
     }
+    if (o.port == NULL && getenv("J288_PORT") != NULL && getenv("J288_PORT")[0] != '\0')
+        o.port = getenv("J288_PORT");
     if (o.config == NULL && o.port == NULL) {
         cli_error("no bus: give --config FILE or --port DEV (or set $J288_PORT)");
         return CLI_EXIT_USAGE;
     }
     memset(&ro, 0, sizeof ro);
+    memset(&plot, 0, sizeof plot);
     ro.port = o.port;
-    ro.baud = o.baud;
+    if (cli_bus_baud(o.baud, &ro.baud) != 0)
+        return CLI_EXIT_USAGE;
+    ro.on_cycle = plot_cycle;
+    ro.user = &plot;
     ro.margin_us = o.margin_us;
     ro.echo = o.echo;
     ro.retries = (uint8_t)(o.retries > 0 ? o.retries : 0);
@@ -351,12 +406,19 @@ int cli_cmd_top(int argc, char **argv, const cli_global_t *g)
         return cli_stop_signal != 0 ? cli_signal_exit_code() : CLI_EXIT_FAIL;
     }
     j288_robot_set_stop_flag(&robot, &cli_stop_signal);
+    if (plot_joints(&robot, a.plot, &a, &plot) != 0) {
+        j288_robot_close(&robot);
+        return CLI_EXIT_USAGE;
+    }
     ansi = !a.once && isatty(STDOUT_FILENO);
     if (!ansi)
         print_notices(stderr, &robot, "\n");
-    rc = ansi ? live(&robot, &a, o.config != NULL ? o.config : o.port) : acquire_angles(&robot);
-    if (!ansi && rc != J288_ERR_ABORTED)
-        draw(&robot, o.config != NULL ? o.config : o.port, false);
+    rc = ansi ? live(&robot, &a, o.config != NULL ? o.config : o.port, &plot)
+              : acquire_angles(&robot);
+    if (!ansi && rc != J288_ERR_ABORTED) {
+        print_frame(stdout, &robot, o.config != NULL ? o.config : o.port, false);
+        (void)fflush(stdout);
+    }
     if (rc == J288_ERR_OFFLINE)
         cli_error("%s", j288_robot_error(&robot));
     /* Every servo was only ever sent lock; the broadcast lock leaves the whole bus so. */

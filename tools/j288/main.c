@@ -32,6 +32,7 @@ static const command_t commands[] = {
     {"zero", cli_cmd_zero, "make a joint's current pose its zero (written to --config)"},
     {"calibrate", cli_cmd_calibrate, "fit a joint's rotor phase (written to --config)"},
     {"top", cli_cmd_top, "live view of every joint and the bus counters (q quits)"},
+    {"jog", cli_cmd_jog, "step a joint with the arrow keys and tune its gains, live"},
     {NULL, NULL, NULL}};
 
 static void usage(FILE *f)
@@ -43,7 +44,7 @@ static void usage(FILE *f)
           "commands:\n",
           f);
     for (c = commands; c->name != NULL; c++) {
-        fprintf(f, "  %-9s %s\n", c->name, c->summary);
+        fprintf(f, "  %-10s %s\n", c->name, c->summary); /* 2 blanks at least: help2man */
     }
     fputs("\n"
           "global options (bus commands also take them after the command):\n"
@@ -51,6 +52,7 @@ static void usage(FILE *f)
           "  --baud N     line rate in bit/s (default: $J288_BAUD, else 6000000)\n"
           "  --config F   robot config: log, status, hold, stop without --id/--joint drive\n"
           "               every bus and joint in it (j288 --config F log --help)\n"
+          "  --margin-us N, --echo, --retries N   as each bus command's (j288 scan --help)\n"
           "  --version    print the library version\n"
           "\n"
           "exit status: 0 success; 1 invalid frame, device or bus failure (no reply, servo\n"
@@ -60,12 +62,36 @@ static void usage(FILE *f)
           f);
 }
 
-enum { OPT_PORT, OPT_BAUD, OPT_VERSION, OPT_CONFIG };
+enum { OPT_PORT, OPT_BAUD, OPT_VERSION, OPT_CONFIG, OPT_MARGIN, OPT_ECHO, OPT_RETRIES };
 static const cli_opt_t global_opts[] = {{"--port", true, OPT_PORT},
                                         {"--config", true, OPT_CONFIG},
                                         {"--baud", true, OPT_BAUD},
                                         {"--version", false, OPT_VERSION},
+                                        {"--margin-us", true, OPT_MARGIN},
+                                        {"--echo", false, OPT_ECHO},
+                                        {"--retries", true, OPT_RETRIES},
                                         {NULL, false, 0}};
+
+/* A global option with a value: 0, or -1 after an error line. */
+static int global_value(cli_global_t *g, int key, const char *v)
+{
+    double x;
+    if (key == OPT_PORT) {
+        g->port = v;
+    } else if (key == OPT_CONFIG) {
+        g->config = v;
+    } else if (key == OPT_BAUD && cli_parse_qty(J288_QTY_BAUD, "--baud", v, &x) == 0) {
+        g->baud = (uint32_t)x;
+    } else if (key == OPT_MARGIN && cli_parse_qty(J288_QTY_MARGIN_US, "--margin-us", v, &x) == 0) {
+        g->margin_us = (uint32_t)x;
+    } else if (key == OPT_RETRIES && cli_parse_qty(J288_QTY_RETRIES, "--retries", v, &x) == 0) {
+        g->retries = (uint8_t)x;
+        g->has_retries = true;
+    } else {
+        return -1;
+    }
+    return 0;
+}
 
 /* A servo whose watchdog tripped was cleared and reported (cli_bus.h): never exit 0 then. */
 static int watchdog_exit(int code)
@@ -75,13 +101,13 @@ static int watchdog_exit(int code)
 
 int main(int argc, char **argv)
 {
-    cli_global_t g = {NULL, 0, NULL};
+    cli_global_t g;
     cli_args_t a;
     const char *v;
     const command_t *c;
-    long long baud;
     int key;
 
+    memset(&g, 0, sizeof g);
     cli_set_command(NULL);
     cli_args_init(&a, argc, argv);
     /* Global options stop at the first positional argument: the command. */
@@ -105,14 +131,10 @@ int main(int argc, char **argv)
             printf("j288 %s\n", J288_VERSION_STRING);
             return CLI_EXIT_OK;
         }
-        if (key == OPT_PORT) {
-            g.port = v;
-        } else if (key == OPT_CONFIG) {
-            g.config = v;
-        } else if (cli_parse_int("--baud", v, 9600, 100000000, &baud) != 0) {
+        if (key == OPT_ECHO) {
+            g.echo = true;
+        } else if (global_value(&g, key, v) != 0) {
             return CLI_EXIT_USAGE;
-        } else {
-            g.baud = (uint32_t)baud;
         }
     }
     if (strcmp(v, "help") == 0) {
