@@ -173,6 +173,22 @@ void cli_report_watchdog(const char *what)
               what);
 }
 
+unsigned cli_report_lost_buses(const j288_robot_t *r)
+{
+    char names[256] = "";
+    unsigned b, n = 0;
+    for (b = 0; b < j288_robot_nbuses(r); b++) {
+        j288_robot_bus_stats_t bs;
+        if (j288_robot_bus_stats(r, b, &bs) != J288_OK || bs.down_events + bs.gone_events == 0u)
+            continue;
+        (void)snprintf(names + strlen(names), sizeof names - strlen(names), "%s'%s'",
+                       n++ > 0u ? ", " : "", j288_robot_bus_name(r, b));
+    }
+    if (n > 0u)
+        cli_error("%s %s lost during the command (exit 1)", n > 1u ? "buses" : "bus", names);
+    return n;
+}
+
 int cli_bus_baud(uint32_t given, uint32_t *baud)
 {
     const char *env = getenv("J288_BAUD");

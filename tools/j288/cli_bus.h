@@ -84,6 +84,11 @@ void cli_print_notices(const char *notices);
  * J288_ROBOT_EV_WATCHDOG event). */
 void cli_report_watchdog(const char *what);
 
+/* Say in one error line which buses were lost (went down or vanished) since r was opened:
+ * "bus 'leg1' lost during the command (exit 1)". Returns how many; 0 says nothing. A front end
+ * that drives joints exits CLI_EXIT_FAIL on any (issue 29: no silent robot fault). */
+unsigned cli_report_lost_buses(const j288_robot_t *r);
+
 /* Start from the global options (cli_global_t). */
 void cli_bus_opts_init(cli_bus_opts_t *o, const cli_global_t *g);
 

@@ -452,23 +452,6 @@ static void print_notices(const j288_robot_t *r)
 
 static FILE *g_csv_open; /* closed by finish() when a command ends before its run */
 
-/* A bus lost at any time of the command is its failure, said in one line: the buses lost. */
-static int lost_buses(const j288_robot_t *r)
-{
-    char names[256] = "";
-    unsigned b, n = 0;
-    for (b = 0; b < j288_robot_nbuses(r); b++) {
-        j288_robot_bus_stats_t bs;
-        if (j288_robot_bus_stats(r, b, &bs) != J288_OK || bs.down_events + bs.gone_events == 0u)
-            continue;
-        (void)snprintf(names + strlen(names), sizeof names - strlen(names), "%s'%s'",
-                       n++ > 0 ? ", " : "", j288_robot_bus_name(r, b));
-    }
-    if (n > 0u)
-        cli_error("%s %s lost during the command (exit 1)", n > 1u ? "buses" : "bus", names);
-    return n > 0u ? CLI_EXIT_FAIL : CLI_EXIT_OK;
-}
-
 static int finish(j288_robot_t *r, int code)
 {
     if (g_csv_open != NULL) {
@@ -478,8 +461,8 @@ static int finish(j288_robot_t *r, int code)
     if (cli_stop_signal != 0) {
         (void)j288_robot_stop(r);
         code = cli_signal_exit_code();
-    } else if (code == CLI_EXIT_OK) {
-        code = lost_buses(r);
+    } else if (code == CLI_EXIT_OK && cli_report_lost_buses(r) != 0u) {
+        code = CLI_EXIT_FAIL;
     }
     j288_robot_close(r);
     return code;

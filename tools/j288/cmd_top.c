@@ -327,7 +327,8 @@ static int plot_joints(const j288_robot_t *r, const char *names, const top_args_
     return 0;
 }
 
-/* Redraw every interval until q, a signal or the loss of every bus; v cycles the plot. */
+/* Redraw every interval until q or a signal (a bus gone is shown, and reopened when it
+ * reappears at its path); v cycles the plot. */
 static int live(j288_robot_t *r, const top_args_t *a, const char *source, top_plot_t *pl)
 {
     uint32_t period_us = (uint32_t)(1e6 / a->rate_hz + 0.5);
