@@ -1051,6 +1051,20 @@ int j288_robot_set_target(j288_robot_t *r, unsigned joint, const j288_robot_targ
     return rc;
 }
 
+int j288_robot_check_target(const j288_robot_t *r, unsigned joint, const j288_robot_target_t *t)
+{
+    j288_joint_target_t jt;
+    j288_cmd_raw_t cmd;
+    int rc;
+    if (r == NULL || t == NULL)
+        return J288_ERR_NULL;
+    rc = target_check(r, joint);
+    if (rc != J288_OK)
+        return rc;
+    to_joint_target(t, &jt);
+    return j288_joint_command(&r->joint[joint], &jt, &cmd, NULL);
+}
+
 int j288_robot_set_targets(j288_robot_t *r, size_t n, const double *pos, const double *speed,
                            const double *torque, const double *kp, const double *kd,
                            unsigned *bad)

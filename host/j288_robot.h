@@ -412,6 +412,11 @@ int j288_robot_read_all(const j288_robot_t *r, size_t n, double *pos, double *sp
  * j288_joint_command(), J288_ERR_BAD_ARG (bad index), J288_ERR_OFFLINE (its bus is gone). */
 int j288_robot_set_target(j288_robot_t *r, unsigned joint, const j288_robot_target_t *t);
 
+/* Whether j288_robot_set_target() would take this target now (the same checks), changing
+ * nothing: a caller that applies several targets all or none checks each first. Returns
+ * J288_OK or the code j288_robot_set_target() would return. */
+int j288_robot_check_target(const j288_robot_t *r, unsigned joint, const j288_robot_target_t *t);
+
 /* Every joint at once from arrays of n (>= njoints) entries; speed, torque, kp, kd may be
  * NULL (0, 0, and each joint's configured gains, J288_ROBOT_DEFAULT_KP/_KD where none). All
  * targets are checked before any is set: on an error nothing changes and *bad (may be NULL)

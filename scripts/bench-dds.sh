@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# usage: [BUILD=build] [DURATION=5] [ROUNDS=3] [COUNT=300] [CALLGRIND=1] scripts/bench-dds.sh
-#        (make bench-dds)
+# usage: [BUILD=build] [DURATION=5] [ROUNDS=3] [COUNT=300] [CALLGRIND=1] [STATE_ONLY=1]
+#        [BASE_DDS=OTHER/j288-dds] scripts/bench-dds.sh         (make bench-dds)
 # j288-dds's cost, in a private network namespace (test/dds/lib_dds.sh), against four j288-sim
 # buses of three servos (pseudo-terminals), everything back to back:
 # - cycles/s and CPU per cycle of the runner alone (`j288 --config F log --rate 0`), of the
@@ -11,6 +11,12 @@
 #   test/bench/write_stamp.so preloaded into the bridge), p50 / p99 / max over COUNT commands;
 # - with CALLGRIND=1, instructions per cycle (valgrind --tool=callgrind, every thread): the
 #   runner alone, and the bridge publishing to a subscriber, split into its parts.
+# - the state rate: rt/joint_states samples a subscriber gets per second from the bridge at
+#   --rate 500, idle, beside `stress-ng --cpu 2`, and while a peer floods rt/joint_command with
+#   1.6 MB samples (100,000 names) at 50 a second; each as a ratio to idle. With BASE_DDS (an
+#   older build's j288-dds, e.g. 2af1ea0's) the same for it, the two bridges taking turns in
+#   every round. STATE_ONLY=1: that part alone. With CALLGRIND=1 also what one 1.6 MB sample
+#   costs each bridge in instructions (valgrind --tool=callgrind, every thread).
 # Wall-clock figures on a shared machine: compare the rows of one run. Needs make dds, j288.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -23,6 +29,7 @@ COUNT=${COUNT:-300}
 ROUNDS=${ROUNDS:-3}
 tmp=$(mktemp -d)
 SIM_DIR=$tmp
+e2e_scaled() { echo "$1"; } # (test/e2e/lib_e2e.sh's, unscaled: lib_sim.sh's waits use it)
 . test/e2e/lib_sim.sh
 PEER=$BUILD/test/dds_peer
 DDS=$BIN/j288-dds
@@ -32,8 +39,99 @@ for f in "$BIN/j288" "$DDS" "$PEER" "$SIM" "$SHIM"; do
     [ -x "$f" ] || [ -f "$f" ] || { echo "bench-dds: $f missing (make dds all, then make bench-dds)" >&2; exit 1; }
 done
 
-start_sims 4 --exit-after 600 --log "$tmp/log.{k}"
+start_sims 4 --exit-after 1800 --log "$tmp/log.{k}"
 robot_config 4 "$tmp/robot.yaml" 5000 20 1
+
+# state_rate BRIDGE idle|load|flood: joint_states samples per second a subscriber got in
+# DURATION s from BRIDGE at --rate 500, idle, beside stress-ng --cpu 2, or under a flood
+state_rate() {
+    local b l="" n
+    "$1" --config "$tmp/robot.yaml" --domain "$DDS_DOMAIN" --rate 500 2>"$tmp/sr.err" &
+    b=$!
+    for _ in $(seq 1 30); do "$PEER" states --timeout 1 >"$tmp/first" 2>/dev/null && ! grep -q nan "$tmp/first" && break; done
+    case $2 in
+        load) stress-ng --cpu 2 --timeout $((DURATION + 3)) >/dev/null 2>&1 & l=$! ;;
+        flood) "$PEER" flood --hz 50 --for $((DURATION + 3)) >"$tmp/flood" 2>/dev/null & l=$!
+               for _ in $(seq 1 200); do grep -qs '^writer ' "$tmp/flood" && break; sleep 0.05; done ;;
+    esac
+    sleep 1
+    n=$("$PEER" listen --for "$DURATION" | sed -n 's/^samples //p')
+    [ "$2" = flood ] && wait "$l" && sed -n 's/^sent \([0-9]*\) in \([0-9.]*\) s$/\1 \2/p' "$tmp/flood" >>"$tmp/sent"
+    [ -n "$l" ] && { kill "$l" 2>/dev/null; wait "$l" 2>/dev/null; }
+    kill -INT $b; wait $b || true
+    # and the bridge's CPU time (all its threads, Cyclone's receive thread too) per cycle, over
+    # its whole run, from its summary line: what the condition cost it, less swayed by other load
+    awk -v n="${n:-0}" -v d="$DURATION" 'BEGIN { printf "%.1f ", n / d }'
+    sed -n 's/^j288-dds: \([0-9]*\) cycles .*, cpu \([0-9.]*\) s$/\1 \2/p' "$tmp/sr.err" |
+        awk '{ printf "%.0f", ($1 > 0 ? 1e6 * $2 / $1 : 0) }'
+}
+if [ "${STATE_ONLY:-0}" = 1 ] || [ -n "${BASE_DDS:-}" ]; then
+    : >"$tmp/state"; : >"$tmp/sent"
+    load_before=$(cut -d' ' -f1-3 /proc/loadavg)
+    bridges=("$DDS")
+    [ -n "${BASE_DDS:-}" ] && bridges=("$BASE_DDS" "$DDS")
+    for r in $(seq 1 "$ROUNDS"); do
+        for kind in idle load flood; do
+            for k in "${!bridges[@]}"; do
+                echo "$k $kind $(state_rate "${bridges[$k]}" $kind)" >>"$tmp/state"
+            done
+        done
+    done
+    echo "j288-dds state rate at --rate 500: joint_states samples/s a subscriber got, ${DURATION} s each,"
+    echo "medians of $ROUNDS rounds (range); 4 buses x 3 servos on j288-sim, $(nproc) cores, load average before: $load_before, after: $(cut -d' ' -f1-3 /proc/loadavg)"
+    python3 - "$tmp/state" "${BASE_DDS:-}" "$DDS" <<'PY'
+import sys, statistics as st
+rows, cpu = {}, {}
+for l in open(sys.argv[1]):
+    k, kind, rate, c = (l.split() + ['0'])[:4]
+    rows.setdefault((int(k), kind), []).append(float(rate))
+    cpu.setdefault((int(k), kind), []).append(float(c))
+names = [a for a in sys.argv[2:] if a]
+print('%-40s %18s %18s %18s %14s %14s' % ('bridge', 'idle', 'beside stress-ng', 'under a flood', 'stress / idle', 'flood / idle'))
+for k, name in enumerate(names):
+    med = {kind: st.median(rows[(k, kind)]) for kind in ('idle', 'load', 'flood')}
+    cell = lambda kind: '%.0f (%.0f-%.0f)' % (med[kind], min(rows[(k, kind)]), max(rows[(k, kind)]))
+    print('%-40s %18s %18s %18s %13.0f%% %13.0f%%' % (name[-40:], cell('idle'), cell('load'), cell('flood'),
+          100 * med['load'] / med['idle'], 100 * med['flood'] / med['idle']))
+print('the bridge\'s CPU time per cycle over its run (us, all its threads), medians:')
+for k, name in enumerate(names):
+    print('%-40s %18.0f %18.0f %18.0f' % (name[-40:], *(st.median(cpu[(k, kind)]) for kind in ('idle', 'load', 'flood'))))
+PY
+    awk '{ n += $1; t += $2 } END { if (t > 0) printf "the flooding peer wrote %.0f samples/s (%d in %.0f s)\n", n / t, n, t }' "$tmp/sent"
+    if [ "${CALLGRIND:-0}" = 1 ]; then
+        # what one 1.6 MB sample costs each bridge, in instructions (callgrind, every thread):
+        # a run with 20 of them and one without, the per-cycle work of the quiet run taken off
+        echo "instructions a 1.6 MB command sample costs the bridge (callgrind, all threads):"
+        for k in "${!bridges[@]}"; do
+            for kind in quiet flood; do
+                valgrind --tool=callgrind --callgrind-out-file="$tmp/cg.$k.$kind" "${bridges[$k]}" \
+                    --config "$tmp/robot.yaml" --domain "$DDS_DOMAIN" --rate 100 2>"$tmp/cg.err" &
+                vp=$!
+                for _ in $(seq 1 60); do "$PEER" states --timeout 1 >"$tmp/first" 2>/dev/null && ! grep -q nan "$tmp/first" && break; done
+                if [ $kind = flood ]; then "$PEER" flood --count 20 --hz 10 >/dev/null 2>&1; else sleep 4; fi
+                sleep 2
+                "$PEER" diag --timeout 30 >"$tmp/cg.diag" 2>/dev/null
+                kill -INT $vp; wait $vp || true
+                echo "$k $kind $(sed -n 's/^j288-dds: \([0-9]*\) cycles .*/\1/p' "$tmp/cg.err") \
+                    $(callgrind_annotate "$tmp/cg.$k.$kind" 2>/dev/null | awk '/PROGRAM TOTALS/ { gsub(",", "", $1); print $1; exit }') \
+                    $(awk -F= '/^j288-dds: bridge\|messages=/ { m = $2 } /^j288-dds: bridge\|dropped_by_dds=/ { d = $2 } END { print m + d }' "$tmp/cg.diag")"
+            done
+        done >"$tmp/cg.rows"
+        python3 - "$tmp/cg.rows" "${BASE_DDS:-}" "$DDS" <<'PY'
+import sys
+rows = {}
+for l in open(sys.argv[1]):
+    k, kind, cycles, total, samples = l.split()
+    rows[(int(k), kind)] = (int(cycles), int(total), int(samples))
+for k, name in enumerate(a for a in sys.argv[2:] if a):
+    qc, qt, _ = rows[(k, 'quiet')]
+    fc, ft, n = rows[(k, 'flood')]
+    per = (ft - fc * qt / qc) / n if n else float('nan')
+    print('%-40s %12.0f per sample (%d samples reached it; %.0f per cycle otherwise)' % (name[-40:], per, n, qt / qc))
+PY
+    fi
+    [ "${STATE_ONLY:-0}" = 1 ] && exit 0
+fi
 
 # runner_run: "cycles rate cpu" of the runner alone (its JSON; CPU from time(1))
 runner_run() {

@@ -31,6 +31,9 @@ packages=(
     tmux                            # test/e2e/cli_top.sh: j288 top on a terminal (required
                                     # under CI=true, skipped with a notice elsewhere)
     cyclonedds-dev cyclonedds-tools # j288-dds (mk/dds.mk): libddsc, its pkg-config file, idlc
+    libsystemd-dev                  # j288-dds's sd_notify (READY, WATCHDOG; mk/dds.mk, make deb)
+    systemd                         # systemd-analyze: test/dds/service.sh, make deb-check
+    libfastrtps-dev fastddsgen g++  # make test-dds-fastdds: the Fast DDS peer (test/dds/fastdds_peer.cpp)
     iproute2 util-linux             # the DDS tests' private network namespace (ip, unshare)
     # Windows (mk/windows.mk): make windows cross-builds with mingw-w64, make test-windows runs
     # the programs under Wine (64-bit only: no i386 packages, no X server; ~200 MB)

@@ -5,6 +5,7 @@
 #   without errors; only j288-dds depends on Cyclone DDS (libddsc).
 # check: then apt install them for real (root or sudo: CI, or a machine you may change), check
 #   j288 --version, j288-dds --version, pkg-config, find_package(j288) (test/cmake_consumer),
+#   j288-dds's systemd unit (systemd-analyze verify, offline),
 #   import j288 and the completion, purge them and check that none of their files is left.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -36,6 +37,10 @@ for p in j288-tools j288-dds; do dpkg-deb -f "$out/${p}_${version}_"*.deb Depend
     tee "$out/depends.txt"
 [ "$(grep -c libddsc "$out/depends.txt")" = 1 ] && grep -q '^j288-dds: .*libddsc' "$out/depends.txt" ||
     { echo "deb: libddsc must be a dependency of j288-dds alone" >&2; exit 1; }
+# j288-dds ships its systemd unit (debian/j288-dds@.service, docs/dds.md "Running on a robot")
+dpkg-deb -c "$out/j288-dds_${version}_"*.deb >"$out/j288-dds.files" # (grep -q on a pipe: SIGPIPE)
+grep -q ' ./lib/systemd/system/j288-dds@.service$' "$out/j288-dds.files" ||
+    { echo "deb: j288-dds lacks lib/systemd/system/j288-dds@.service" >&2; exit 1; }
 [ "$mode" = check ] || exit 0
 
 sudo=
@@ -52,6 +57,10 @@ done
 quiet cmake -S test/cmake_consumer -B "$out/consumer"
 quiet cmake --build "$out/consumer"
 echo "find_package(j288): $("$out/consumer/j288_consumer")"
+# the unit as installed, its ExecStart and man page included (no systemd needs to run)
+unit_out=$(systemd-analyze verify /lib/systemd/system/j288-dds@.service 2>&1) && [ -z "$unit_out" ] ||
+    { echo "deb: systemd-analyze verify j288-dds@.service: $unit_out" >&2; exit 1; }
+echo "systemd-analyze verify /lib/systemd/system/j288-dds@.service: clean"
 py=$(cd / && env -u J288_LIB -u PYTHONPATH -u PYTHONDONTWRITEBYTECODE $sudo /usr/bin/python3 -c 'import j288; print(j288.__file__, j288.__version__)')
 [ "$py" = "/usr/lib/python3/dist-packages/j288/__init__.py $version" ] || { echo "deb: python: $py" >&2; exit 1; }
 echo "python3 -c 'import j288': $py"

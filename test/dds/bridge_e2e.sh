@@ -1,15 +1,17 @@
 #!/usr/bin/env bash
 # j288-dds end to end, in a private network namespace (lib_dds.sh): two j288-sim buses of three
-# servos each, the bridge, and test/dds/dds_peer (written apart from the bridge) on DDS.
+# servos each, the bridge, and test/dds/dds_peer (written apart from the bridge, with ROS 2's
+# unbounded types) on DDS.
 # Checked: rt/joint_states carries the config's names and the simulator's true angles (0.002
 # rad); a rt/joint_command moves a joint there; silence holds it (the timeout, stderr and
 # diagnostics), or locks it (--on-timeout lock); each bad input (unknown name, arrays of
-# different lengths, a joint named twice, no values, NaN, infinity, outside the limits; more
-# names than joints as its real cause) is refused with nothing sent, reported once however
-# often it comes; a namespace moves the topics; a servo watchdog trip is reported; Ctrl-C
-# locks every bus; with --stop-on-bus-loss a frozen bus locks all; bad options and a config
-# too big for unitree mode are refused before anything is opened; the harness's truth()
+# different lengths, a joint named twice, no values, NaN, infinity, outside the limits) is
+# refused with nothing sent, reported once however often it comes; a ROS 2 namespace (/robot1)
+# moves the topics, and names ROS 2 forbids are refused; a servo watchdog trip is reported;
+# Ctrl-C locks every bus; with --stop-on-bus-loss a frozen bus locks all; bad options and a
+# config too big for unitree mode are refused before anything is opened; the harness's truth()
 # fails on a simulator that never answers; a frozen reliable reader stalls nothing.
+# (Bounded input, type hashes, one commander per joint, all or nothing: input_e2e.sh.)
 # Every wait polls and is bounded; no check depends on the machine's speed (replies get a
 # 250 ms margin: the simulators may run under valgrind, make test-valgrind).
 set -u
@@ -98,16 +100,6 @@ bad() {
     near "$before" "$after" 0.002 || { echo "leg0_3 moved: $before -> $after"; return 1; }
 }
 t_unknown_name() { bad leg0_3,leg9_9 'unknown joint name' 1,1 - -; }
-t_too_many_names() {
-    # more names than the robot can have joints (65 > J288_ROBOT_MAX_JOINTS), the first
-    # unknown: refused as an unknown name (counted: diagnostics then say 20), not reported as
-    # a joint named twice
-    local names=leg9_8 speeds=0 i
-    for i in $(seq 1 64); do names="$names,leg9_8"; speeds="$speeds,0"; done
-    "$PEER" command --count 10 --hz 100 "$names" - "$speeds" - || return 1
-    wait_diag "^j288-dds: bridge|unknown joint name=20$" || { echo "not counted as unknown names"; return 1; }
-    ! grep -q 'joint named twice' "$SIM_DIR/bridge.err" || { echo "reported as a joint named twice"; return 1; }
-}
 t_lengths_differ() { bad leg0_3 'array lengths differ' 1,2 - -; }
 t_named_twice() { bad leg0_3,leg0_3 'joint named twice' 1,1 - -; }
 t_no_values() { bad leg0_3 'no joint or no values' - - -; }
@@ -120,7 +112,7 @@ t_infinity() {
 }
 t_outside_limits() { bad leg0_3 "target outside the joint's limits" 4.0 - -; }
 t_refusals_in_diagnostics() {
-    wait_diag "^j288-dds: bridge|unknown joint name=20$" "^j288-dds: bridge|NaN or infinite value=30$" \
+    wait_diag "^j288-dds: bridge|unknown joint name=10$" "^j288-dds: bridge|NaN or infinite value=30$" \
         '^j288-dds: bus leg1|sweeps=' '^j288-dds: joint leg0_1|winding_temp_c='
 }
 t_watchdog_trip_reported() {
@@ -149,14 +141,24 @@ t_ctrl_c_locks_every_bus() {
     locked_all 0 1 && grep -q 'SIGINT: every bus locked' "$SIM_DIR/bridge.err"
 }
 t_timeout_locks() {
+    # in the namespace /robot1 (ROS 2's form: 2af1ea0 refused it)
     PEER_ARGS=(--ns robot1)
-    start_bridge --on-timeout lock --namespace robot1 || return 1
-    PEER_ARGS=()
+    start_bridge --on-timeout lock --namespace /robot1; local rc=$?
+    PEER_ARGS=() # whatever came of it: the later checks read outside the namespace
+    [ $rc -eq 0 ] || return 1
     "$PEER" --ns robot1 command --for 0.5 --hz 50 leg0_1 - 0.5 - || return 1
     wait_err 'joint leg0_1: no command for 100 ms: locked' || return 1
-    : >"$SIM_DIR/log.0"; sleep 0.3
-    grep -q ' id=1 status=0' "$SIM_DIR/log.0" && ! grep -q ' id=1 status=1' "$SIM_DIR/log.0" ||
-        { echo "leg0_1 not at lock"; return 1; }
+    # at lock: a 0.3 s stretch of the simulator's log with its lock frames and no FOC frame,
+    # within 10 s scaled (a bridge slowed by ASan on a loaded machine may still take a command
+    # the peer sent before the timeout, drive the joint again, and time out once more)
+    local i n ok=0
+    for i in $(seq 1 "$(e2e_scaled 30)"); do
+        n=$(wc -l <"$SIM_DIR/log.0"); sleep 0.3
+        tail -n +"$((n + 1))" "$SIM_DIR/log.0" >"$SIM_DIR/stretch"
+        grep -q ' id=1 status=0' "$SIM_DIR/stretch" && ! grep -q ' id=1 status=1' "$SIM_DIR/stretch" &&
+            { ok=1; break; }
+    done
+    [ $ok -eq 1 ] || { echo "leg0_1 not at lock"; return 1; }
     ! "$PEER" states --timeout 2 >/dev/null || { echo "state outside the namespace"; return 1; }
     "$PEER" --ns robot1 states --timeout 5 | grep -q '^leg0_1 '
     stop_bridge
@@ -182,10 +184,20 @@ t_bus_loss_locks_all() {
 }
 
 t_bad_options() {
-    local rc
+    local rc ns
     "$DDS" --config "$SIM_DIR/robot.yaml" --rate -1 2>"$SIM_DIR/err"; rc=$?
     [ $rc -eq 2 ] && grep -q -- '--rate takes' "$SIM_DIR/err" || { echo "--rate -1: exit $rc"; return 1; }
-    "$DDS" --config "$SIM_DIR/robot.yaml" --namespace /a//b 2>/dev/null; [ $? -eq 2 ] || return 1
+    # ROS 2's namespace rules, checked before the config is read (2af1ea0 accepted 1robot and
+    # a/1b, and went on to the missing config: exit 1)
+    for ns in /a//b 1robot /robot1/2nd /robot1/ 'robot-1' '/a b' //robot1; do
+        "$DDS" --config "$SIM_DIR/no-such.yaml" --namespace "$ns" 2>"$SIM_DIR/err"; rc=$?
+        [ $rc -eq 2 ] && grep -q 'not a ROS 2 namespace' "$SIM_DIR/err" ||
+            { echo "--namespace '$ns': exit $rc: $(cat "$SIM_DIR/err")"; return 1; }
+    done
+    for ns in /robot1 robot1 /robot_1/arm / _x/y2; do
+        "$DDS" --config "$SIM_DIR/no-such.yaml" --namespace "$ns" 2>"$SIM_DIR/err"; rc=$?
+        [ $rc -eq 1 ] || { echo "--namespace '$ns' refused: exit $rc: $(cat "$SIM_DIR/err")"; return 1; }
+    done
     "$DDS" --config "$SIM_DIR/robot.yaml" --on-timeout drift 2>/dev/null; [ $? -eq 2 ] || return 1
     "$DDS" --config "$SIM_DIR/robot.yaml" --domain 233 2>/dev/null; [ $? -eq 2 ] || return 1
     "$DDS" --rate 100 2>/dev/null; [ $? -eq 2 ] || return 1
@@ -198,6 +210,9 @@ t_bad_options() {
       for i in $(seq 0 5); do echo "  - {name: b$i, bus: b, id: $i}"; done; } >"$SIM_DIR/big.yaml"
     "$DDS" --config "$SIM_DIR/big.yaml" --unitree 2>"$SIM_DIR/err"; [ $? -eq 1 ] || return 1
     grep -q -- '--unitree: 21 joints, LowCmd_ has 20 motors' "$SIM_DIR/err" || return 1
+    "$DDS" --config "$SIM_DIR/big.yaml" --unitree-hg --rate 0 2>"$SIM_DIR/err" & local p=$!
+    wait_exit $p 30 # 21 joints fit unitree_hg's 35: it goes on to open the (missing) devices
+    grep -q 'j288-none-a' "$SIM_DIR/err" || { echo "--unitree-hg: $(cat "$SIM_DIR/err")"; return 1; }
     "$DDS" --help | grep -q 'rt/\[NS/\]joint_command'
 }
 t_stale_truth_fails() {
@@ -219,7 +234,6 @@ e2e_check frozen_reader_does_not_stall t_frozen_reader_does_not_stall
 e2e_check command_moves_a_joint t_command_moves_a_joint
 e2e_check silence_holds t_silence_holds
 e2e_check unknown_name t_unknown_name
-e2e_check too_many_names t_too_many_names
 e2e_check lengths_differ t_lengths_differ
 e2e_check named_twice t_named_twice
 e2e_check no_values t_no_values

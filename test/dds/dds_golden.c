@@ -1,9 +1,12 @@
 /*
- * dds_golden - what Cyclone DDS puts on the wire for two fixed samples, printed as hex: a
- * sensor_msgs JointState_, a unitree_go LowCmd_ and a std_msgs Header_ (its body ends off a
- * 4-byte boundary: the encapsulation's padding count) (its crc set by tools/j288-dds's
- * unitree_crc.c). test/dds/golden.sh compares the lines with test/dds/golden.py, which
- * computes the same bytes from the XCDR1 rules and unitree's crc32_core independently.
+ * dds_golden - what Cyclone DDS puts on the wire for fixed samples, printed as hex: a
+ * sensor_msgs JointState_ (the bridge's bounded type), a unitree_go LowCmd_ (its crc set by
+ * tools/j288-dds's unitree_crc.c) and a std_msgs Header_ (its body ends off a 4-byte
+ * boundary: the encapsulation's padding count); the crc of a unitree_go LowState_ and of a
+ * unitree_hg LowCmd_ and LowState_; and the ROS 2 type hash of every type the bridge puts on
+ * DDS (tools/j288-dds/typehash.c), as 'typehash NAME HASH' lines. test/dds/golden.sh compares the lines with test/dds/golden.py, which
+ * computes the same bytes from the XCDR1 rules and unitree's crc32_core independently, and
+ * with test/dds/typehash.py, which computes the hashes from the IDL.
  * Each sample goes through a writer and a reader of one participant (local delivery), and
  * the reader's serialized sample (dds_takecdr) is printed whole: encapsulation header and
  * body. The samples here and in golden.py must stay the same (they say so in both).
@@ -19,8 +22,10 @@
 
 #include "sensor_msgs.h"
 #include "std_msgs.h"
+#include "typehash.h"
 #include "unitree_crc.h"
 #include "unitree_go.h"
+#include "unitree_hg.h"
 
 static int print_cdr(dds_entity_t pp, const dds_topic_descriptor_t *desc, const char *name,
                      const void *sample)
@@ -68,13 +73,12 @@ static int print_cdr(dds_entity_t pp, const dds_topic_descriptor_t *desc, const 
 /* The JointState sample (the same in golden.py). */
 static void joint_state(sensor_msgs_msg_dds__JointState_ *m)
 {
-    static char hip[] = "hip", knee[] = "knee", frame[] = "base";
-    static char *names[] = {hip, knee};
+    static char names[2][32] = {"hip", "knee"};
     static double pos[] = {0.5, -1.25}, eff[] = {2.0, 0.0};
     memset(m, 0, sizeof *m);
     m->header.stamp.sec = 1700000000;
     m->header.stamp.nanosec = 123456789u;
-    m->header.frame_id = frame;
+    strcpy(m->header.frame_id, "base");
     m->name._buffer = names;
     m->name._length = m->name._maximum = 2;
     m->position._buffer = pos;
@@ -182,6 +186,62 @@ static void low_state(unitree_go_msg_dds__LowState_ *m)
     m->reserve = 0xCAFEF00Du;
 }
 
+/* The unitree_hg samples for the crc alone (the same in golden.py). */
+static void hg_low_cmd(unitree_hg_msg_dds__LowCmd_ *m)
+{
+    unsigned i;
+    memset(m, 0, sizeof *m);
+    m->mode_pr = 1;
+    m->mode_machine = 6;
+    for (i = 0; i < 35u; i++) {
+        unitree_hg_msg_dds__MotorCmd_ *c = &m->motor_cmd[i];
+        c->mode = i % 3u == 0u ? 1u : 0u;
+        c->q = 0.125f * (float)i;
+        c->dq = -0.25f * (float)i;
+        c->tau = 0.5f;
+        c->kp = 40.0f;
+        c->kd = 1.5f;
+        c->reserve = 100u + i;
+    }
+    for (i = 0; i < 4u; i++)
+        m->reserve[i] = 0x01010101u * (i + 1u);
+}
+
+static void hg_low_state(unitree_hg_msg_dds__LowState_ *m)
+{
+    static const float imu[13] = {1.0f, 0, 0, 0, 0.5f, -0.5f, 0.25f, 0, 0, 9.75f, 0.125f, -0.125f, 3.0f};
+    unsigned i;
+    memset(m, 0, sizeof *m);
+    m->version[0] = 1;
+    m->version[1] = 2;
+    m->mode_pr = 0;
+    m->mode_machine = 5;
+    m->tick = 987654;
+    memcpy(m->imu_state.quaternion, imu, 4 * sizeof(float));
+    memcpy(m->imu_state.gyroscope, imu + 4, 3 * sizeof(float));
+    memcpy(m->imu_state.accelerometer, imu + 7, 3 * sizeof(float));
+    memcpy(m->imu_state.rpy, imu + 10, 3 * sizeof(float));
+    m->imu_state.temperature = -7;
+    for (i = 0; i < 35u; i++) {
+        unitree_hg_msg_dds__MotorState_ *s = &m->motor_state[i];
+        s->mode = (uint8_t)(i % 2u);
+        s->q = 0.5f * (float)i;
+        s->dq = -0.25f * (float)i;
+        s->ddq = 0.0625f;
+        s->tau_est = 1.5f;
+        s->temperature[0] = (int16_t)(30 + (int)i);
+        s->temperature[1] = (int16_t)(-5 - (int)i);
+        s->vol = 24.25f;
+        s->sensor[0] = i;
+        s->sensor[1] = 7u * i;
+        s->motorstate = i == 3u ? 0x20u : 0u;
+        s->reserve[3] = 0xFFFFFFFFu - i;
+    }
+    for (i = 0; i < 40u; i++)
+        m->wireless_remote[i] = (uint8_t)(200u + i);
+    m->reserve[0] = 0xCAFEF00Du;
+}
+
 int main(int argc, char **argv)
 {
     dds_domainid_t domain = argc > 1 ? (dds_domainid_t)atoi(argv[1]) : 0;
@@ -189,9 +249,11 @@ int main(int argc, char **argv)
     static sensor_msgs_msg_dds__JointState_ js;
     static unitree_go_msg_dds__LowCmd_ lc;
     static unitree_go_msg_dds__LowState_ ls;
-    static char ab[] = "ab";
-    std_msgs_msg_dds__Header_ hd = {{-2, 7u}, ab}; /* the same in golden.py */
-    int rc = 0;
+    static unitree_hg_msg_dds__LowCmd_ hc;
+    static unitree_hg_msg_dds__LowState_ hs;
+    static std_msgs_msg_dds__Header_ hd = {{-2, 7u}, "ab"}; /* the same in golden.py */
+    char hash[J288_DDS_TYPEHASH_LEN];
+    int rc = 0, t;
     if (pp < 0) {
         fprintf(stderr, "dds_golden: participant: %s\n", dds_strretcode(pp));
         return 1;
@@ -201,6 +263,14 @@ int main(int argc, char **argv)
     printf("lowcmd_crc %08lx\n", (unsigned long)lc.crc);
     low_state(&ls);
     printf("lowstate_crc %08lx\n", (unsigned long)j288_dds_lowstate_crc(&ls));
+    hg_low_cmd(&hc);
+    printf("hg_lowcmd_crc %08lx\n", (unsigned long)j288_dds_hg_lowcmd_crc(&hc));
+    hg_low_state(&hs);
+    printf("hg_lowstate_crc %08lx\n", (unsigned long)j288_dds_hg_lowstate_crc(&hs));
+    for (t = 0; t < (int)J288_DDS_NTYPES; t++) {
+        j288_dds_typehash((j288_dds_type_t)t, hash);
+        printf("typehash %s %s\n", j288_dds_type_name((j288_dds_type_t)t), hash);
+    }
     if (print_cdr(pp, &sensor_msgs_msg_dds__JointState__desc, "joint_state", &js) != 0 ||
         print_cdr(pp, &unitree_go_msg_dds__LowCmd__desc, "lowcmd", &lc) != 0 ||
         print_cdr(pp, &std_msgs_msg_dds__Header__desc, "header", &hd) != 0)

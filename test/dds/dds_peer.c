@@ -1,21 +1,33 @@
 /*
  * dds_peer - a DDS peer of j288-dds for the tests and the benchmark, written apart from the
- * bridge: it shares only the IDL (the wire contract, checked byte for byte by golden.sh) and
- * computes unitree's crc its own way, as unitree_sdk2 does (the message in a C struct's layout,
- * crc32_core over its words in memory: little-endian hosts only, which the tests run on).
+ * bridge: it shares only the IDL (the wire contract, checked byte for byte by golden.sh),
+ * compiled as ROS 2 declares the types (-DJ288_DDS_AS_ROS2: unbounded sequences and strings;
+ * dds_peer_xt also with XTypes type information), and computes unitree's crc its own way, as
+ * unitree_sdk2 does (the message in a C struct's layout, crc32_core over its words in memory:
+ * little-endian hosts only, which the tests run on).
  *
- * usage: dds_peer [--domain N] [--ns NS] COMMAND ...
+ * usage: dds_peer [--domain N] [--ns NS] [--hg] COMMAND ...
+ *   --hg                      lowstate and lowcmd with unitree_hg's messages (35 motors)
  *   states [--timeout S]      the next rt/joint_states: 'name POS VEL EFF' lines
  *   diag [--timeout S]        the next rt/diagnostics: 'status NAME|LEVEL|MESSAGE' then
  *                             'NAME|KEY=VALUE' lines
  *   command [--for S | --count N] [--hz H] NAMES POS VEL EFF
  *                             rt/joint_command; each a comma list, '-' for an empty array;
  *                             values may be nan, inf; for S seconds, or exactly N messages
- *                             (one by default), at H per second (100)
+ *                             (one by default), at H per second (100); prints 'writer GUID'
+ *                             (its writer's, as the bridge names it) once matched
+ *   flood [--for S | --count N] [--hz H] [--names K]
+ *                             rt/joint_command with K names (default 100000) of 11
+ *                             characters: 1.6 MB samples, more names than any robot has;
+ *                             at the end 'sent N in S s'
+ *   endpoints [--timeout S]   the endpoints of other participants on rt/ topics, once at least
+ *                             3 are seen (and 1 s more): 'pub|sub TOPIC TYPE USERDATA' lines
  *   lowstate [--timeout S]    the next rt/lowstate: 'motor I Q DQ TAU TEMP MODE' lines for the
  *                             motors, then 'crc ok' or 'crc bad'
  *   lowcmd [--for S | --count N] [--hz H] [--bad-crc] MOTOR MODE Q DQ TAU KP KD
  *                             rt/lowcmd for one motor (the others mode 0), crc set (or wrong)
+ *   lowstate, lowcmd with --hg: unitree_hg's LowState_ (also 'mode_pr N' and temperatures
+ *                             case,winding per motor) and LowCmd_
  *   listen [--for S] [--freeze]
  *                             read rt/joint_states for S seconds: 'samples N'; --freeze:
  *                             stop itself (SIGSTOP) after the first sample, a matched
@@ -38,11 +50,13 @@
 #include "diagnostic_msgs.h"
 #include "sensor_msgs.h"
 #include "unitree_go.h"
+#include "unitree_hg.h"
 
 #define MAXN 80 /* more than J288_ROBOT_MAX_JOINTS: the bridge must refuse that too */
 
 static dds_domainid_t domain;
 static const char *ns;
+static int hg; /* --hg: unitree_hg's messages */
 
 static void topic_name(char *out, size_t cap, const char *name)
 {
@@ -196,9 +210,43 @@ typedef struct {
     uint32_t reserve, crc;
 } raw_low_state;
 
+/* unitree_hg's (the humanoids') */
+typedef struct {
+    uint8_t mode;
+    float q, dq, tau, kp, kd;
+    uint32_t reserve;
+} raw_hg_motor_cmd;
+
+typedef struct {
+    uint8_t mode_pr, mode_machine;
+    raw_hg_motor_cmd motor[35];
+    uint32_t reserve[4], crc;
+} raw_hg_low_cmd;
+
+typedef struct {
+    uint8_t mode;
+    float q, dq, ddq, tau_est;
+    int16_t temperature[2];
+    float vol;
+    uint32_t sensor[2], motorstate, reserve[4];
+} raw_hg_motor_state;
+
+typedef struct {
+    uint32_t version[2];
+    uint8_t mode_pr, mode_machine;
+    uint32_t tick;
+    float quaternion[4], gyroscope[3], accelerometer[3], rpy[3];
+    int16_t imu_temperature;
+    raw_hg_motor_state motor[35];
+    uint8_t wireless_remote[40];
+    uint32_t reserve[4], crc;
+} raw_hg_low_state;
+
 /* unitree's sizes (C99 has no static assert: a negative array size fails the build) */
 typedef char raw_low_cmd_is_812[sizeof(raw_low_cmd) == 812u ? 1 : -1];
 typedef char raw_low_state_is_1180[sizeof(raw_low_state) == 1180u ? 1 : -1];
+typedef char raw_hg_low_cmd_is_1004[sizeof(raw_hg_low_cmd) == 1004u ? 1 : -1];
+typedef char raw_hg_low_state_is_2092[sizeof(raw_hg_low_state) == 2092u ? 1 : -1];
 
 static uint32_t crc32_core(const uint32_t *ptr, uint32_t len)
 {
@@ -234,7 +282,7 @@ static uint32_t crc32_core(const uint32_t *ptr, uint32_t len)
 
 static uint32_t image_crc(const unsigned char *img, size_t size)
 {
-    uint32_t words[300];
+    uint32_t words[600];
     memcpy(words, img, size); /* little-endian host: the words as unitree reads them */
     return crc32_core(words, (uint32_t)(size / 4u - 1u));
 }
@@ -316,6 +364,79 @@ static uint32_t lowstate_crc(const unitree_go_msg_dds__LowState_ *m)
     return image_crc(img, sizeof img);
 }
 
+static uint32_t hg_lowcmd_crc(const unitree_hg_msg_dds__LowCmd_ *m)
+{
+    unsigned char img[sizeof(raw_hg_low_cmd)];
+    unsigned i;
+    memset(img, 0, sizeof img);
+    PUT(img, 0, raw_hg_low_cmd, mode_pr, m->mode_pr);
+    PUT(img, 0, raw_hg_low_cmd, mode_machine, m->mode_machine);
+    for (i = 0; i < 35; i++) {
+        size_t base = offsetof(raw_hg_low_cmd, motor) + i * sizeof(raw_hg_motor_cmd);
+        const unitree_hg_msg_dds__MotorCmd_ *c = &m->motor_cmd[i];
+        PUT(img, base, raw_hg_motor_cmd, mode, c->mode);
+        PUT(img, base, raw_hg_motor_cmd, q, c->q);
+        PUT(img, base, raw_hg_motor_cmd, dq, c->dq);
+        PUT(img, base, raw_hg_motor_cmd, tau, c->tau);
+        PUT(img, base, raw_hg_motor_cmd, kp, c->kp);
+        PUT(img, base, raw_hg_motor_cmd, kd, c->kd);
+        PUT(img, base, raw_hg_motor_cmd, reserve, c->reserve);
+    }
+    PUT(img, 0, raw_hg_low_cmd, reserve, m->reserve);
+    return image_crc(img, sizeof img);
+}
+
+static uint32_t hg_lowstate_crc(const unitree_hg_msg_dds__LowState_ *m)
+{
+    unsigned char img[sizeof(raw_hg_low_state)];
+    unsigned i;
+    memset(img, 0, sizeof img);
+    PUT(img, 0, raw_hg_low_state, version, m->version);
+    PUT(img, 0, raw_hg_low_state, mode_pr, m->mode_pr);
+    PUT(img, 0, raw_hg_low_state, mode_machine, m->mode_machine);
+    PUT(img, 0, raw_hg_low_state, tick, m->tick);
+    PUT(img, 0, raw_hg_low_state, quaternion, m->imu_state.quaternion);
+    PUT(img, 0, raw_hg_low_state, gyroscope, m->imu_state.gyroscope);
+    PUT(img, 0, raw_hg_low_state, accelerometer, m->imu_state.accelerometer);
+    PUT(img, 0, raw_hg_low_state, rpy, m->imu_state.rpy);
+    PUT(img, 0, raw_hg_low_state, imu_temperature, m->imu_state.temperature);
+    for (i = 0; i < 35; i++) {
+        size_t base = offsetof(raw_hg_low_state, motor) + i * sizeof(raw_hg_motor_state);
+        const unitree_hg_msg_dds__MotorState_ *s = &m->motor_state[i];
+        PUT(img, base, raw_hg_motor_state, mode, s->mode);
+        PUT(img, base, raw_hg_motor_state, q, s->q);
+        PUT(img, base, raw_hg_motor_state, dq, s->dq);
+        PUT(img, base, raw_hg_motor_state, ddq, s->ddq);
+        PUT(img, base, raw_hg_motor_state, tau_est, s->tau_est);
+        PUT(img, base, raw_hg_motor_state, temperature, s->temperature);
+        PUT(img, base, raw_hg_motor_state, vol, s->vol);
+        PUT(img, base, raw_hg_motor_state, sensor, s->sensor);
+        PUT(img, base, raw_hg_motor_state, motorstate, s->motorstate);
+        PUT(img, base, raw_hg_motor_state, reserve, s->reserve);
+    }
+    PUT(img, 0, raw_hg_low_state, wireless_remote, m->wireless_remote);
+    PUT(img, 0, raw_hg_low_state, reserve, m->reserve);
+    return image_crc(img, sizeof img);
+}
+
+static int cmd_hg_lowstate(double timeout_s)
+{
+    static unitree_hg_msg_dds__LowState_ m;
+    unsigned i;
+    if (read_one(&unitree_hg_msg_dds__LowState__desc, "lowstate", timeout_s, &m) != 0)
+        return 1;
+    for (i = 0; i < 35; i++)
+        printf("motor %u %.6f %.6f %.6f %d,%d %u %.2f %u\n", i, (double)m.motor_state[i].q,
+               (double)m.motor_state[i].dq, (double)m.motor_state[i].tau_est,
+               m.motor_state[i].temperature[0], m.motor_state[i].temperature[1],
+               (unsigned)m.motor_state[i].mode, (double)m.motor_state[i].vol,
+               (unsigned)m.motor_state[i].motorstate);
+    printf("mode_pr %u\ncrc %s %08lx %08lx\n", (unsigned)m.mode_pr,
+           hg_lowstate_crc(&m) == m.crc ? "ok" : "bad", (unsigned long)m.crc,
+           (unsigned long)hg_lowstate_crc(&m));
+    return 0;
+}
+
 static int cmd_lowstate(double timeout_s)
 {
     static unitree_go_msg_dds__LowState_ m;
@@ -337,10 +458,13 @@ static int cmd_lowstate(double timeout_s)
  * participant's endpoint announcements, the writer's (made first) with them: its best-effort
  * command reader drops what a writer it does not know yet sends (a loaded machine lost some of
  * a test's counted commands that way). False when none came: the caller goes on regardless. */
-static int bridge_knows_us(dds_entity_t pp, int unitree, double timeout_s)
+static int bridge_knows_us(dds_entity_t pp, const dds_topic_descriptor_t *cmd, double timeout_s)
 {
-    dds_entity_t tp = unitree ? make_topic(pp, &unitree_go_msg_dds__LowState__desc, "lowstate")
-                              : make_topic(pp, &sensor_msgs_msg_dds__JointState__desc, "joint_states");
+    dds_entity_t tp = cmd == &unitree_go_msg_dds__LowCmd__desc
+                          ? make_topic(pp, &unitree_go_msg_dds__LowState__desc, "lowstate")
+                      : cmd == &unitree_hg_msg_dds__LowCmd__desc
+                          ? make_topic(pp, &unitree_hg_msg_dds__LowState__desc, "lowstate")
+                          : make_topic(pp, &sensor_msgs_msg_dds__JointState__desc, "joint_states");
     dds_entity_t r = dds_create_reader(pp, tp, NULL, NULL);
     void *ptrs[1] = {NULL};
     dds_sample_info_t si;
@@ -373,7 +497,14 @@ static dds_entity_t writer_for(const dds_topic_descriptor_t *d, const char *name
     do { /* until the bridge's reader is there, then until the bridge knows this writer */
         dds_get_publication_matched_status(w, &st);
         if (st.current_count > 0) {
-            (void)bridge_knows_us(pp, d == &unitree_go_msg_dds__LowCmd__desc, 5.0);
+            dds_guid_t g;
+            unsigned k;
+            (void)bridge_knows_us(pp, d, 5.0);
+            if (dds_get_guid(w, &g) == DDS_RETCODE_OK) { /* as the bridge prints it */
+                printf("writer ");
+                for (k = 0; k < 16; k++)
+                    printf("%02x%s", g.v[k], k < 15 ? "." : "\n");
+            }
             return w;
         }
         dds_sleepfor(DDS_MSECS(20));
@@ -382,8 +513,9 @@ static dds_entity_t writer_for(const dds_topic_descriptor_t *d, const char *name
     return -1;
 }
 
-/* Publish write() at hz: count times when count > 0, else for seconds (once when 0). */
-static void pace(int count, double seconds, double hz, void (*write)(void *ctx), void *ctx)
+/* Publish write() at hz: count times when count > 0, else for seconds (once when 0). Returns
+ * how many were written. */
+static int pace(int count, double seconds, double hz, void (*write)(void *ctx), void *ctx)
 {
     double end = mono_s() + seconds, next = mono_s();
     int sent = 0;
@@ -394,6 +526,7 @@ static void pace(int count, double seconds, double hz, void (*write)(void *ctx),
         while (mono_s() < next)
             dds_sleepfor(DDS_USECS(200));
     } while (count > 0 ? sent < count : mono_s() < end);
+    return sent;
 }
 
 /* "a,b,c" -> values; "-" -> none. */
@@ -410,105 +543,180 @@ static uint32_t parse_list(char *s, double *out)
 
 typedef struct {
     dds_entity_t w;
-    sensor_msgs_msg_dds__JointState_ m;
-} js_ctx;
+    const void *m;
+} sample_ctx;
 
-static void write_js(void *p)
+static void write_sample(void *p)
 {
-    js_ctx *c = p;
-    dds_write(c->w, &c->m);
+    sample_ctx *c = p;
+    dds_write(c->w, c->m);
+}
+
+/* m on topic name (type d) as pace() says, once a reader matched; prints 'sent N in S s' with
+ * print_sent. 1 when no reader matched. */
+static int publish(const dds_topic_descriptor_t *d, const char *name, const void *m, int count,
+                   double seconds, double hz, int print_sent)
+{
+    sample_ctx c;
+    double t0;
+    int n;
+    c.m = m;
+    c.w = writer_for(d, name);
+    if (c.w < 0)
+        return 1;
+    t0 = mono_s();
+    n = pace(count, seconds, hz, write_sample, &c);
+    if (print_sent)
+        printf("sent %d in %.2f s\n", n, mono_s() - t0);
+    dds_wait_for_acks(c.w, DDS_SECS(2));
+    return 0;
 }
 
 static int cmd_command(int count, double seconds, double hz, char **argv)
 {
     static char *names[MAXN];
     static double pos[MAXN], vel[MAXN], eff[MAXN];
-    static js_ctx c;
+    static sensor_msgs_msg_dds__JointState_ m;
     uint32_t n = 0;
     char *tok;
     for (tok = strtok(argv[0], ","); tok != NULL && n < MAXN; tok = strtok(NULL, ","))
         names[n++] = tok;
-    c.m.header.frame_id = (char *)"";
-    c.m.name._buffer = names;
-    c.m.name._length = c.m.name._maximum = n;
-    c.m.position._buffer = pos;
-    c.m.position._length = c.m.position._maximum = parse_list(argv[1], pos);
-    c.m.velocity._buffer = vel;
-    c.m.velocity._length = c.m.velocity._maximum = parse_list(argv[2], vel);
-    c.m.effort._buffer = eff;
-    c.m.effort._length = c.m.effort._maximum = parse_list(argv[3], eff);
-    c.w = writer_for(&sensor_msgs_msg_dds__JointState__desc, "joint_command");
-    if (c.w < 0)
-        return 1;
-    pace(count, seconds, hz, write_js, &c);
-    dds_wait_for_acks(c.w, DDS_SECS(2));
-    return 0;
+    m.header.frame_id = (char *)"";
+    m.name._buffer = names;
+    m.name._length = m.name._maximum = n;
+    m.position._buffer = pos;
+    m.position._length = m.position._maximum = parse_list(argv[1], pos);
+    m.velocity._buffer = vel;
+    m.velocity._length = m.velocity._maximum = parse_list(argv[2], vel);
+    m.effort._buffer = eff;
+    m.effort._length = m.effort._maximum = parse_list(argv[3], eff);
+    return publish(&sensor_msgs_msg_dds__JointState__desc, "joint_command", &m, count, seconds, hz, 0);
 }
 
-typedef struct {
-    dds_entity_t w;
-    unitree_go_msg_dds__LowCmd_ m;
-} lc_ctx;
-
-static void write_lc(void *p)
-{
-    lc_ctx *c = p;
-    dds_write(c->w, &c->m);
-}
+/* One motor's command (unitree_go's or unitree_hg's MotorCmd_) from MOTOR MODE Q DQ TAU KP KD. */
+#define SET_MOTOR(mc, argv)                        \
+    do {                                           \
+        (mc)->mode = (uint8_t)atoi((argv)[1]);     \
+        (mc)->q = strtof((argv)[2], NULL);         \
+        (mc)->dq = strtof((argv)[3], NULL);        \
+        (mc)->tau = strtof((argv)[4], NULL);       \
+        (mc)->kp = strtof((argv)[5], NULL);        \
+        (mc)->kd = strtof((argv)[6], NULL);        \
+    } while (0)
 
 static int cmd_lowcmd(int count, double seconds, double hz, int bad_crc, char **argv)
 {
-    static lc_ctx c;
-    unitree_go_msg_dds__MotorCmd_ *mc;
+    static unitree_go_msg_dds__LowCmd_ m;
     int motor = atoi(argv[0]);
     if (motor < 0 || motor >= 20)
         return 2;
-    c.m.head[0] = 0xFE;
-    c.m.head[1] = 0xEF;
-    c.m.level_flag = 0xFF;
-    mc = &c.m.motor_cmd[motor];
-    mc->mode = (uint8_t)atoi(argv[1]);
-    mc->q = strtof(argv[2], NULL);
-    mc->dq = strtof(argv[3], NULL);
-    mc->tau = strtof(argv[4], NULL);
-    mc->kp = strtof(argv[5], NULL);
-    mc->kd = strtof(argv[6], NULL);
-    c.m.crc = lowcmd_crc(&c.m) ^ (bad_crc ? 1u : 0u);
-    c.w = writer_for(&unitree_go_msg_dds__LowCmd__desc, "lowcmd");
-    if (c.w < 0)
-        return 1;
-    pace(count, seconds, hz, write_lc, &c);
-    dds_wait_for_acks(c.w, DDS_SECS(2));
-    return 0;
+    m.head[0] = 0xFE;
+    m.head[1] = 0xEF;
+    m.level_flag = 0xFF;
+    SET_MOTOR(&m.motor_cmd[motor], argv);
+    m.crc = lowcmd_crc(&m) ^ (bad_crc ? 1u : 0u);
+    return publish(&unitree_go_msg_dds__LowCmd__desc, "lowcmd", &m, count, seconds, hz, 0);
+}
+
+static int cmd_hg_lowcmd(int count, double seconds, double hz, int bad_crc, char **argv)
+{
+    static unitree_hg_msg_dds__LowCmd_ m;
+    int motor = atoi(argv[0]);
+    if (motor < 0 || motor >= 35)
+        return 2;
+    m.mode_pr = (uint8_t)(getenv("DDS_PEER_MODE_PR") ? atoi(getenv("DDS_PEER_MODE_PR")) : 0);
+    SET_MOTOR(&m.motor_cmd[motor], argv);
+    m.crc = hg_lowcmd_crc(&m) ^ (bad_crc ? 1u : 0u);
+    return publish(&unitree_hg_msg_dds__LowCmd__desc, "lowcmd", &m, count, seconds, hz, 0);
+}
+
+/* JointState commands with k names: far more than the bridge's types allow. */
+static int cmd_flood(int count, double seconds, double hz, long k)
+{
+    static sensor_msgs_msg_dds__JointState_ m;
+    static char text[16];
+    long i;
+    char **names = malloc((size_t)k * sizeof *names);
+    char *pool = malloc((size_t)k * 12u);
+    if (names == NULL || pool == NULL || k <= 0)
+        return 2;
+    for (i = 0; i < k; i++) {
+        names[i] = pool + 12 * i;
+        snprintf(names[i], 12, "flood%06ld", i % 1000000);
+    }
+    m.header.frame_id = text;
+    m.name._buffer = names;
+    m.name._length = m.name._maximum = (uint32_t)k;
+    return publish(&sensor_msgs_msg_dds__JointState__desc, "joint_command", &m, count, seconds, hz, 1);
+}
+
+/* The endpoints other participants have on rt/ topics, with their USER_DATA. */
+static int cmd_endpoints(double timeout_s)
+{
+    dds_entity_t pp = dds_create_participant(domain, NULL, NULL);
+    dds_entity_t rd[2];
+    const char *kind[2] = {"pub", "sub"};
+    dds_guid_t self;
+    double end = mono_s() + timeout_s, seen_at = 0;
+    char lines[64][400];
+    int n = 0, k;
+    rd[0] = dds_create_reader(pp, DDS_BUILTIN_TOPIC_DCPSPUBLICATION, NULL, NULL);
+    rd[1] = dds_create_reader(pp, DDS_BUILTIN_TOPIC_DCPSSUBSCRIPTION, NULL, NULL);
+    dds_get_guid(pp, &self);
+    while (mono_s() < end && (n < 3 || mono_s() < seen_at + 1.0)) {
+        for (k = 0; k < 2; k++) {
+            void *ptrs[1] = {NULL};
+            dds_sample_info_t si;
+            while (dds_take(rd[k], ptrs, &si, 1, 1) > 0) {
+                dds_builtintopic_endpoint_t *ep = ptrs[0];
+                void *ud = NULL;
+                size_t sz = 0;
+                if (si.valid_data && memcmp(ep->participant_key.v, self.v, 12) != 0 &&
+                    strncmp(ep->topic_name, "rt/", 3) == 0 && n < 64) {
+                    dds_qget_userdata(ep->qos, &ud, &sz);
+                    snprintf(lines[n++], sizeof lines[0], "%s %s %s %.*s", kind[k], ep->topic_name,
+                             ep->type_name, (int)sz, ud != NULL ? (const char *)ud : "");
+                    dds_free(ud);
+                    seen_at = mono_s();
+                }
+                dds_return_loan(rd[k], ptrs, 1);
+            }
+        }
+        dds_sleepfor(DDS_MSECS(20));
+    }
+    for (k = 0; k < n; k++)
+        printf("%s\n", lines[k]);
+    return n >= 3 ? 0 : 1;
 }
 
 static int cmd_latency(int count, double hz, char **argv)
 {
     static char *names[1];
     static double pos[1];
-    static js_ctx c;
+    static sensor_msgs_msg_dds__JointState_ m;
+    dds_entity_t w;
     double a = strtod(argv[1], NULL), b = strtod(argv[2], NULL);
     int i;
     names[0] = argv[0];
-    c.m.header.frame_id = (char *)"";
-    c.m.name._buffer = names;
-    c.m.name._length = c.m.name._maximum = 1;
-    c.m.position._buffer = pos;
-    c.m.position._length = c.m.position._maximum = 1;
-    c.w = writer_for(&sensor_msgs_msg_dds__JointState__desc, "joint_command");
-    if (c.w < 0)
+    m.header.frame_id = (char *)"";
+    m.name._buffer = names;
+    m.name._length = m.name._maximum = 1;
+    m.position._buffer = pos;
+    m.position._length = m.position._maximum = 1;
+    w = writer_for(&sensor_msgs_msg_dds__JointState__desc, "joint_command");
+    if (w < 0)
         return 1;
     for (i = 0; i < count; i++) {
         struct timespec ts;
         double next = mono_s() + 1.0 / hz;
         pos[0] = (i % 2) ? b : a;
         clock_gettime(CLOCK_MONOTONIC, &ts);
-        dds_write(c.w, &c.m);
+        dds_write(w, &m);
         printf("sent %lld %.6f\n", (long long)ts.tv_sec * 1000000000LL + ts.tv_nsec, pos[0]);
         while (mono_s() < next)
             dds_sleepfor(DDS_USECS(100));
     }
-    dds_wait_for_acks(c.w, DDS_SECS(2));
+    dds_wait_for_acks(w, DDS_SECS(2));
     return 0;
 }
 
@@ -516,18 +724,22 @@ int main(int argc, char **argv)
 {
     double timeout_s = 10.0, seconds = 0.0, hz = 100.0;
     int i = 1, bad_crc = 0, freeze = 0, count = 0; /* latency: 100 when not given */
+    long names = 100000;
     const char *cmd;
     const char *env = getenv("DDS_DOMAIN");
     if (env != NULL)
         domain = (dds_domainid_t)atoi(env);
     for (; i < argc && strncmp(argv[i], "--", 2) == 0; i += 2) {
-        if (i + 1 >= argc)
+        if (i + 1 >= argc && strcmp(argv[i], "--hg") != 0)
             return 2;
         if (strcmp(argv[i], "--domain") == 0)
             domain = (dds_domainid_t)atoi(argv[i + 1]);
         else if (strcmp(argv[i], "--ns") == 0)
             ns = argv[i + 1];
-        else
+        else if (strcmp(argv[i], "--hg") == 0) {
+            hg = 1;
+            i--; /* takes no value */
+        } else
             return 2;
     }
     if (i >= argc)
@@ -552,6 +764,8 @@ int main(int argc, char **argv)
             hz = atof(argv[i + 1]);
         else if (strcmp(argv[i], "--count") == 0)
             count = atoi(argv[i + 1]);
+        else if (strcmp(argv[i], "--names") == 0)
+            names = atol(argv[i + 1]);
         else
             return 2;
         i++;
@@ -564,11 +778,16 @@ int main(int argc, char **argv)
     if (strcmp(cmd, "diag") == 0)
         return cmd_diag(timeout_s);
     if (strcmp(cmd, "lowstate") == 0)
-        return cmd_lowstate(timeout_s);
+        return hg ? cmd_hg_lowstate(timeout_s) : cmd_lowstate(timeout_s);
+    if (strcmp(cmd, "endpoints") == 0)
+        return cmd_endpoints(timeout_s);
+    if (strcmp(cmd, "flood") == 0 && argc == i)
+        return cmd_flood(count, seconds, hz, names);
     if (strcmp(cmd, "command") == 0 && argc - i == 4)
         return cmd_command(count, seconds, hz, argv + i);
     if (strcmp(cmd, "lowcmd") == 0 && argc - i == 7)
-        return cmd_lowcmd(count, seconds, hz, bad_crc, argv + i);
+        return hg ? cmd_hg_lowcmd(count, seconds, hz, bad_crc, argv + i)
+                  : cmd_lowcmd(count, seconds, hz, bad_crc, argv + i);
     if (strcmp(cmd, "latency") == 0 && argc - i == 3)
         return cmd_latency(count > 0 ? count : 100, hz, argv + i);
     fprintf(stderr, "dds_peer: bad usage (see the top of test/dds/dds_peer.c)\n");

@@ -15,8 +15,11 @@ The unitree crc (unitree_sdk2): the message copied into a C struct (natural alig
 padding), crc32_core over its 32-bit little-endian words but the last: polynomial 0x04C11DB7,
 initial 0xFFFFFFFF, each word shifted in most significant bit first, no final XOR.
 
-Prints `name hex` lines in dds_golden's order (and the crc of a LowState sample, which only
-the crc test uses). The samples must match dds_golden.c's."""
+unitree_hg (the humanoids) the same way: LowCmd 1004 bytes, LowState 2092.
+
+Prints `name hex` lines in dds_golden's order (and the crc of a LowState sample and of
+unitree_hg's LowCmd and LowState samples, which only the crc test uses). The samples must match
+dds_golden.c's."""
 import struct
 
 
@@ -125,6 +128,34 @@ def lowstate_crc():
     return crc32_core(struct.unpack('<295I', raw)[:-1])
 
 
+# unitree_hg's C structs: MotorCmd (mode, 5 floats, uint32) 28 bytes; MotorState (mode, 4 floats,
+# int16[2], float, uint32[2], uint32, uint32[4]) 56; IMUState (13 floats, int16) 56.
+HG_LOWCMD_FMT = '<BB2x' + 'B3x5fI' * 35 + '4I' + 'I'
+HG_LOWSTATE_FMT = '<2IBB2xI' + '13fh2x' + 'B3x4f2hf2II4I' * 35 + '40B' + '4I' + 'I'
+
+
+def hg_lowcmd_crc():
+    v = [1, 6]
+    for i in range(35):
+        v += [1 if i % 3 == 0 else 0, 0.125 * i, -0.25 * i, 0.5, 40.0, 1.5, 100 + i]
+    v += [0x01010101 * (k + 1) for k in range(4)] + [0]
+    raw = struct.pack(HG_LOWCMD_FMT, *v)
+    assert len(raw) == 1004
+    return crc32_core(struct.unpack('<251I', raw)[:-1])
+
+
+def hg_lowstate_crc():
+    v = [1, 2, 0, 5, 987654]
+    v += [1.0, 0.0, 0.0, 0.0, 0.5, -0.5, 0.25, 0.0, 0.0, 9.75, 0.125, -0.125, 3.0, -7]
+    for i in range(35):
+        v += [i % 2, 0.5 * i, -0.25 * i, 0.0625, 1.5, 30 + i, -5 - i, 24.25, i, 7 * i,
+              0x20 if i == 3 else 0, 0, 0, 0, 0xFFFFFFFF - i]
+    v += [200 + k for k in range(40)] + [0xCAFEF00D, 0, 0, 0] + [0]
+    raw = struct.pack(HG_LOWSTATE_FMT, *v)
+    assert len(raw) == 2092
+    return crc32_core(struct.unpack('<523I', raw)[:-1])
+
+
 def lowcmd(crc):
     c = Cdr()
     for fmt, v in lowcmd_fields(crc):
@@ -142,6 +173,8 @@ if __name__ == '__main__':
     crc = lowcmd_crc()
     print('lowcmd_crc %08x' % crc)
     print('lowstate_crc %08x' % lowstate_crc())
+    print('hg_lowcmd_crc %08x' % hg_lowcmd_crc())
+    print('hg_lowstate_crc %08x' % hg_lowstate_crc())
     print('joint_state ' + joint_state().hex())
     print('lowcmd ' + lowcmd(crc).hex())
     print('header ' + header_only().hex())

@@ -7,7 +7,7 @@
 #include "bridge.h"
 
 #define DIAG_MAX_STATUS (1u + J288_ROBOT_MAX_BUSES + J288_ROBOT_MAX_JOINTS)
-#define DIAG_MAX_VALUES 24u
+#define DIAG_MAX_VALUES 28u
 #define DIAG_POOL (64u * 1024u)
 
 enum { LEVEL_OK = 0, LEVEL_WARN = 1, LEVEL_ERROR = 2, LEVEL_STALE = 3 };
@@ -72,6 +72,7 @@ static void bridge_status(bridge_t *b, diagnostic_msgs_msg_dds__DiagnosticArray_
     diagnostic_msgs_msg_dds__DiagnosticStatus_ *s;
     for (c = 0; c < BRIDGE_NCAUSES; c++)
         total += b->refused[c];
+    total += b->dropped;
     refused = total - b->refused_reported; /* a warning while refusals go on, not forever */
     b->refused_reported = total;
     for (j = 0; j < j288_robot_njoints(b->robot); j++)
@@ -80,13 +81,18 @@ static void bridge_status(bridge_t *b, diagnostic_msgs_msg_dds__DiagnosticArray_
                str("j288-dds: bridge"), str("j288-dds"));
     s->message = b->stopped ? str("stopped: %s", b->stop_reason)
                  : timed_out != 0u ? str("%u joint(s) timed out", timed_out)
-                 : refused != 0u ? str("%lu command(s) refused since the last report",
+                 : refused != 0u ? str("%lu command(s) refused or dropped since the last report",
                                        (unsigned long)refused)
                                 : str("ok");
     kv(s, "messages", str("%lu", (unsigned long)b->messages));
     kv(s, "timeout_ms", str("%lu", (unsigned long)(b->timeout_us / 1000u)));
-    kv(s, "refused", str("%lu", (unsigned long)total));
+    kv(s, "refused", str("%lu", (unsigned long)(total - b->dropped)));
+    kv(s, "refused_whole_messages", str("%lu", (unsigned long)b->refused_whole));
+    kv(s, "atomic", str("%s", b->atomic ? "true" : "false"));
     kv(s, "timeout_policy", str("%s", b->policy == TIMEOUT_HOLD ? "hold" : "lock"));
+    kv(s, "dropped_by_dds", str("%lu", (unsigned long)b->dropped));
+    if (b->dropped != 0u)
+        kv(s, "dropped_from", str("%s", b->dropped_guid));
     for (c = 0; c < BRIDGE_NCAUSES; c++)
         if (b->refused[c] != 0u)
             kv(s, bridge_cause_name((bridge_cause_t)c), str("%lu", (unsigned long)b->refused[c]));
@@ -139,6 +145,10 @@ static void joint_status(bridge_t *b, unsigned j, diagnostic_msgs_msg_dds__Diagn
     kv(s, "online", str("%s", st.online ? "true" : "false"));
     kv(s, "command", str("%s", mode_name(b->joint[j].mode)));
     kv(s, "commands_accepted", str("%lu", (unsigned long)b->joint[j].accepted));
+    kv(s, "owner", str("%s", b->joint[j].owned ? b->joint[j].owner_guid : "none"));
+    kv(s, "refused_other_writer", str("%lu", (unsigned long)b->joint[j].refused_other));
+    if (b->joint[j].refused_other != 0u)
+        kv(s, "other_writer", str("%s", b->joint[j].other_guid));
     kv(s, "timeouts", str("%lu", (unsigned long)b->joint[j].timeouts));
     kv(s, "watchdog_trips", str("%lu", (unsigned long)b->joint[j].watchdog));
     kv(s, "faults", str("0x%06lx", (unsigned long)st.faults));
@@ -163,8 +173,7 @@ void bridge_fill_diagnostics(bridge_t *b, diagnostic_msgs_msg_dds__DiagnosticArr
     unsigned i;
     d.used = 0;
     memset(m, 0, sizeof *m);
-    bridge_stamp_now(&m->header.stamp);
-    m->header.frame_id = str("");
+    bridge_stamp_now(&m->header.stamp); /* frame_id: empty */
     m->status._buffer = d.status;
     bridge_status(b, m);
     for (i = 0; i < j288_robot_nbuses(b->robot); i++)

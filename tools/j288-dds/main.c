@@ -2,9 +2,11 @@
  * j288-dds - the robot of a config file on DDS, as ROS 2 and unitree_sdk2 programs expect it
  * (docs/dds.md). One thread: take the commands that came in, run one cycle of the robot
  * runner, publish the state; diagnostics about once a second; sleep to the next period.
- * DDS's own threads receive in the background; nothing of theirs touches the robot.
+ * DDS's own threads receive in the background; nothing of theirs touches the robot (their log
+ * lines pass through log_sink(), which only counts the samples DDS dropped).
  */
 #include <errno.h>
+#include <pthread.h>
 #include <signal.h>
 #include <sys/resource.h>
 #include <stdio.h>
@@ -15,10 +17,16 @@
 #include <dds/dds.h>
 
 #include "bridge.h"
+#include "service.h"
+#include "typehash.h"
 
 #define DIAG_PERIOD_US 1000000u
 #define DEFAULT_RATE_HZ 500.0
 #define TAKE_MAX 32
+#define NS_MAX 245 /* ROS 2's RMW_NAMESPACE_MAX_LENGTH */
+#define TOPIC_MAX (NS_MAX + 40)
+
+typedef enum { MODE_ROS = 0, MODE_UNITREE_GO, MODE_UNITREE_HG } bridge_mode_t;
 
 static const char usage[] =
     "usage: j288-dds --config ROBOT.yaml [options]\n"
@@ -29,29 +37,41 @@ static const char usage[] =
     "\n"
     "  --config FILE       the robot config (buses and joints)\n"
     "  --domain N          DDS domain id, 0-232 (default: $ROS_DOMAIN_ID, else 0)\n"
-    "  --namespace NS      topics rt/NS/... (letters, digits, _ and /)\n"
+    "  --namespace NS      topics rt/NS/...: a ROS 2 namespace (/robot1, or robot1 taken as\n"
+    "                      /robot1; letters, digits, _ and single inner /, no part starting\n"
+    "                      with a digit; / alone: none)\n"
     "  --rate HZ           cycles per second (default 500; 0: back to back)\n"
-    "  --timeout MS        a command older than this is no longer followed (default 100)\n"
+    "  --timeout MS        a command older than this is no longer followed, and its writer\n"
+    "                      no longer owns the joint (default 100)\n"
     "  --on-timeout hold|lock   then hold the joint where it is at its gains (default), or\n"
     "                      lock it\n"
-    "  --unitree           unitree_sdk2 mode: rt/lowstate and rt/lowcmd (unitree_go LowState_,\n"
-    "                      LowCmd_; motors in config order, crc checked and set) instead of\n"
-    "                      joint_states and joint_command\n"
+    "  --per-joint         apply the joints of a command that are not refused (default: a\n"
+    "                      command with any joint refused applies to none)\n"
+    "  --unitree           unitree_sdk2 mode, unitree_go (Go2, B2, H1): rt/lowstate and\n"
+    "                      rt/lowcmd (LowState_, LowCmd_; motors in config order, crc checked\n"
+    "                      and set) instead of joint_states and joint_command\n"
+    "  --unitree-hg        the same with unitree_hg's messages (G1, H1-2)\n"
     "  --stop-on-bus-loss  a bus that stops answering or vanishes locks every bus, and\n"
     "                      commands are refused until restart\n"
     "  --help, --version\n"
     "Gains: each joint's kp and kd from the config, else kp 20 N*m/rad, kd 2.5 N*m*s/rad.\n"
-    "SIGINT / SIGTERM: every bus locked (broadcast lock, watchdog bit 0), then exit 0.\n";
+    "One commander per joint: the first writer whose command for a joint is applied owns it\n"
+    "until it has been silent for the timeout; other writers' commands for it are refused.\n"
+    "SIGINT / SIGTERM: every bus locked (broadcast lock, watchdog bit 0), then exit 0.\n"
+    "Under systemd (NOTIFY_SOCKET): READY=1 once up, WATCHDOG=1 from the loop when\n"
+    "WatchdogSec is set; a loop that stops cycling is killed and restarted by systemd, and\n"
+    "its servos lock by their own 1 s watchdog meanwhile.\n";
 
 typedef struct {
     const char *config;
     long domain;
-    const char *ns;
     double rate_hz;
     uint32_t timeout_us;
     bridge_timeout_policy_t policy;
-    bool unitree;
+    bridge_mode_t mode;
+    bool per_joint;
     bool stop_on_bus_loss;
+    char ns[NS_MAX + 1]; /* without the leading /; "" for none */
 } options_t;
 
 static volatile sig_atomic_t stop_signal;
@@ -82,18 +102,32 @@ static bool number(const char *s, double lo, double hi, double *out)
     return true;
 }
 
-static bool good_namespace(const char *ns)
+/* ROS 2's rules for a node namespace (rcl makes a relative one absolute, rmw validates it):
+ * into out without the leading /, "" for the root. NULL when it is valid, else why not. */
+static const char *ros_namespace(const char *ns, char out[NS_MAX + 1])
 {
-    const char *p;
-    if (*ns == '\0' || *ns == '/' || ns[strlen(ns) - 1] == '/' || strlen(ns) > 100u)
-        return false;
-    for (p = ns; *p != '\0'; p++) {
-        bool ok = (*p >= 'a' && *p <= 'z') || (*p >= 'A' && *p <= 'Z') || (*p >= '0' && *p <= '9') ||
-                  *p == '_' || (*p == '/' && p[1] != '/');
-        if (!ok)
-            return false;
+    const char *p = ns[0] == '/' ? ns + 1 : ns;
+    size_t n = strlen(p);
+    if (n == 0u) {
+        out[0] = '\0';
+        return NULL;
     }
-    return true;
+    if (n + 1u > NS_MAX)
+        return "longer than 245 characters";
+    if (p[n - 1u] == '/')
+        return "ends with /";
+    for (; *p != '\0'; p++) {
+        bool start = p == (ns[0] == '/' ? ns + 1 : ns) || p[-1] == '/';
+        if (!((*p >= 'a' && *p <= 'z') || (*p >= 'A' && *p <= 'Z') || (*p >= '0' && *p <= '9') ||
+              *p == '_' || *p == '/'))
+            return "characters other than letters, digits, _ and /";
+        if (*p == '/' && start)
+            return "repeated /";
+        if (start && *p >= '0' && *p <= '9')
+            return "a part starts with a digit";
+    }
+    memcpy(out, ns[0] == '/' ? ns + 1 : ns, n + 1u);
+    return NULL;
 }
 
 /* 0: go on; otherwise the exit status (help and version: 0 after printing, with *done). */
@@ -121,8 +155,11 @@ static int parse(int argc, char **argv, options_t *o, bool *done)
             printf("j288-dds %s\n", j288_robot_version());
             *done = true;
             return 0;
-        } else if (strcmp(a, "--unitree") == 0) {
-            o->unitree = true;
+        } else if (strcmp(a, "--unitree") == 0 || strcmp(a, "--unitree-hg") == 0) {
+            o->mode = strcmp(a, "--unitree") == 0 ? MODE_UNITREE_GO : MODE_UNITREE_HG;
+            takes = false;
+        } else if (strcmp(a, "--per-joint") == 0) {
+            o->per_joint = true;
             takes = false;
         } else if (strcmp(a, "--stop-on-bus-loss") == 0) {
             o->stop_on_bus_loss = true;
@@ -136,9 +173,11 @@ static int parse(int argc, char **argv, options_t *o, bool *done)
                 return bad_usage("--domain takes a domain id 0-232", val);
             o->domain = (long)v;
         } else if (strcmp(a, "--namespace") == 0) {
-            if (!good_namespace(val))
-                return bad_usage("--namespace takes letters, digits, _ and single inner /", val);
-            o->ns = val;
+            const char *why = ros_namespace(val, o->ns);
+            if (why != NULL) {
+                fprintf(stderr, "j288-dds: --namespace %s: not a ROS 2 namespace: %s\n", val, why);
+                return bad_usage("--namespace takes a ROS 2 namespace such as /robot1", NULL);
+            }
         } else if (strcmp(a, "--rate") == 0) {
             if (!number(val, 0, 10000, &v) || (v > 0 && v < 0.1))
                 return bad_usage("--rate takes 0 (back to back) or 0.1-10000 Hz", val);
@@ -227,15 +266,69 @@ static bool every_bus_gone(const j288_robot_t *r)
 /* ---- DDS entities ---- */
 
 typedef struct {
-    dds_entity_t participant, state_w, diag_w, cmd_r;
+    dds_entity_t domain, participant, state_w, diag_w, cmd_r;
+    bridge_mode_t mode;
 } dds_io_t;
+
+
+/* The domain, with Cyclone's Internal/MaxSampleSize at J288_DDS_MAX_SAMPLE_KIB: above the
+ * bridge's largest own sample, diagnostics of 64 joints (under 100 KiB: 73 statuses of at most
+ * 28 values, strings from a 64 KiB pool, diag.c), far below a sample that would keep the
+ * receive thread busy reassembling it. Cyclone drops a larger one at its first fragment.
+ * Configured by this setting first, then by $CYCLONEDDS_URI as usual
+ * (Cyclone reads a list of sources in order, the later overriding the earlier: a user's own
+ * MaxSampleSize wins). */
+static dds_entity_t create_domain(dds_domainid_t id)
+{
+    const char *user = getenv("CYCLONEDDS_URI");
+    size_t cap = 200u + (user != NULL ? strlen(user) : 0u);
+    char *cfg = malloc(cap);
+    dds_entity_t d;
+    if (cfg == NULL)
+        return DDS_RETCODE_OUT_OF_RESOURCES;
+    snprintf(cfg, cap, "<CycloneDDS><Domain id=\"any\"><Internal><MaxSampleSize>%ukB</MaxSampleSize>"
+             "</Internal></Domain></CycloneDDS>%s%s", J288_DDS_MAX_SAMPLE_KIB, user != NULL ? "," : "",
+             user != NULL ? user : "");
+    d = dds_create_domain(id, cfg);
+    free(cfg);
+    return d;
+}
 
 static dds_entity_t topic(dds_entity_t pp, const dds_topic_descriptor_t *desc, const char *ns,
                           const char *name)
 {
-    char full[160];
-    snprintf(full, sizeof full, "rt/%s%s%s", ns != NULL ? ns : "", ns != NULL ? "/" : "", name);
+    char full[TOPIC_MAX];
+    snprintf(full, sizeof full, "rt/%s%s%s", ns, *ns != '\0' ? "/" : "", name);
     return dds_create_topic(pp, desc, full, NULL, NULL);
+}
+
+/* A copy of q with the USER_DATA ROS 2 gives an endpoint of type t: "typehash=RIHS01_...;". */
+static dds_qos_t *with_typehash(const dds_qos_t *q, j288_dds_type_t t)
+{
+    dds_qos_t *c = dds_create_qos();
+    char hash[J288_DDS_TYPEHASH_LEN], ud[J288_DDS_TYPEHASH_LEN + 16];
+    int n;
+    (void)dds_copy_qos(c, q);
+    j288_dds_typehash(t, hash);
+    n = snprintf(ud, sizeof ud, "typehash=%s;", hash);
+    dds_qset_userdata(c, ud, (size_t)n);
+    return c;
+}
+
+static dds_entity_t writer(dds_entity_t pp, dds_entity_t tp, const dds_qos_t *q, j288_dds_type_t t)
+{
+    dds_qos_t *c = with_typehash(q, t);
+    dds_entity_t w = dds_create_writer(pp, tp, c, NULL);
+    dds_delete_qos(c);
+    return w;
+}
+
+static dds_entity_t reader(dds_entity_t pp, dds_entity_t tp, const dds_qos_t *q, j288_dds_type_t t)
+{
+    dds_qos_t *c = with_typehash(q, t);
+    dds_entity_t r = dds_create_reader(pp, tp, c, NULL);
+    dds_delete_qos(c);
+    return r;
 }
 
 /* Reliable keep-last-1 writers (they match reliable and best-effort readers alike, so ROS 2's
@@ -244,34 +337,50 @@ static dds_entity_t topic(dds_entity_t pp, const dds_topic_descriptor_t *desc, c
  * The writers never block the loop: keep-last 1 already replaces an unacknowledged sample
  * (a frozen reliable reader measured no slower, docs/dds.md), and a max blocking time of 0
  * makes it a guarantee: a write that would wait fails at once and the next cycle's sample
- * takes its place. */
+ * takes its place. Every endpoint carries ROS 2's typehash USER_DATA, the participant ROS 2's
+ * "enclave=/;" (what rmw_cyclonedds gives a node's). */
 static int dds_open(dds_io_t *io, const options_t *o)
 {
-    dds_qos_t *wq = dds_create_qos(), *rq = dds_create_qos();
+    static const char enclave[] = "enclave=/;";
+    dds_qos_t *wq = dds_create_qos(), *rq = dds_create_qos(), *pq = dds_create_qos();
     dds_entity_t st, dg, cm;
+    j288_dds_type_t st_t, cm_t;
     int rc = 0;
     dds_qset_reliability(wq, DDS_RELIABILITY_RELIABLE, 0);
     dds_qset_history(wq, DDS_HISTORY_KEEP_LAST, 1);
     dds_qset_reliability(rq, DDS_RELIABILITY_BEST_EFFORT, 0);
     dds_qset_history(rq, DDS_HISTORY_KEEP_LAST, TAKE_MAX);
-    io->participant = dds_create_participant((dds_domainid_t)o->domain, NULL, NULL);
+    dds_qset_userdata(pq, enclave, sizeof enclave - 1u);
+    io->mode = o->mode;
+    io->domain = create_domain((dds_domainid_t)o->domain);
+    io->participant = io->domain < 0 ? io->domain
+                                     : dds_create_participant((dds_domainid_t)o->domain, pq, NULL);
     if (io->participant < 0) {
-        fprintf(stderr, "j288-dds: DDS participant on domain %ld: %s\n", o->domain,
+        fprintf(stderr, "j288-dds: DDS %s on domain %ld: %s\n",
+                io->domain < 0 ? "domain (CYCLONEDDS_URI?)" : "participant", o->domain,
                 dds_strretcode(io->participant));
         rc = -1;
         goto out;
     }
-    if (o->unitree) {
+    if (o->mode == MODE_UNITREE_GO) {
         st = topic(io->participant, &unitree_go_msg_dds__LowState__desc, o->ns, "lowstate");
         cm = topic(io->participant, &unitree_go_msg_dds__LowCmd__desc, o->ns, "lowcmd");
+        st_t = J288_DDS_TYPE_GO_LOWSTATE;
+        cm_t = J288_DDS_TYPE_GO_LOWCMD;
+    } else if (o->mode == MODE_UNITREE_HG) {
+        st = topic(io->participant, &unitree_hg_msg_dds__LowState__desc, o->ns, "lowstate");
+        cm = topic(io->participant, &unitree_hg_msg_dds__LowCmd__desc, o->ns, "lowcmd");
+        st_t = J288_DDS_TYPE_HG_LOWSTATE;
+        cm_t = J288_DDS_TYPE_HG_LOWCMD;
     } else {
         st = topic(io->participant, &sensor_msgs_msg_dds__JointState__desc, o->ns, "joint_states");
         cm = topic(io->participant, &sensor_msgs_msg_dds__JointState__desc, o->ns, "joint_command");
+        st_t = cm_t = J288_DDS_TYPE_JOINT_STATE;
     }
     dg = topic(io->participant, &diagnostic_msgs_msg_dds__DiagnosticArray__desc, o->ns, "diagnostics");
-    io->state_w = dds_create_writer(io->participant, st, wq, NULL);
-    io->diag_w = dds_create_writer(io->participant, dg, wq, NULL);
-    io->cmd_r = dds_create_reader(io->participant, cm, rq, NULL);
+    io->state_w = writer(io->participant, st, wq, st_t);
+    io->diag_w = writer(io->participant, dg, wq, J288_DDS_TYPE_DIAGNOSTIC_ARRAY);
+    io->cmd_r = reader(io->participant, cm, rq, cm_t);
     if (st < 0 || cm < 0 || dg < 0 || io->state_w < 0 || io->diag_w < 0 || io->cmd_r < 0) {
         fprintf(stderr, "j288-dds: DDS topics, writers or reader could not be made\n");
         rc = -1;
@@ -279,11 +388,49 @@ static int dds_open(dds_io_t *io, const options_t *o)
 out:
     dds_delete_qos(wq);
     dds_delete_qos(rq);
+    dds_delete_qos(pq);
     return rc;
 }
 
+/* A GUID as ROS 2 prints a GID: 16 bytes in hex, dot separated. */
+static void guid_text(const uint8_t v[16], char out[BRIDGE_GUID_LEN])
+{
+    unsigned k;
+    for (k = 0; k < 16u; k++)
+        snprintf(out + 3u * k, 4u, "%02x%s", v[k], k < 15u ? "." : "");
+}
+
+/* The GUIDs of the writers seen lately, by Cyclone's instance handle (a writer's GUID is
+ * looked up once, while it is matched). */
+#define WRITERS_KEPT 16u
+static struct {
+    uint64_t handle[WRITERS_KEPT];
+    char guid[WRITERS_KEPT][BRIDGE_GUID_LEN];
+    unsigned next;
+} writers;
+
+static const char *writer_guid(dds_entity_t rd, dds_instance_handle_t ih)
+{
+    dds_builtintopic_endpoint_t *ep;
+    unsigned k;
+    for (k = 0; k < WRITERS_KEPT; k++)
+        if (writers.handle[k] == ih && ih != 0u)
+            return writers.guid[k];
+    k = writers.next;
+    writers.next = (writers.next + 1u) % WRITERS_KEPT;
+    writers.handle[k] = ih;
+    ep = dds_get_matched_publication_data(rd, ih);
+    if (ep != NULL) {
+        guid_text(ep->key.v, writers.guid[k]);
+        dds_builtintopic_free_endpoint(ep);
+    } else {
+        snprintf(writers.guid[k], sizeof writers.guid[k], "unknown (no longer matched)");
+    }
+    return writers.guid[k];
+}
+
 /* Every command waiting, oldest first. */
-static void take_commands(bridge_t *b, const dds_io_t *io, bool unitree)
+static void take_commands(bridge_t *b, const dds_io_t *io)
 {
     void *samples[TAKE_MAX] = {NULL};
     dds_sample_info_t info[TAKE_MAX];
@@ -291,15 +438,78 @@ static void take_commands(bridge_t *b, const dds_io_t *io, bool unitree)
     uint32_t now = j288_robot_now_us();
     dds_return_t i;
     for (i = 0; i < n; i++) {
+        bridge_writer_t w;
         if (!info[i].valid_data)
             continue;
-        if (unitree)
-            bridge_take_lowcmd(b, samples[i], now);
+        w.id = info[i].publication_handle;
+        w.guid = writer_guid(io->cmd_r, info[i].publication_handle);
+        if (io->mode == MODE_UNITREE_GO)
+            bridge_take_lowcmd(b, samples[i], &w, now);
+        else if (io->mode == MODE_UNITREE_HG)
+            bridge_take_hg_lowcmd(b, samples[i], &w, now);
         else
-            bridge_take_command(b, samples[i], now);
+            bridge_take_command(b, samples[i], &w, now);
     }
     if (n > 0)
         (void)dds_return_loan(io->cmd_r, samples, n);
+}
+
+/* ---- Cyclone's log: the samples it drops ---- */
+
+/* Cyclone logs (a warning, from its receive thread) each sample it drops: larger than the
+ * MaxSampleSize the bridge sets (dds_open), or outside the bounds of its types (sensor_msgs.idl).
+ * The sink counts those and keeps the writer's GUID for the loop to pick up; every other line
+ * goes to stderr as Cyclone's own sink writes it. */
+static struct {
+    pthread_mutex_t lock;
+    uint32_t count;
+    char guid[BRIDGE_GUID_LEN];
+} drops = {PTHREAD_MUTEX_INITIALIZER, 0u, ""};
+
+/* The writer's GUID in a line about a sample Cyclone dropped (its PGUIDFMT, four words in
+ * hex), or NULL when the line is about something else: "dropping oversize (N > MAX) sample S
+ * from remote writer G ..." (larger than MaxSampleSize, at its first fragment) or
+ * "data(application, ...): G #S: deserialization ... failed" (outside the types' bounds). */
+static const char *dropped_writer(const char *msg)
+{
+    const char *g;
+    if (strstr(msg, "dropping oversize (") != NULL && (g = strstr(msg, "from remote writer ")) != NULL)
+        return g + strlen("from remote writer ");
+    if (strstr(msg, ": deserialization ") != NULL && (g = strstr(msg, "): ")) != NULL)
+        return g + 3;
+    return NULL;
+}
+
+static void log_sink(void *arg, const dds_log_data_t *d)
+{
+    unsigned w[4];
+    const char *g = dropped_writer(d->message);
+    (void)arg;
+    if (g != NULL && sscanf(g, "%x:%x:%x:%x", &w[0], &w[1], &w[2], &w[3]) == 4) {
+        uint8_t v[16];
+        unsigned k;
+        for (k = 0; k < 16u; k++)
+            v[k] = (uint8_t)(w[k / 4u] >> (24u - 8u * (k % 4u)));
+        (void)pthread_mutex_lock(&drops.lock);
+        drops.count++;
+        guid_text(v, drops.guid);
+        (void)pthread_mutex_unlock(&drops.lock);
+        return;
+    }
+    (void)fwrite(d->message - d->hdrsize, 1, d->hdrsize + d->size + 1u, stderr); /* and its \n */
+}
+
+/* The drops since the last call, to the bridge. */
+static void collect_drops(bridge_t *b)
+{
+    uint32_t n;
+    char guid[BRIDGE_GUID_LEN];
+    (void)pthread_mutex_lock(&drops.lock);
+    n = drops.count;
+    drops.count = 0;
+    memcpy(guid, drops.guid, sizeof guid);
+    (void)pthread_mutex_unlock(&drops.lock);
+    bridge_dropped(b, n, guid);
 }
 
 /* CLOCK_MONOTONIC in seconds (the runner's microsecond clock wraps after 71 minutes). */
@@ -310,12 +520,17 @@ static double mono_s(void)
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
-static void publish_state(bridge_t *b, const dds_io_t *io, bool unitree, double start_s)
+static void publish_state(bridge_t *b, const dds_io_t *io, double start_s)
 {
-    if (unitree) {
+    uint32_t tick_ms = (uint32_t)(uint64_t)((mono_s() - start_s) * 1000.0);
+    if (io->mode == MODE_UNITREE_GO) {
         static unitree_go_msg_dds__LowState_ ls;
-        bridge_fill_lowstate(b, &ls, (uint32_t)(uint64_t)((mono_s() - start_s) * 1000.0));
+        bridge_fill_lowstate(b, &ls, tick_ms);
         (void)dds_write(io->state_w, &ls);
+    } else if (io->mode == MODE_UNITREE_HG) {
+        static unitree_hg_msg_dds__LowState_ hs;
+        bridge_fill_hg_lowstate(b, &hs, tick_ms);
+        (void)dds_write(io->state_w, &hs);
     } else {
         sensor_msgs_msg_dds__JointState_ js;
         bridge_fill_joint_state(b, &js);
@@ -363,28 +578,61 @@ static void print_summary(const j288_robot_t *r, double start_s)
             secs > 0 ? (double)rs.cycles / secs : 0.0, cpu);
 }
 
+/* The STATUS= line systemd shows (systemctl status): the cycle rate since the previous one. */
+typedef struct {
+    const j288_robot_t *robot;
+    const bridge_t *bridge;
+    uint32_t cycles;
+    double at_s;
+} status_ctx_t;
+
+static void service_status(void *ctx, char *buf, unsigned cap)
+{
+    status_ctx_t *c = ctx;
+    j288_robot_stats_t rs;
+    double now = mono_s(), dt = now - c->at_s;
+    unsigned k;
+    uint32_t refused = 0;
+    (void)j288_robot_stats(c->robot, &rs);
+    for (k = 0; k < BRIDGE_NCAUSES; k++)
+        refused += c->bridge->refused[k];
+    snprintf(buf, cap, "%.0f cycles/s, %lu cycles, %u joints on %u buses, %lu commands, %lu refused",
+             dt > 0 ? (double)(rs.cycles - c->cycles) / dt : 0.0, (unsigned long)rs.cycles,
+             j288_robot_njoints(c->robot), j288_robot_nbuses(c->robot),
+             (unsigned long)c->bridge->messages, (unsigned long)refused);
+    c->cycles = rs.cycles;
+    c->at_s = now;
+}
+
 static int run(const options_t *o)
 {
+    static const char *const mode_topics[] = {"rt/joint_states + rt/joint_command",
+                                              "rt/lowstate + rt/lowcmd (unitree_go)",
+                                              "rt/lowstate + rt/lowcmd (unitree_hg)"};
     static j288_robot_config_t cfg;
     static j288_robot_t robot;
     static bridge_t b;
     static pending_t pending;
-    char err[J288_ROBOT_CONFIG_ERROR_MAX];
+    char err[J288_ROBOT_CONFIG_ERROR_MAX], line[300];
     j288_robot_options_t ro;
     dds_io_t io;
+    status_ctx_t sc;
     struct timespec next;
     long period_ns = o->rate_hz > 0 ? (long)(1e9 / o->rate_hz) : 0;
+    unsigned slots = o->mode == MODE_UNITREE_GO ? J288_DDS_UNITREE_MOTORS : J288_DDS_HG_MOTORS;
     uint32_t last_diag;
     double start_s;
     int rc, status = 0;
 
+    (void)service_start();
     if (j288_robot_config_load(o->config, &cfg, err, sizeof err) != 0) {
         fprintf(stderr, "j288-dds: %s\n", err);
         return 1;
     }
-    if (o->unitree && cfg.njoints > J288_DDS_UNITREE_MOTORS) {
-        fprintf(stderr, "j288-dds: --unitree: %u joints, LowCmd_ has %u motors\n",
-                (unsigned)cfg.njoints, J288_DDS_UNITREE_MOTORS);
+    if (o->mode != MODE_ROS && cfg.njoints > slots) {
+        fprintf(stderr, "j288-dds: %s: %u joints, LowCmd_ has %u motors\n",
+                o->mode == MODE_UNITREE_GO ? "--unitree" : "--unitree-hg", (unsigned)cfg.njoints,
+                slots);
         return 1;
     }
     memset(&ro, 0, sizeof ro);
@@ -398,24 +646,31 @@ static int run(const options_t *o)
         return 1;
     }
     j288_robot_set_stop_flag(&robot, &stop_signal);
+    dds_set_log_sink(log_sink, NULL);
     if (dds_open(&io, o) != 0) {
         j288_robot_close(&robot);
-        if (io.participant > 0)
-            (void)dds_delete(io.participant);
+        if (io.domain > 0)
+            (void)dds_delete(io.domain);
         return 1;
     }
-    bridge_init(&b, &robot, &cfg, o->timeout_us, o->policy);
-    fprintf(stderr, "j288-dds: %u joints on %u buses, domain %ld, %s%s%s, %s\n",
-            j288_robot_njoints(&robot), j288_robot_nbuses(&robot), o->domain,
-            o->unitree ? "rt/lowstate + rt/lowcmd" : "rt/joint_states + rt/joint_command",
-            o->ns != NULL ? " in namespace " : "", o->ns != NULL ? o->ns : "",
-            o->rate_hz > 0 ? "paced" : "back to back");
+    bridge_init(&b, &robot, &cfg, o->timeout_us, o->policy, !o->per_joint);
+    snprintf(line, sizeof line, "%u joints on %u buses, domain %ld, %s%s%s, %s, %s",
+             j288_robot_njoints(&robot), j288_robot_nbuses(&robot), o->domain, mode_topics[o->mode],
+             o->ns[0] != '\0' ? " in namespace /" : "", o->ns, o->rate_hz > 0 ? "paced" : "back to back",
+             o->per_joint ? "commands per joint" : "commands all or nothing");
+    fprintf(stderr, "j288-dds: %s\n", line);
     start_s = mono_s();
+    sc.robot = &robot;
+    sc.bridge = &b;
+    sc.cycles = 0;
+    sc.at_s = start_s;
     last_diag = j288_robot_now_us();
     (void)clock_gettime(CLOCK_MONOTONIC, &next);
     publish_diagnostics(&b, &io);
+    service_ready(line);
     while (stop_signal == 0) {
-        take_commands(&b, &io, o->unitree);
+        take_commands(&b, &io);
+        collect_drops(&b);
         bridge_check_timeouts(&b, j288_robot_now_us());
         rc = j288_robot_cycle(&robot, 0, NULL);
         handle_events(&b, &pending);
@@ -428,25 +683,30 @@ static int run(const options_t *o)
         }
         if (rc == J288_ERR_OFFLINE) /* stop on bus loss: the runner locked every bus */
             bridge_stopped(&b, j288_robot_error(&robot));
-        publish_state(&b, &io, o->unitree, start_s);
+        publish_state(&b, &io, start_s);
         if ((uint32_t)(j288_robot_now_us() - last_diag) >= DIAG_PERIOD_US) {
             last_diag = j288_robot_now_us();
             publish_diagnostics(&b, &io);
         }
+        service_tick((uint64_t)(mono_s() * 1e6), service_status, &sc);
         if (period_ns > 0)
             wait_period(&next, period_ns);
     }
     if (stop_signal != 0) {
+        service_stopping(stop_signal == SIGINT ? "SIGINT: locking every bus" : "SIGTERM: locking every bus");
         rc = j288_robot_stop(&robot); /* again after an abort: harmless, and the cycle may not
                                          have seen the flag */
         fprintf(stderr, "j288-dds: %s: every bus locked (%s)\n",
                 stop_signal == SIGINT ? "SIGINT" : "SIGTERM",
                 rc == J288_OK ? "broadcast lock sent" : j288_strerror(rc));
         publish_diagnostics(&b, &io);
+    } else {
+        service_stopping("every bus is gone");
     }
     print_summary(&robot, start_s);
     j288_robot_close(&robot);
-    (void)dds_delete(io.participant);
+    (void)dds_delete(io.domain);
+    dds_set_log_sink(NULL, NULL);
     return status;
 }
 

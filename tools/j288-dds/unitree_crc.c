@@ -64,6 +64,13 @@ static void put_i16s(packer_t *p, const int16_t *v, size_t n)
         put_u16(p, (uint16_t)v[k]);
 }
 
+static void put_u32s(packer_t *p, const uint32_t *v, size_t n)
+{
+    size_t k;
+    for (k = 0; k < n; k++)
+        put_u32(p, v[k]);
+}
+
 static void put_bytes(packer_t *p, const uint8_t *b, size_t n)
 {
     memcpy(p->buf + p->pos, b, n);
@@ -183,4 +190,74 @@ uint32_t j288_dds_lowstate_crc(const unitree_go_msg_dds__LowState_ *m)
     uint8_t buf[J288_DDS_LOWSTATE_PACKED];
     j288_dds_pack_lowstate(m, buf);
     return j288_crc32(buf, J288_DDS_LOWSTATE_PACKED / 4u - 1u);
+}
+
+void j288_dds_pack_hg_lowcmd(const unitree_hg_msg_dds__LowCmd_ *m,
+                             uint8_t out[J288_DDS_HG_LOWCMD_PACKED])
+{
+    packer_t p = {out, 0u};
+    unsigned i;
+    put_u8(&p, m->mode_pr);
+    put_u8(&p, m->mode_machine);
+    for (i = 0; i < 35u; i++) {
+        const unitree_hg_msg_dds__MotorCmd_ *c = &m->motor_cmd[i];
+        align(&p, 4u); /* the struct's alignment */
+        put_u8(&p, c->mode);
+        put_f32(&p, c->q);
+        put_f32(&p, c->dq);
+        put_f32(&p, c->tau);
+        put_f32(&p, c->kp);
+        put_f32(&p, c->kd);
+        put_u32(&p, c->reserve);
+    }
+    put_u32s(&p, m->reserve, 4u);
+    put_u32(&p, 0u); /* crc */
+}
+
+void j288_dds_pack_hg_lowstate(const unitree_hg_msg_dds__LowState_ *m,
+                               uint8_t out[J288_DDS_HG_LOWSTATE_PACKED])
+{
+    packer_t p = {out, 0u};
+    const unitree_hg_msg_dds__IMUState_ *imu = &m->imu_state;
+    unsigned i;
+    put_u32s(&p, m->version, 2u);
+    put_u8(&p, m->mode_pr);
+    put_u8(&p, m->mode_machine);
+    put_u32(&p, m->tick);
+    put_f32s(&p, imu->quaternion, 4u);
+    put_f32s(&p, imu->gyroscope, 3u);
+    put_f32s(&p, imu->accelerometer, 3u);
+    put_f32s(&p, imu->rpy, 3u);
+    put_i16s(&p, &imu->temperature, 1u);
+    for (i = 0; i < 35u; i++) {
+        const unitree_hg_msg_dds__MotorState_ *s = &m->motor_state[i];
+        align(&p, 4u);
+        put_u8(&p, s->mode);
+        put_f32(&p, s->q);
+        put_f32(&p, s->dq);
+        put_f32(&p, s->ddq);
+        put_f32(&p, s->tau_est);
+        put_i16s(&p, s->temperature, 2u);
+        put_f32(&p, s->vol);
+        put_u32s(&p, s->sensor, 2u);
+        put_u32(&p, s->motorstate);
+        put_u32s(&p, s->reserve, 4u);
+    }
+    put_bytes(&p, m->wireless_remote, 40u);
+    put_u32s(&p, m->reserve, 4u);
+    put_u32(&p, 0u); /* crc */
+}
+
+uint32_t j288_dds_hg_lowcmd_crc(const unitree_hg_msg_dds__LowCmd_ *m)
+{
+    uint8_t buf[J288_DDS_HG_LOWCMD_PACKED];
+    j288_dds_pack_hg_lowcmd(m, buf);
+    return j288_crc32(buf, J288_DDS_HG_LOWCMD_PACKED / 4u - 1u);
+}
+
+uint32_t j288_dds_hg_lowstate_crc(const unitree_hg_msg_dds__LowState_ *m)
+{
+    uint8_t buf[J288_DDS_HG_LOWSTATE_PACKED];
+    j288_dds_pack_hg_lowstate(m, buf);
+    return j288_crc32(buf, J288_DDS_HG_LOWSTATE_PACKED / 4u - 1u);
 }
