@@ -82,11 +82,13 @@ firmware:
 	 $(MAKE) --no-print-directory firmware-build FW_BUILD="$$elfs"
 
 # Then the port against ST's headers where the stub cannot stand in: J288_STM32_DCACHE=1
-# stops with its #error on the F4 and builds on the H7 (when fetched).
+# stops with its #error on the F4 and builds on the H7 (when fetched); and the stub's constants
+# against ST's, per family fetched (test/stm32/stub_matches_st.sh, also in `make test`).
 FW_BUILD ?= $(FW_ELFS)
 firmware-build: $(FW_BUILD)
 	@if $(call FW_HAVE,f4); then \
 	     ST_DIR=$(ST_DIR) ARM_CC=$(call TC,m4f,CC) CC="$(CC)" bash test/stm32/dcache_needs_a_cache.sh; fi
+	@ST_DIR=$(ST_DIR) BUILD=$(BUILD) CC="$(CC)" bash test/stm32/stub_matches_st.sh
 
 # ---- make bench-stm32-hal: what the port adds per transaction, on F4 and G4 -------------------
 # test/stm32/hal_bench.c on Cortex-M4 under QEMU (-icount), built against ST's headers and HAL

@@ -11,7 +11,8 @@
 #                        stdio or process-exit symbol
 #   make test-be         unit tests built for s390x (big-endian) and run under qemu-s390x
 #   make test-32         unit tests built for armhf (32-bit) and run under qemu-arm
-#   make coverage        gcov line/branch coverage of lib/ from the unit tests (gcovr, enforced)
+#   make coverage        gcov line/branch coverage of lib/ from the unit tests, and line coverage of
+#                        port/stm32_hal per model of the silicon from its suite (gcovr, enforced)
 #   make soak            fault soak: >= 100000 transactions against j288-sim on a pty
 #   make soak-short      the CI variant, under valgrind memcheck when it is there
 # Outside CI a missing tool skips its target with a notice; with CI=true it is a failure.
@@ -101,18 +102,30 @@ COVERAGE_LINE ?= 100
 COVERAGE_BRANCH ?= 95
 COVERAGE_TESTS ?= $(UNIT_TESTS)
 
+# The STM32 port: each build of its suite (mk/tests.mk: test:objdir) covers one model's lines.
+COVERAGE_STM32_LINE ?= 98
+COVERAGE_STM32 := test_stm32_port:stm32host test_stm32_port_g4:stm32host-g4 \
+    test_stm32_port_h7:stm32host-h7 test_stm32_port_m7r0p1:stm32host-m7r0p1
+
 .PHONY: coverage coverage-run
 coverage: $(UNITY)/unity.c
 	+@$(call REQUIRE,gcovr,gcovr); \
 	 $(SUBMAKE) BUILD=$(BUILD)/cov OPT="-O0 -g" EXTRA_CFLAGS=--coverage EXTRA_LDFLAGS=--coverage coverage-run
 
-coverage-run: $(COVERAGE_TESTS)
+coverage-run: $(COVERAGE_TESTS) $(STM32_FAMILY_TESTS)
 	find $(BUILD) -name '*.gcda' -delete
 	$(call RUN_TESTS,$(COVERAGE_TESTS))
 	@mkdir -p $(BUILD)/coverage
 	gcovr --root . --filter 'lib/' --exclude-unreachable-branches --fail-under-line $(COVERAGE_LINE) \
 	    --fail-under-branch $(COVERAGE_BRANCH) --print-summary --html-details $(BUILD)/coverage/index.html $(OBJ)/lib
 	@echo "coverage: HTML report in $(BUILD)/coverage/index.html"
+	@for v in $(COVERAGE_STM32); do t=$${v%%:*}; d=$${v#*:}; \
+	    find $(OBJ)/$$d -name '*.gcda' -delete; \
+	    $(BUILD)/test/$$t >$(BUILD)/coverage/$$t.log 2>&1 || { cat $(BUILD)/coverage/$$t.log; exit 1; }; \
+	    echo "coverage: port/stm32_hal, $$t:"; \
+	    gcovr --root . --filter 'port/stm32_hal/' --fail-under-line $(COVERAGE_STM32_LINE) --print-summary \
+	        $(OBJ)/$$d | grep -E '^lines:|j288_stm32.c' || exit 1; \
+	done
 
 # ---- fault soak (test/soak/): the Linux port and scheduler against j288-sim, faults on, then
 # off in the same simulator (SIGUSR1): the next sweep must be all healthy. Under memcheck the

@@ -155,6 +155,8 @@ static void bus_setup(void)
 
     if ((j288_stm32_init(&bus1, &pc, &bc) != J288_OK) ||
         (j288_sched_init(&sched, j288_stm32_bus(&bus1), &sc) != J288_OK)) {
+        /* a refused configuration: bus1.init_error in the debugger, or
+         * j288_stm32_init_error_str(j288_stm32_init_error(&bus1)) */
         board_fatal();
     }
     for (uint8_t id = 0; id < SERVO_COUNT; id++) {

@@ -11,16 +11,33 @@
  * How the line runs (docs/stm32.md says why):
  *  - The receiver is never switched off and the receive stream runs circular from init on,
  *    so there is no moment at the turnaround where a reply byte can be lost. The line hears
- *    our own 20 bytes, and their end is the end of the transmit (seen at the idle line after
- *    them; with a DE pin, transmit complete drops DE at once instead): with the bus's echo
- *    option they are handed to the bus, which checks them (collisions); without, skipped.
+ *    our own 20 bytes (unless it is deaf_while_transmitting): with the bus's echo option they
+ *    are handed to the bus, which checks them (collisions); without, skipped.
+ *  - A transmit ends at the UART's transmit complete (TC) with the TX stream's count at 0: at
+ *    TC's interrupt with a DE pin (dropped first thing there) or a deaf line, else at the idle
+ *    line after the echo, TC then being set (a TC raised mid-frame by a stall of the stream is
+ *    waited past). The echo's end is where it started plus its length when the line hears us
+ *    and no flag says a byte of it was lost; otherwise every byte from its start goes to the
+ *    bus after the transmit's end, whose parser finds the reply among them: a lost echo byte
+ *    costs nothing, and a broadcast ends (with the echo option, the echo the bus checks is then
+ *    a byte short: J288_ERR_COLLISION).
  *  - The receive position is read from the stream's counter (NDTR/CNDTR) at every event: idle
  *    line, half and whole buffer. The events may come in any order, late or twice: every byte
- *    is handed to the bus once, in order, as long as less than a buffer passes between two
- *    events (the half and complete interrupts see to that).
+ *    is handed to the bus once, in order, as long as each event is served within the timing
+ *    budget (below). A lap beyond it (the stream overwrote bytes not handed over) is detected
+ *    from the half/complete flags and reported as J288_LINE_OVERRUN (rx_laps).
  *  - Line errors are left to the CRC: one-bit sampling (no noise flag, which on the newer
  *    USART keeps a good byte from the DMA) and the error interrupt masked; nothing aborts the
  *    reception. Flags seen at the next event are counted and reported to the bus.
+ *
+ * Timing budget (docs/stm32.md works it out): each of the bus's interrupts (UART, RX stream)
+ * must be served within J288_STM32_RX_BUF_SIZE/4 - 1 character times of being raised (105 us
+ * at the default 256 bytes and 6 Mbps, 52 us at 128): later, bytes may be overwritten before
+ * they are handed over (reported as J288_LINE_OVERRUN, rx_laps, not silent). A reply reaches
+ * the bus at its idle line plus the UART interrupt's latency: the bus's margin_us (20 us by
+ * default) must cover that latency. The DE pin drops within the UART interrupt's latency of
+ * the last stop bit; a servo answering sooner meets our driver still on (hardware DE,
+ * de_hardware, has no such delay).
  *
  * What the application does (examples/stm32_hal/, docs/stm32.md):
  *  - HAL_HalfDuplex_Init() at the bus baud (6 Mbps), 8N1; a DMA stream/channel for TX and one
@@ -37,6 +54,15 @@
  * Interrupt context: j288_stm32_on_* are ISR-safe and meant for the bus's IRQs. init/deinit
  * are thread only. No function of the port waits on SysTick: a stream that must stop is
  * stopped at the register with a bounded wait.
+ *
+ * The bus lock (the port's lock/unlock operations, taken by the bus around thread-context calls
+ * of a bus with advance_in_isr) masks the bus's interrupts: BASEPRI at irq_priority, or PRIMASK.
+ * Locks nest, across buses and in any order (one depth count for the port: the first lock saves
+ * PRIMASK and BASEPRI, the last unlock restores them). Code that runs under it (the bus's
+ * completion callbacks) must not lower BASEPRI or clear PRIMASK: an RTOS critical section that
+ * ends by writing BASEPRI = 0 (FreeRTOS taskEXIT_CRITICAL outside a nested section) unmasks the
+ * bus's interrupts while the bus believes itself locked; use the RTOS's nesting-aware form or
+ * leave the work to thread code after the call.
  */
 #ifndef J288_STM32_H
 #define J288_STM32_H
@@ -84,6 +110,17 @@ extern "C" {
 #ifndef J288_STM32_STOP_SPINS
 #define J288_STM32_STOP_SPINS 64u
 #endif
+
+/* Reads of the RX stream's counter that the end of a transmit waits for at most, for the last
+ * echoed byte to be stored (normally there already) or, after a TX stream stall, to finish on
+ * the wire: a character time and more on any core (a read is a few cycles). */
+#ifndef J288_STM32_ECHO_SPINS
+#define J288_STM32_ECHO_SPINS 256u
+#endif
+
+/* Every peripheral register access of the port is J288_STM32_REG(reg), an lvalue: plain by
+ * default. A model of the silicon (the tests' fake HAL, test/stm32/) defines it to watch them.
+ * Leave it alone in firmware. */
 
 /* The CRC unit is shared by everything on the chip (other libraries, firmware image checks).
  * One frame CRC resets the unit and feeds 4 or 5 words (well under a microsecond at 168 MHz)
@@ -182,10 +219,19 @@ typedef struct {
     j288_stm32_pin_drive_t tx_drive;
 
     /* Optional driver-enable pin of an external transceiver: driven active while we
-     * transmit, inactive otherwise. de_port NULL: no pin. */
+     * transmit, inactive otherwise (dropped first thing at transmit complete, within the UART
+     * interrupt's latency). de_port NULL: no pin. */
     GPIO_TypeDef *de_port;
     uint16_t de_pin;
     bool de_active_low;
+
+    /* The UART drives the transceiver's DE itself (USARTs with CR3.DEM: F0, F3, F7, G0, G4,
+     * H7, L4...): set up by the application with HAL_RS485Ex_Init (polarity, assertion and
+     * deassertion times) and the pin in its USART_DE alternate function. DE then drops DEDT
+     * after the last stop bit whatever the interrupt latency. The port only checks it: init
+     * refuses it without CR3.DEM set, together with de_port, or on a family without it (F1,
+     * F2, F4). */
+    bool de_hardware;
 
     /* Time. now_us: the application's monotonic microsecond tick (callable from any
      * context, wraps at 2^32). When NULL, htim's counter is the tick; it must then count at
@@ -221,8 +267,12 @@ typedef struct {
     uint32_t tx_frames;    /* transmits started */
     uint32_t rx_events;    /* receive events taken (idle line, half, complete) */
     uint32_t rx_bytes;     /* bytes handed to the bus */
-    uint32_t rx_skipped;   /* bytes not handed over: our own echo (without the echo option)
-                              and bytes heard before a transmit, which belong to nobody */
+    uint32_t rx_skipped;   /* bytes not handed over: our own echo (without the echo option),
+                              bytes heard before a transmit, which belong to nobody, and
+                              bytes lost to a lap or a stream restart */
+    uint32_t rx_laps;      /* times the RX stream overwrote bytes not yet handed over (an
+                              event served beyond the timing budget): reported to the bus as
+                              J288_LINE_OVERRUN */
     uint32_t noise_errors;   /* line error flags seen at an event (the byte was still stored */
     uint32_t framing_errors; /* on the F4; the newer USART drops a flagged byte): each reported */
     uint32_t overruns;       /* to the bus as a line error, the frame left to the CRC */
@@ -230,10 +280,34 @@ typedef struct {
     uint32_t dma_errors;   /* RX stream transfer errors: the stream was restarted */
     uint32_t dma_resets;   /* transmits found still running from an earlier transaction and
                               stopped before the next (a lost TX complete interrupt) */
+    uint32_t tx_stalls;    /* transmits found idle mid-frame (the TX stream stalled a
+                              character or more: TC, or the echo's idle line, raised early) and
+                              waited past; seen only when the interrupt comes during the stall */
     uint32_t timer_events; /* compare interrupts taken (timer_rearms included) */
     uint32_t timer_rearms; /* of those, early ones (before the deadline): re-armed for the
                               rest, the bus not called */
 } j288_stm32_stats_t;
+
+/* Why j288_stm32_init() returned J288_ERR_BAD_CONFIG (j288_stm32_init_error()). */
+typedef enum {
+    J288_STM32_INIT_OK = 0,
+    J288_STM32_INIT_NO_DMA,             /* the UART handle has no DMA stream linked */
+    J288_STM32_INIT_BDMA,               /* H7: a BDMA channel (D3 domain, LPUART1) */
+    J288_STM32_INIT_NOT_HALF_DUPLEX,    /* CR3.HDSEL clear: HAL_HalfDuplex_Init not called */
+    J288_STM32_INIT_DMA_DIRECTION,      /* TX not memory-to-peripheral, RX not the reverse */
+    J288_STM32_INIT_DMA_REQUEST,        /* a DMAMUX request that is not this UART's */
+    J288_STM32_INIT_BUFFER_UNREACHABLE, /* DMA buffers in CCM or TCM RAM */
+    J288_STM32_INIT_BUFFER_ALIGNMENT,   /* J288_STM32_DCACHE and not on a cache line */
+    J288_STM32_INIT_DCACHE,             /* D-cache on, J288_STM32_DCACHE=0, buffers cached */
+    J288_STM32_INIT_PRIORITY,           /* irq_priority beyond the NVIC's bits */
+    J288_STM32_INIT_ECHO_DEAF,          /* the echo option on a deaf line */
+    J288_STM32_INIT_TIMER_CHANNEL,      /* tim_channel not TIM_CHANNEL_1..4 */
+    J288_STM32_INIT_TIMER_PRELOAD,      /* the channel's compare preload (OCxPE) on */
+    J288_STM32_INIT_NO_CLOCK,           /* no now_us, no 32-bit 1 MHz timer */
+    J288_STM32_INIT_DE_HARDWARE,        /* de_hardware without CR3.DEM, or with de_port */
+    J288_STM32_INIT_CRC_CONFIG,         /* CRC handle not in the reset configuration */
+    J288_STM32_INIT_CRC_ANSWER          /* CRC unit fails its known answer */
+} j288_stm32_init_error_t;
 
 /* One bus on one UART. Caller-allocated (statically, usually); must not move while
  * registered. Private: use the functions below. */
@@ -250,16 +324,22 @@ typedef struct j288_stm32 {
     uint8_t tx_shift;
     uint8_t rx_shift;
     bool echo;                 /* the bus checks the echo: hand it over */
-    bool tc_ends_tx;           /* transmit complete ends a transmit (DE pin, deaf line), not
-                                  the echo's idle line */
-    volatile uint16_t rx_pos;  /* position in the circular buffer handed out so far */
-    volatile uint16_t tx_len;  /* bytes of the last transmit (its echo) */
-    volatile uint16_t tx_start; /* where its echo starts in the receive buffer */
-    volatile bool tx_on;       /* a transmit is in flight */
-    uint32_t lock_saved;
+    bool tc_irq;               /* TC's interrupt ends a transmit (a DE pin to drop at once, or a
+                                  deaf line); else the echo's idle line does */
     volatile bool live;        /* registered: the IRQ entries serve it */
+    volatile bool tx_on;       /* a transmit is in flight */
+    bool rx_dead;              /* the RX stream would not restart (retried at a transmit) */
+    bool lapped;               /* the RX stream went round unseen: what waits is overwritten */
+    uint16_t echo_len;         /* bytes of the last transmit's echo: its length, or 0 (a deaf
+                                  line, or lost to a stream restart) */
+    /* Indices in the receive buffer. Written in the bus's interrupts, and by start_tx in an
+     * order that needs no lock (j288_stm32.c). */
+    uint32_t rx_pos;           /* the next byte to hand over */
+    uint32_t flag_idx;         /* where the half/complete flags were last cleared */
+    volatile uint32_t tx_start; /* where the last transmit's echo starts */
     uint8_t bounce[J288_STM32_BOUNCE_SIZE]; /* a wrapped run, handed over in one piece */
     volatile uint32_t tim_deadline; /* last arm_timeout deadline (now_us clock) */
+    j288_stm32_init_error_t init_error;
     j288_stm32_stats_t stats;
 } j288_stm32_t;
 
@@ -267,28 +347,55 @@ typedef struct j288_stm32 {
 
 /* Set up p, register it and initialise its bus (j288_bus_init with bus_cfg, which may be
  * NULL for defaults). cfg and bus_cfg are copied; what cfg points to must outlive the bus.
- * The application initialises the UART, its DMA streams, the timer (started) and the CRC
- * unit before. Init then takes the UART's registers: one-bit sampling, error interrupt off,
- * transmitter and receiver on, DMA requests both ways, idle-line interrupt; the RX stream
- * circular over dma->rx with its half/complete/error interrupts, started; the TX stream
- * pointed at dma->tx. The DE pin is left inactive and the TX pin driven as tx_drive says.
- * Errors: J288_ERR_NULL (p, cfg, huart or dma), J288_ERR_BUSY (this UART is registered
- * already, or J288_STM32_MAX_BUSES are), J288_ERR_BAD_CONFIG for any of:
- *   - dma in RAM the DMA controller cannot reach: the F4's CCM data RAM
- *     (0x10000000-0x1000FFFF), the H7's ITCM (below 0x00040000) and DTCM
- *     (0x20000000-0x2001FFFF); or, with J288_STM32_DCACHE, not on a cache line;
- *   - no now_us and no 32-bit 1 MHz timer, or a tim_channel that is no TIM_CHANNEL_n;
- *   - the UART handle has no DMA stream linked (hdmatx or hdmarx NULL);
- *   - bus_cfg->echo with deaf_while_transmitting: no echo can come;
- *   - the CRC unit does not compute the servo's CRC: a handle in another configuration (see
- *     hcrc above), or a unit that fails a known-answer check (its clock not enabled,
- *     HAL_CRC_Init not called, registers reprogrammed by other code);
- * J288_ERR_PORT (a DMA stream that would not stop), or j288_bus_init()'s codes.
- * Thread only. */
+ * The application initialises the UART (HAL_HalfDuplex_Init), its DMA streams (HAL_DMA_Init,
+ * linked to the handle), the timer (started) and the CRC unit before. Init then takes the
+ * UART's registers with every interrupt source masked and the bus not yet live: the UART off
+ * while one-bit sampling is set (error interrupt off), the streams stopped and set up, their
+ * flags cleared (the TX stream pointed at dma->tx, the RX stream circular over dma->rx,
+ * started), the UART on again and its stale IDLE and error flags cleared; then the bus is live
+ * and the last enables follow (DMA requests, the RX stream's half/complete/error interrupts,
+ * the idle-line interrupt). The DE pin is left inactive and the TX pin driven as tx_drive says.
+ * Errors: J288_ERR_NULL (p, cfg, huart or dma), J288_ERR_BUSY (this UART or p is registered
+ * already, or J288_STM32_MAX_BUSES are), J288_ERR_BAD_CONFIG with its reason in
+ * j288_stm32_init_error(p) (p's other fields untouched):
+ *   J288_STM32_INIT_NO_DMA              hdmatx or hdmarx NULL (or their Instance);
+ *   J288_STM32_INIT_BDMA                an H7 BDMA channel (LPUART1's D3 DMA): not driven;
+ *   J288_STM32_INIT_NOT_HALF_DUPLEX     CR3.HDSEL clear;
+ *   J288_STM32_INIT_DMA_DIRECTION       the TX stream not memory-to-peripheral, or the RX
+ *                                       stream not peripheral-to-memory;
+ *   J288_STM32_INIT_DMA_REQUEST         (G4, H7...) a DMAMUX channel whose request id is not
+ *                                       this UART's TX (resp. RX);
+ *   J288_STM32_INIT_BUFFER_UNREACHABLE  dma in RAM the DMA controller cannot reach: the F4's
+ *                                       CCM data RAM (0x10000000-0x1000FFFF), the F3's CCM SRAM
+ *                                       (0x10000000-0x10003FFF), the H7's ITCM (below
+ *                                       0x00040000) and DTCM (0x20000000-0x2001FFFF);
+ *   J288_STM32_INIT_BUFFER_ALIGNMENT    with J288_STM32_DCACHE, not on a cache line;
+ *   J288_STM32_INIT_DCACHE              a core with a D-cache, J288_STM32_DCACHE=0, the cache
+ *                                       on (SCB->CCR.DC) and the buffers not in a region the
+ *                                       MPU makes non-cacheable (or shareable);
+ *   J288_STM32_INIT_PRIORITY            irq_priority >= 1 << __NVIC_PRIO_BITS;
+ *   J288_STM32_INIT_ECHO_DEAF           bus_cfg->echo with deaf_while_transmitting;
+ *   J288_STM32_INIT_TIMER_CHANNEL       a tim_channel that is no TIM_CHANNEL_1..4;
+ *   J288_STM32_INIT_TIMER_PRELOAD       its output compare preload (OCxPE) on;
+ *   J288_STM32_INIT_NO_CLOCK            no now_us and no 32-bit 1 MHz timer;
+ *   J288_STM32_INIT_DE_HARDWARE         de_hardware on a USART without CR3.DEM, with DEM not
+ *                                       set, or together with de_port;
+ *   J288_STM32_INIT_CRC_CONFIG          the CRC handle in another configuration (hcrc above);
+ *   J288_STM32_INIT_CRC_ANSWER          a CRC unit that fails a known-answer check (its clock
+ *                                       not enabled, HAL_CRC_Init not called, registers
+ *                                       reprogrammed by other code);
+ * J288_ERR_PORT (a DMA stream that would not stop, or would not start), or j288_bus_init()'s
+ * codes. Thread only. */
 int j288_stm32_init(j288_stm32_t *p, const j288_stm32_config_t *cfg,
                     const j288_bus_config_t *bus_cfg);
 
-/* Unregister p: the callbacks ignore its handles from now on, a transfer in flight is
+/* Why the last j288_stm32_init(p, ...) returned J288_ERR_BAD_CONFIG (J288_STM32_INIT_OK for
+ * NULL, or after a successful init), and a short English description of a reason (never NULL).
+ * Any context. */
+j288_stm32_init_error_t j288_stm32_init_error(const j288_stm32_t *p);
+const char *j288_stm32_init_error_str(j288_stm32_init_error_t e);
+
+/* Unregister p, its interrupt sources masked first: the callbacks ignore its handles from now on, a transfer in flight is
  * aborted (a command on the wire is cut short; its transaction gets no completion
  * callback), the timer channel's interrupt is disabled and the DE pin made inactive. p may
  * then be initialised again. Does nothing for a p that is not registered. Thread only. */
@@ -307,10 +414,12 @@ uint32_t j288_stm32_now_us(const j288_stm32_t *p);
  * updating them, so two fields read one after the other may be from different moments. */
 const j288_stm32_stats_t *j288_stm32_stats(const j288_stm32_t *p);
 
-/* Interrupt entries, ISR-safe; each does nothing for NULL or an unregistered p.
+/* Interrupt entries, ISR-safe; each does nothing for NULL, and for a p that is not registered
+ * masks the interrupt sources of its UART and RX stream (unless another bus has taken that UART
+ * since), so that a pending entry from before init or after deinit cannot come back.
  * on_uart_irq: call from the UART's IRQ handler (instead of HAL_UART_IRQHandler): the idle
  *   line (received bytes handed over), line error flags (counted, reported), transmit
- *   complete (the bus is told; the echo skipped or handed over first).
+ *   complete (DE dropped, the echo skipped or handed over, the bus told).
  * on_dma_rx_irq: call from the RX stream's IRQ handler (instead of HAL_DMA_IRQHandler): half
  *   and complete (received bytes handed over), transfer error (stream restarted, reported).
  * Bytes are handed to the bus during the call; the DMA buffer is not read after it returns. */

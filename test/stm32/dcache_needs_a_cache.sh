@@ -4,7 +4,8 @@
 # its CMSIS headers declare no cache maintenance) must stop the build with an #error that says
 # why, and nothing else, not with implicit declarations; on a Cortex-M7 it must build. The HAL
 # stub models both cores (__DCACHE_PRESENT=0U or 1U). With ST_DIR and ARM_CC (mk/firmware.mk,
-# after scripts/fetch-st.sh) the same against ST's real F4 and, when fetched, H7 HAL.
+# after scripts/fetch-st.sh) the same against ST's real F4 and, when fetched, H7 HAL (there with
+# J288_STM32_DCACHE=0 too: the port's D-cache check reads CMSIS's SCB and MPU).
 set -u
 cc=${CC:-cc}
 flags=(-std=c99 -Wall -Wextra -Werror -fsyntax-only -Ilib/include -Iport/stm32_hal -Itest/stm32/stub)
@@ -40,6 +41,11 @@ if [ -n "${ST_DIR:-}" ] && [ -n "${ARM_CC:-}" ]; then
         if ! "$ARM_CC" "${st[@]}" "${h7[@]}" -Wpedantic -Wconversion -Wshadow -DJ288_STM32_DCACHE=1 \
             port/stm32_hal/j288_stm32.c; then
             echo "FAIL: J288_STM32_DCACHE=1 does not build against the H7 HAL"; fail=1
+        fi
+        # J288_STM32_DCACHE=0 on the M7: the D-cache / MPU check against CMSIS's SCB and MPU
+        if ! "$ARM_CC" "${st[@]}" "${h7[@]}" -Wpedantic -Wconversion -Wshadow -DJ288_STM32_DCACHE=0 \
+            port/stm32_hal/j288_stm32.c; then
+            echo "FAIL: J288_STM32_DCACHE=0 does not build against the H7 HAL"; fail=1
         fi
     else
         echo "dcache_needs_a_cache: no H7 HAL in $ST_DIR, its check skipped"

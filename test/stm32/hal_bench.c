@@ -216,6 +216,8 @@ static int port_setup(void)
     hdma_rx.Instance = &rx_ch;
     hdma_rx.DmaBaseAddress = &dma1_regs;
     hdma_rx.ChannelIndex = RX_SHIFT;
+    tx_ch.CCR = DMA_CCR_DIR | DMA_CCR_MINC; /* what HAL_DMA_Init writes: memory to peripheral */
+    rx_ch.CCR = DMA_CCR_MINC;
 #else
     memset(dma2_block, 0, sizeof dma2_block);
     hdma_tx.Instance = DMA2_STREAM(7u);
@@ -300,8 +302,8 @@ static void line_receive(const uint8_t *src, uint32_t n)
 }
 
 /* The TX stream sends its 20 bytes, which the single wire echoes to the receiver, then the
- * last stop bit goes out (TC, an interrupt only when enabled); the line idles before the
- * servo answers. */
+ * last stop bit goes out: TC, whose interrupt ends the transmit; a character later the line
+ * idles (IDLE, a second interrupt) before the servo answers. */
 static void hw_transmit_done(void)
 {
     pause_begin();
@@ -314,7 +316,7 @@ static void hw_transmit_done(void)
     TX_STREAM->CR &= ~(uint32_t)DMA_SxCR_EN; /* a stream stops; a channel stays enabled */
 #endif
     UART_STATUS = S_TC;
-    if ((usart1_regs.CR1 & USART_CR1_TCIE) != 0u) { /* a DE pin's end of transmit */
+    if ((usart1_regs.CR1 & USART_CR1_TCIE) != 0u) {
         port_uart_irq();
     }
     UART_STATUS = S_TC | S_IDLE;

@@ -7,6 +7,9 @@
  */
 #include "stm32_hal_stub.h"
 
+/* The UARTs' register blocks (a device header names fixed addresses; RAM here). */
+USART_TypeDef stub_usart[3];
+
 HAL_StatusTypeDef HAL_Init(void) { return HAL_OK; }
 uint32_t HAL_GetTick(void) { return 0u; }
 void HAL_NVIC_SetPriority(IRQn_Type IRQn, uint32_t PreemptPriority, uint32_t SubPriority)
@@ -41,22 +44,6 @@ HAL_StatusTypeDef HAL_HalfDuplex_Init(UART_HandleTypeDef *huart)
     huart->RxState = HAL_UART_STATE_READY;
     return HAL_OK;
 }
-HAL_StatusTypeDef HAL_HalfDuplex_EnableTransmitter(UART_HandleTypeDef *huart) { (void)huart; return HAL_OK; }
-HAL_StatusTypeDef HAL_HalfDuplex_EnableReceiver(UART_HandleTypeDef *huart) { (void)huart; return HAL_OK; }
-HAL_StatusTypeDef HAL_UART_Transmit_DMA(UART_HandleTypeDef *huart, const uint8_t *pData, uint16_t Size)
-{
-    huart->pTxBuffPtr = pData;
-    huart->TxXferSize = Size;
-    return HAL_OK;
-}
-HAL_StatusTypeDef HAL_UARTEx_ReceiveToIdle_DMA(UART_HandleTypeDef *huart, uint8_t *pData, uint16_t Size)
-{
-    huart->pRxBuffPtr = pData;
-    huart->RxXferSize = Size;
-    return HAL_OK;
-}
-HAL_StatusTypeDef HAL_UART_AbortReceive(UART_HandleTypeDef *huart) { (void)huart; return HAL_OK; }
-HAL_StatusTypeDef HAL_UART_AbortTransmit(UART_HandleTypeDef *huart) { (void)huart; return HAL_OK; }
 void HAL_UART_IRQHandler(UART_HandleTypeDef *huart) { (void)huart; }
 
 HAL_StatusTypeDef HAL_TIM_Base_Init(TIM_HandleTypeDef *htim) { (void)htim; return HAL_OK; }
@@ -104,14 +91,24 @@ uint32_t __get_PRIMASK(void)
 }
 void __set_PRIMASK(uint32_t priMask) { __asm volatile("msr primask, %0" : : "r"(priMask) : "memory"); }
 void __disable_irq(void) { __asm volatile("cpsid i" : : : "memory"); }
+void __enable_irq(void) { __asm volatile("cpsie i" : : : "memory"); }
+void __DMB(void) { __asm volatile("dmb 0xF" : : : "memory"); }
+void __DSB(void) { __asm volatile("dsb 0xF" : : : "memory"); }
+void __ISB(void) { __asm volatile("isb 0xF" : : : "memory"); }
 #else
 static uint32_t primask_shadow;
 uint32_t __get_PRIMASK(void) { return primask_shadow; }
 void __set_PRIMASK(uint32_t priMask) { primask_shadow = priMask; }
 void __disable_irq(void) { primask_shadow = 1u; }
+void __enable_irq(void) { primask_shadow = 0u; }
+void __DMB(void) {}
+void __DSB(void) {}
+void __ISB(void) {}
 #endif
 
 #if __DCACHE_PRESENT
+SCB_Type stub_scb;
+MPU_Type stub_mpu;
 void SCB_CleanDCache_by_Addr(volatile void *addr, int32_t dsize)
 {
     (void)addr;
@@ -135,7 +132,7 @@ void __set_BASEPRI_MAX(uint32_t basePri)
     }
 }
 
-#if !defined(J288_STUB_G4)
+#if !defined(J288_STUB_ISR_USART)
 /* The F4's SR (rc_w0) and DR accesses, plain. */
 void stub_usart_sr_clear(USART_TypeDef *u, uint32_t bits) { u->SR = ~bits; }
 uint32_t stub_usart_dr_read(USART_TypeDef *u) { return u->DR; }
