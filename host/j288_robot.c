@@ -52,11 +52,21 @@ static void emit(j288_robot_t *r, const j288_robot_event_t *ev)
         r->opt.on_event(r->opt.user, ev);
 }
 
+/* A bus event, counted where no caller can miss it (cycle info, robot and bus stats). */
 static void emit_bus(j288_robot_t *r, j288_robot_event_kind_t kind, unsigned bus)
 {
     j288_robot_event_t ev;
-    if (r->opt.stop_on_bus_loss && !r->bus_lost &&
-        (kind == J288_ROBOT_EV_BUS_DOWN || kind == J288_ROBOT_EV_BUS_GONE)) {
+    bool lost = kind == J288_ROBOT_EV_BUS_DOWN || kind == J288_ROBOT_EV_BUS_GONE;
+    if (lost) {
+        r->lost_pending++;
+        r->stats.bus_losses++;
+        r->bus[bus].stats.lost_at_us = j288_serial_now_us();
+    } else {
+        r->back_pending++;
+        r->stats.bus_returns++;
+        r->bus[bus].stats.back_at_us = j288_serial_now_us();
+    }
+    if (r->opt.stop_on_bus_loss && !r->bus_lost && lost) {
         r->bus_lost = true;
         r->lost_bus = bus;
     }
@@ -167,6 +177,7 @@ static void on_sweep(void *user, uint32_t sweep, uint32_t now_us)
         b->empty_run = 0;
         if (!b->stats.up) {
             b->stats.up = true;
+            b->stats.up_events++;
             emit_bus(r, J288_ROBOT_EV_BUS_UP, b->index);
         }
         return;
@@ -266,13 +277,30 @@ static int check_same_device(j288_robot_t *r, unsigned i, const char *port)
     return J288_OK;
 }
 
+/* Bus engine and scheduler on the open port (at open, and anew at a reopen). */
+static int start_engine(j288_robot_t *r, j288_robot_bus_t *b)
+{
+    j288_bus_config_t bc;
+    j288_sched_config_t sc;
+    int rc;
+    j288_serial_bus_config(&b->serial, &bc);
+    bc.retries = r->opt.retries;
+    rc = j288_serial_bus_init(&b->serial, &b->bus, &bc);
+    if (rc != J288_OK)
+        return rc;
+    memset(&sc, 0, sizeof sc);
+    sc.on_event = on_servo_event;
+    sc.on_sweep = on_sweep;
+    sc.on_reply = on_reply;
+    sc.user = b;
+    return j288_sched_init(&b->sched, &b->bus, &sc);
+}
+
 static int open_bus(j288_robot_t *r, unsigned i, const char *name, const char *port,
                     const j288_robot_config_bus_t *cb)
 {
     j288_robot_bus_t *b = &r->bus[i];
     j288_serial_options_t lo;
-    j288_bus_config_t bc;
-    j288_sched_config_t sc;
     uint32_t baud = r->opt.baud;
     int rc;
     unsigned id;
@@ -297,6 +325,9 @@ static int open_bus(j288_robot_t *r, unsigned i, const char *name, const char *p
     rc = check_same_device(r, i, port);
     if (rc != J288_OK)
         return rc;
+    (void)snprintf(b->port, sizeof b->port, "%s", port);
+    b->baud = baud;
+    b->sopt = lo;
     rc = j288_serial_open(&b->serial, port, baud, &lo);
     if (rc != J288_OK) {
         set_err(r, "bus '%s': %s", name, j288_serial_error(&b->serial));
@@ -304,17 +335,7 @@ static int open_bus(j288_robot_t *r, unsigned i, const char *name, const char *p
     }
     b->open = true;
     b->stats.up = true;
-    j288_serial_bus_config(&b->serial, &bc);
-    bc.retries = r->opt.retries;
-    rc = j288_serial_bus_init(&b->serial, &b->bus, &bc);
-    if (rc == J288_OK) {
-        memset(&sc, 0, sizeof sc);
-        sc.on_event = on_servo_event;
-        sc.on_sweep = on_sweep;
-        sc.on_reply = on_reply;
-        sc.user = b;
-        rc = j288_sched_init(&b->sched, &b->bus, &sc);
-    }
+    rc = start_engine(r, b);
     if (rc == J288_OK)
         rc = j288_joint_bus_init(&b->jb, &b->sched, on_joint_event, b);
     if (rc != J288_OK)
@@ -487,6 +508,26 @@ static bool stop_requested(const j288_robot_t *r)
     return r->stop_flag != NULL && *r->stop_flag != 0;
 }
 
+/* The device of bus b vanished: said once, the device closed at once (a USB adapter that
+ * re-enumerates gets its old name back only once nobody holds the old node), its joints'
+ * angles forgotten (the servos may well be power-cycled by the time it returns), and its
+ * first reopen attempt due one interval later. */
+static void bus_gone(j288_robot_t *r, j288_robot_bus_t *b, uint32_t now)
+{
+    unsigned j;
+    b->stats.gone = true;
+    b->stats.up = false;
+    b->stats.gone_events++;
+    set_err(r, "bus '%s': %s", b->name, j288_serial_error(&b->serial));
+    j288_serial_close(&b->serial);
+    for (j = 0; j < r->njoints; j++) {
+        if (r->joint_bus[j] == b->index)
+            j288_joint_reset(&r->joint[j]);
+    }
+    b->reopen_at_us = now + J288_ROBOT_REOPEN_US;
+    emit_bus(r, J288_ROBOT_EV_BUS_GONE, b->index);
+}
+
 /* Poll every bus; report and leave out a bus whose device vanished. */
 static void poll_all(j288_robot_t *r, uint32_t now)
 {
@@ -496,13 +537,85 @@ static void poll_all(j288_robot_t *r, uint32_t now)
         if (!bus_live(b))
             continue;
         j288_sched_poll(&b->sched, now);
-        if (j288_serial_offline(&b->serial)) {
-            b->stats.gone = true;
-            b->stats.up = false;
-            set_err(r, "bus '%s': %s", b->name, j288_serial_error(&b->serial));
-            emit_bus(r, J288_ROBOT_EV_BUS_GONE, i);
+        if (j288_serial_offline(&b->serial))
+            bus_gone(r, b, now);
+    }
+}
+
+/* Open gone bus b's device again and restart the bus from scratch (j288_robot.h:
+ * reconnection): engine and scheduler anew, the slots that were enabled enabled at lock
+ * (watchdog bit 0), every joint's angle to be found again (reset when it went). False when
+ * the device is not there (yet): the next attempt is an interval later. */
+static bool reopen_bus(j288_robot_t *r, j288_robot_bus_t *b, uint32_t now)
+{
+    uint16_t enabled = 0;
+    uint8_t id;
+    b->reopen_at_us = now + J288_ROBOT_REOPEN_US;
+    b->stats.reopen_attempts++;
+    for (id = 0; id < J288_MAX_SERVOS; id++) {
+        if (j288_sched_slot(&b->sched, id)->enabled)
+            enabled = (uint16_t)(enabled | (1u << id));
+    }
+    if (j288_serial_open(&b->serial, b->port, b->baud, &b->sopt) != J288_OK)
+        return false;
+    if (start_engine(r, b) != J288_OK) { /* cannot fail on a port that opened: be safe */
+        j288_serial_close(&b->serial);
+        return false;
+    }
+    for (id = 0; id < J288_MAX_SERVOS; id++) {
+        j288_cmd_raw_t lock;
+        lock_cmd(id, &lock);
+        (void)j288_sched_set_cmd(&b->sched, &lock);
+        (void)j288_sched_enable(&b->sched, id, (enabled & (1u << id)) != 0u);
+    }
+    memset(b->lock_under_foc, 0, sizeof b->lock_under_foc);
+    b->servo_joint_on = 0; /* the servo level's joints start anew too */
+    b->swept_ok = false;
+    b->txn_done = false;
+    b->empty_run = 0;
+    b->stats.gone = false;
+    b->stats.up = true;
+    b->stats.reopens++;
+    emit_bus(r, J288_ROBOT_EV_BUS_BACK, b->index);
+    return true;
+}
+
+/* A gone bus that may be reopened: not one named by its pseudo-terminal (/dev/pts/N), whose
+ * number goes to the next program that asks for a terminal (a link to it, as j288-sim's
+ * --link, is removed and placed anew by whoever serves it). */
+static bool reopenable(const j288_robot_bus_t *b)
+{
+    return b->open && b->stats.gone && strncmp(b->port, "/dev/pts/", 9) != 0;
+}
+
+/* Reconnection: every gone bus whose attempt is due tries its device once. */
+static void reopen_due(j288_robot_t *r, uint32_t now)
+{
+    unsigned i;
+    if (r->opt.no_reopen)
+        return;
+    for (i = 0; i < r->nbuses; i++) {
+        j288_robot_bus_t *b = &r->bus[i];
+        if (reopenable(b) && us_until(b->reopen_at_us, now) <= 0)
+            (void)reopen_bus(r, b, now);
+    }
+}
+
+/* The earliest reopen attempt due among the gone buses (false: none, or no reopening). */
+static bool next_reopen(const j288_robot_t *r, uint32_t now, uint32_t *at)
+{
+    unsigned i;
+    bool any = false;
+    if (r->opt.no_reopen)
+        return false;
+    for (i = 0; i < r->nbuses; i++) {
+        const j288_robot_bus_t *b = &r->bus[i];
+        if (reopenable(b) && (!any || us_until(b->reopen_at_us, now) < us_until(*at, now))) {
+            *at = b->reopen_at_us;
+            any = true;
         }
     }
+    return any;
 }
 
 static bool bus_pending(const j288_robot_bus_t *b)
@@ -568,6 +681,25 @@ static bool any_live(const j288_robot_t *r)
     return false;
 }
 
+/* Every bus is gone: sleep (bounded by until and the stop flag) until the next reopen
+ * attempt is due, and make it. True when a bus is back. */
+static bool wait_for_a_bus(j288_robot_t *r, uint32_t now, uint32_t until)
+{
+    uint32_t due = until; /* (next_reopen sets it; initialised for the compiler) */
+    if (!next_reopen(r, now, &due))
+        return false;
+    if (us_until(due, until) > 0)
+        due = until;
+    while (us_until(due, now) > 0 && !stop_requested(r)) {
+        wait_all(r, now, due); /* no live port: a plain bounded sleep */
+        now = j288_serial_now_us();
+    }
+    if (stop_requested(r))
+        return false;
+    reopen_due(r, now);
+    return any_live(r);
+}
+
 static void start_sweeps(j288_robot_t *r, uint32_t now)
 {
     unsigned i;
@@ -607,7 +739,11 @@ static void finish_cycle(j288_robot_t *r, uint32_t start, j288_robot_cycle_t *in
     info->joints = r->njoints;
     info->complete = fresh == r->njoints;
     info->watchdog = r->wd_cleared;
+    info->lost = r->lost_pending;
+    info->back = r->back_pending;
     r->wd_cleared = 0;
+    r->lost_pending = 0;
+    r->back_pending = 0;
     r->cycle++;
     if (r->opt.on_cycle != NULL)
         r->opt.on_cycle(r->opt.user, r, info);
@@ -635,16 +771,20 @@ int j288_robot_cycle(j288_robot_t *r, uint32_t timeout_us, j288_robot_cycle_t *i
     if (info == NULL)
         info = &local;
     memset(info, 0, sizeof *info);
-    if (!any_live(r)) {
-        set_err(r, "every bus is gone");
-        return J288_ERR_OFFLINE;
-    }
     if (timeout_us == 0u)
         timeout_us = J288_ROBOT_DEFAULT_CYCLE_TIMEOUT_US;
     if (timeout_us > (uint32_t)INT32_MAX)
         timeout_us = (uint32_t)INT32_MAX; /* beyond it the wrapped clock reads as past */
     start = j288_serial_now_us();
     until = start + timeout_us;
+    reopen_due(r, start);
+    if (!any_live(r) && !wait_for_a_bus(r, start, until)) {
+        if (stop_requested(r))
+            return J288_ERR_ABORTED; /* nothing to stop: every bus is gone */
+        set_err(r, "every bus is gone");
+        return J288_ERR_OFFLINE;
+    }
+    start = j288_serial_now_us();
     start_sweeps(r, start);
     for (;;) {
         uint32_t now = j288_serial_now_us();
@@ -698,10 +838,12 @@ static int sleep_until_ns(j288_robot_t *r, uint64_t until_ns, uint64_t *woke_ns)
         if (now_ns >= until_ns) {
             *woke_ns = now_ns;
             poll_all(r, now);
+            reopen_due(r, now);
             return J288_OK;
         }
         poll_all(r, now);
-        if (!any_live(r))
+        reopen_due(r, now);
+        if (!any_live(r) && r->opt.no_reopen)
             return J288_ERR_OFFLINE;
         if (stop_requested(r))
             return J288_ERR_ABORTED;
@@ -709,6 +851,7 @@ static int sleep_until_ns(j288_robot_t *r, uint64_t until_ns, uint64_t *woke_ns)
             uint64_t left_us = (until_ns - now_ns + 999u) / 1000u;
             wait_all(r, now, now + (uint32_t)(left_us < STOP_SLICE_US ? left_us : STOP_SLICE_US));
         } else {
+            /* (every bus gone: a reopen attempt falling due waits for the deadline) */
             uint64_t t = until_ns;
             if (r->stop_flag != NULL && t - now_ns > (uint64_t)STOP_SLICE_US * 1000u)
                 t = now_ns + (uint64_t)STOP_SLICE_US * 1000u;
@@ -732,7 +875,7 @@ int j288_robot_pace(j288_robot_t *r, uint32_t period_us)
         slept = true;
     }
     j288_rt_pace_woke(&r->pacer, &r->timing, woke, slept);
-    if (!any_live(r))
+    if (!any_live(r) && r->opt.no_reopen) /* (else the cycle waits for a bus to come back) */
         return J288_ERR_OFFLINE;
     return stop_requested(r) ? J288_ERR_ABORTED : J288_OK;
 }
@@ -772,7 +915,11 @@ int j288_robot_run(j288_robot_t *r, uint32_t period_us, uint32_t ncycles, uint32
         if (rc != J288_OK)
             return rc;
         rc = j288_robot_cycle(r, 0, NULL);
-        if (rc == J288_ERR_ABORTED || rc == J288_ERR_OFFLINE || rc == J288_ERR_NULL)
+        if (rc == J288_ERR_ABORTED || rc == J288_ERR_NULL)
+            return rc;
+        /* Every bus gone (the cycle waited for a reopen attempt): the run goes on unless
+         * the loss ends it (stop_on_bus_loss) or nothing can come back (no_reopen). */
+        if (rc == J288_ERR_OFFLINE && (r->opt.stop_on_bus_loss || r->opt.no_reopen))
             return rc;
         done++;
     }
@@ -830,7 +977,7 @@ int j288_robot_stop(j288_robot_t *r)
                 continue;
             j288_bus_poll(&b->bus, now);
             if (j288_serial_offline(&b->serial)) {
-                b->stats.gone = true;
+                bus_gone(r, b, now);
                 rc = J288_ERR_OFFLINE;
                 continue;
             }
@@ -894,6 +1041,14 @@ int j288_robot_joint_config(const j288_robot_t *r, unsigned joint, j288_joint_co
     return J288_OK;
 }
 
+/* Whether the joint's servo answers on a bus that is up and not gone: a lost joint's last
+ * angle is history, never reported as known. */
+static bool joint_not_lost(const j288_robot_t *r, unsigned joint)
+{
+    const j288_robot_bus_t *b = &r->bus[r->joint_bus[joint]];
+    return bus_live(b) && b->stats.up && j288_sched_slot(&b->sched, r->joint[joint].cfg.id)->online;
+}
+
 int j288_robot_read(const j288_robot_t *r, unsigned joint, j288_robot_state_t *st)
 {
     const j288_joint_state_t *js;
@@ -907,10 +1062,10 @@ int j288_robot_read(const j288_robot_t *r, unsigned joint, j288_robot_state_t *s
     js = j288_joint_state(&r->joint[joint]);
     slot = j288_sched_slot(&b->sched, j288_joint_config(&r->joint[joint])->id);
     memset(st, 0, sizeof *st);
-    st->known = js->known;
     st->online = slot->online && bus_live(b);
+    st->known = js->known && joint_not_lost(r, joint);
     st->fresh = r->fresh_at[joint] != 0u && r->fresh_at[joint] + 1u == r->cycle;
-    st->pos = js->known ? (double)js->pos : 0.0;
+    st->pos = st->known ? (double)js->pos : 0.0;
     st->speed = (double)js->speed;
     st->torque = (double)js->torque;
     if (slot->has_reply) {
@@ -933,14 +1088,15 @@ int j288_robot_read_all(const j288_robot_t *r, size_t n, double *pos, double *sp
         return J288_ERR_BAD_ARG;
     for (j = 0; j < r->njoints; j++) {
         const j288_joint_state_t *js = j288_joint_state(&r->joint[j]);
+        bool ok = js->known && joint_not_lost(r, j);
         if (pos != NULL)
-            pos[j] = js->known ? (double)js->pos : 0.0;
+            pos[j] = ok ? (double)js->pos : 0.0;
         if (speed != NULL)
             speed[j] = (double)js->speed;
         if (torque != NULL)
             torque[j] = (double)js->torque;
         if (known != NULL)
-            known[j] = js->known ? 1u : 0u;
+            known[j] = ok ? 1u : 0u;
     }
     return J288_OK;
 }

@@ -32,8 +32,37 @@
  *   down_after cycles (measured: 3 servos, 20 ms margin, about 120 ms a cycle for 3 cycles).
  *   A small margin_us on each bus and a small down_after keep that short.
  * - a bus whose device vanishes (adapter unplugged, simulator gone) is reported once
- *   (J288_ROBOT_EV_BUS_GONE, with the port's message in j288_robot_error()) and left out from
- *   then on. Only when every bus is gone does a cycle fail (J288_ERR_OFFLINE).
+ *   (J288_ROBOT_EV_BUS_GONE, with the port's message in j288_robot_error()), its device
+ *   closed at once (a USB adapter that re-enumerates gets its old name back only once nobody
+ *   holds the old node) and its joints' angles forgotten: they read not known, not online,
+ *   not fresh. Cycles go on without it; only a cycle that finds every bus gone fails
+ *   (J288_ERR_OFFLINE).
+ * A lost bus is never silent: besides the events, j288_robot_cycle_t.lost counts the buses
+ * lost (down or gone) since the previous cycle, j288_robot_stats_t.bus_losses all of them,
+ * and j288_robot_bus_stats_t says which bus and when (lost_at_us). A joint whose servo went
+ * offline (the scheduler's offline_after failures) or whose bus is down or gone reads
+ * known = false (its pos 0), whatever the joint layer last knew.
+ *
+ * Reconnection (unless no_reopen): a gone bus's device is opened again at the same path (a
+ * udev symlink such as /dev/serial/by-id/..., or j288-sim's --link) when it reappears. The
+ * attempts are rate-limited: at most one every J288_ROBOT_REOPEN_US per gone bus, made only
+ * at the start of a cycle and in j288_robot_run()'s waits between cycles (never in a stop, a
+ * transfer, an exchange or j288_robot_idle(), whose callers hold a command made for the old
+ * session). An attempt is one non-blocking open (O_NONBLOCK; nothing waits for the device):
+ * a path that is not there fails in microseconds; a device that is there costs its driver's
+ * open and the line set-up, once (a USB adapter: a few control transfers, milliseconds).
+ * The bus comes back restarted from scratch: its bus engine and scheduler initialised anew
+ * (their counters restart), the slots that were enabled enabled again, every one at lock
+ * (watchdog bit 0), and its joints' angles found again from their first replies (the start
+ * of joint.h: no jump is commanded, whatever the servo's angle now is). Their targets are not
+ * restored: the joints stay at lock until the application sets targets again (after
+ * J288_ROBOT_EV_BUS_BACK, cycle info's back, once their angles are known). Reported as
+ * J288_ROBOT_EV_BUS_BACK, j288_robot_cycle_t.back, the bus stats' reopens and back_at_us.
+ * Whatever device is found at the path is taken: name an adapter by a stable path
+ * (/dev/serial/by-id/...), as a kernel name (/dev/ttyUSB0) may come back as another adapter.
+ * A bus named by a pseudo-terminal itself (/dev/pts/N) is never reopened: its number goes to
+ * the next program that asks for a terminal (a link to it, as j288-sim's --link, is removed
+ * and placed anew by whoever serves the pty).
  * Nothing waits without a bound: every transaction ends by its reply deadline (the bus's
  * margin_us), and a cycle by its timeout.
  *
@@ -110,9 +139,11 @@ typedef enum {
     J288_ROBOT_EV_BUS_DOWN,  /* no reply in down_after sweeps: cycles go on without it */
     J288_ROBOT_EV_BUS_UP,    /* a down bus answers again */
     J288_ROBOT_EV_BUS_GONE,  /* its device vanished: left out from now on */
-    J288_ROBOT_EV_WATCHDOG   /* a servo's watchdog had tripped (value 1: the reply said so;
+    J288_ROBOT_EV_WATCHDOG,  /* a servo's watchdog had tripped (value 1: the reply said so;
                                 2: it answered FOC commands in lock mode); cleared by the
                                 runner: see the watchdog policy at the top */
+    J288_ROBOT_EV_BUS_BACK   /* a gone bus's device was opened again: restarted from
+                                scratch, its joints at lock (reconnection, at the top) */
 } j288_robot_event_kind_t;
 
 typedef struct {
@@ -134,6 +165,8 @@ typedef struct {
     unsigned joints;      /* joints in all */
     bool complete;        /* fresh == joints */
     unsigned watchdog;    /* servos found tripped in this cycle (and cleared) */
+    unsigned lost;        /* buses lost (went down or vanished) since the previous cycle */
+    unsigned back;        /* buses back (answering again, or reopened) since then */
 } j288_robot_cycle_t;
 
 typedef struct j288_robot j288_robot_t;
@@ -163,7 +196,11 @@ typedef struct {
     bool pin_cpu;          /* pin that thread to cpu (one it may run on, else the open fails
                               with J288_ERR_BAD_ARG) */
     uint16_t cpu;
+    bool no_reopen;        /* a vanished bus is given up for good (no reconnection) */
 } j288_robot_options_t;
+
+/* Least time between two attempts to reopen a gone bus's device (reconnection, at the top). */
+#define J288_ROBOT_REOPEN_US 200000u
 
 typedef struct {
     uint32_t sweeps;          /* sweeps completed */
@@ -172,7 +209,14 @@ typedef struct {
     uint32_t last_sweep_us;   /* duration of the latest sweep */
     uint32_t worst_sweep_us;
     bool up;                  /* cycles wait for it */
-    bool gone;                /* its device vanished */
+    bool gone;                /* its device vanished (and is not back) */
+    uint32_t gone_events;     /* times its device vanished */
+    uint32_t up_events;       /* times it answered again after being down */
+    uint32_t reopens;         /* times it was opened again (J288_ROBOT_EV_BUS_BACK) */
+    uint32_t reopen_attempts; /* opens tried while it was gone */
+    uint32_t lost_at_us;      /* j288_robot_now_us() when it was last lost (went down or
+                                 vanished); valid once down_events + gone_events > 0 */
+    uint32_t back_at_us;      /* ... when it last came back (up again, or reopened) */
 } j288_robot_bus_stats_t;
 
 typedef struct {
@@ -186,12 +230,15 @@ typedef struct {
     uint32_t complete_cycles;
     uint32_t last_cycle_us;
     uint32_t worst_cycle_us;
+    uint32_t bus_losses;      /* buses lost (down or gone events), every bus, since open */
+    uint32_t bus_returns;     /* buses back (up again, or reopened) */
 } j288_robot_stats_t;
 
 /* A joint's state (j288_robot_read()): joint frame, SI units. */
 typedef struct {
-    bool known;        /* pos is the absolute joint angle (joint.h) */
-    bool online;       /* its servo answers */
+    bool known;        /* pos is the absolute joint angle (joint.h) and the joint is not lost
+                          (its servo online, its bus up and not gone) */
+    bool online;       /* its servo answers (and its bus is not gone) */
     bool fresh;        /* a reply came in the latest cycle */
     double pos;        /* rad (0 while unknown) */
     double speed;      /* rad/s */
@@ -236,6 +283,10 @@ typedef struct {
 
 typedef struct {
     j288_serial_t serial;
+    char port[J288_ROBOT_CONFIG_PORT_MAX]; /* the device, for reopening it */
+    uint32_t baud;                         /* asked at open */
+    j288_serial_options_t sopt;            /* the port's options at open */
+    uint32_t reopen_at_us;                 /* gone: the next reopen attempt */
     j288_bus_t bus;
     j288_sched_t sched;
     j288_joint_bus_t jb;
@@ -271,6 +322,8 @@ struct j288_robot {
     bool bus_lost;       /* stop_on_bus_loss: a bus went down or vanished */
     unsigned lost_bus;   /* which one (the first) */
     unsigned wd_cleared; /* watchdog trips cleared in the cycle in progress */
+    unsigned lost_pending; /* buses lost since the previous cycle's end */
+    unsigned back_pending; /* buses back since then */
     const volatile sig_atomic_t *stop_flag;
     j288_robot_stats_t stats;
     char err[J288_ROBOT_MSG_LEN];
@@ -319,15 +372,19 @@ void j288_robot_close_keep(j288_robot_t *r);
 void j288_robot_set_stop_flag(j288_robot_t *r, const volatile sig_atomic_t *flag);
 
 /*
- * One cycle: start a sweep on every bus (a down bus's sweep only if its previous one ended),
- * drive them all from one loop until every bus that is up has finished, then call on_cycle.
+ * One cycle: reopen a gone bus whose attempt is due (reconnection, at the top), start a sweep
+ * on every bus (a down bus's sweep only if its previous one ended), drive them all from one
+ * loop until every bus that is up has finished, then call on_cycle.
  * timeout_us bounds the cycle (0: 1 s; at most 2^31 - 1 us, about 35 min: more is taken as
  * that). Returns J288_OK when every joint got fresh state, J288_ERR_TIMEOUT when some did not
  * (*info says how many; a cycle at its bound first takes the replies that have arrived, as a
  * host woken late would otherwise lose them, then leaves the remaining sweeps running into
- * the next cycle), J288_ERR_OFFLINE when every bus is gone
- * (with stop_on_bus_loss: when one went down or vanished; every bus is then stopped),
- * J288_ERR_ABORTED after a stop on the stop flag, J288_ERR_NULL. info may be NULL.
+ * the next cycle), J288_ERR_OFFLINE when every bus is gone (with stop_on_bus_loss: when one
+ * went down or vanished; every bus is then stopped), J288_ERR_ABORTED after a stop on the
+ * stop flag, J288_ERR_NULL. info may be NULL. A cycle that finds every bus gone sleeps until
+ * the next reopen attempt is due (at most its bound; not with no_reopen), makes it, and runs
+ * if a bus came back, else returns J288_ERR_OFFLINE without calling on_cycle: a loop of
+ * cycles over a robot whose every device is unplugged waits, it does not spin.
  */
 int j288_robot_cycle(j288_robot_t *r, uint32_t timeout_us, j288_robot_cycle_t *info);
 
@@ -337,9 +394,11 @@ int j288_robot_cycle(j288_robot_t *r, uint32_t timeout_us, j288_robot_cycle_t *i
  * one skipped, never caught up (j288_rt.h). A run that follows another at the same period goes
  * on with its schedule (a caller running in slices keeps one even rate), and ends before a
  * cycle due at or after duration_us, which the next run then takes up. Returns J288_OK, or
- * J288_ERR_ABORTED (stop flag: every bus stopped), J288_ERR_OFFLINE (every bus gone, or with
- * stop_on_bus_loss one lost: every bus stopped), J288_ERR_NULL. Incomplete cycles do not end
- * the run.
+ * J288_ERR_ABORTED (stop flag: every bus stopped), J288_ERR_OFFLINE (with stop_on_bus_loss one
+ * bus lost: every bus stopped; with no_reopen every bus gone), J288_ERR_NULL. Incomplete cycles
+ * do not end the run, nor (with reconnection) cycles that find every bus gone: the run waits
+ * for a device to come back until its end (each such cycle counts toward ncycles);
+ * j288_robot_stats() and the events say what was lost.
  */
 int j288_robot_run(j288_robot_t *r, uint32_t period_us, uint32_t ncycles, uint32_t duration_us);
 
@@ -353,8 +412,9 @@ int j288_robot_run(j288_robot_t *r, uint32_t period_us, uint32_t ncycles, uint32
  * period_us 0 (back to back: durations only). A deadline already past when it is called is
  * missed: it returns at once, and whole periods behind are skipped, never run back to back
  * (the rule, and why, in j288_rt.h). Returns J288_OK, J288_ERR_ABORTED (the stop flag: nothing
- * is sent, the caller stops), J288_ERR_OFFLINE (every bus gone), J288_ERR_NULL. No allocation,
- * no I/O but the ports' own.
+ * is sent, the caller stops), J288_ERR_OFFLINE (every bus gone with no_reopen; with
+ * reconnection the next cycle waits for a device instead), J288_ERR_NULL. No allocation, no
+ * I/O but the ports' own; a gone bus's reopen attempt that falls due is made.
  */
 int j288_robot_pace(j288_robot_t *r, uint32_t period_us);
 /* The next j288_robot_pace() starts a new schedule (e.g. after a pause in the loop, whose

@@ -42,7 +42,7 @@ DDS_TOOL_OBJ := $(addprefix $(OBJ)/tools/j288-dds/,bridge.o diag.o unitree_crc.o
 DDS_TEST_PEER := $(BUILD)/test/dds_peer
 DDS_GOLDEN := $(BUILD)/test/dds_golden
 DDS_TESTS := test/dds/netns_guard.sh test/dds/golden.sh test/dds/bridge_e2e.sh test/dds/input_e2e.sh \
-    test/dds/unitree_e2e.sh test/dds/service.sh
+    test/dds/unitree_e2e.sh test/dds/service.sh test/dds/loss_e2e.sh
 DDS_PEERS := $(DDS_TEST_PEER) $(DDS_TEST_PEER)_xt $(DDS_GOLDEN)
 
 ifeq ($(DDS_FOUND),yes)

@@ -3,6 +3,7 @@
 #   test/linux/test_robot.c   several j288-sim buses from one loop (HOST_TESTS)
 #   test/e2e/cli_robot.sh     j288 --config FILE log|status|hold|stop (TEST_SCRIPTS)
 #   test/e2e/host_stack.sh    a second session after a stop, every front end (TEST_SCRIPTS)
+#   test/e2e/cli_robust.sh    a lost bus, reconnection and signals through the tool (TEST_SCRIPTS)
 # (the runner, its wait over every bus the port's, j288_serial_wait_any(); the loop's real
 # time and timing: host/j288_rt.c, its OS part host/j288_rt_linux.c)
 ROBOT_OBJ := $(OBJ)/host/j288_robot.o $(OBJ)/host/j288_rt.o $(OBJ)/host/j288_rt_linux.o
@@ -34,3 +35,6 @@ TEST_DEPS += $(J288_BIN)
 # One host stack: a second session after every form of stop holds a loaded joint (the CLI's
 # forms and Python's; the Python ones use the shared library, which python.mk adds).
 TEST_SCRIPTS += test/e2e/host_stack.sh
+# Issue 29 through the tool: a lost bus is exit 1, a restarted simulator's joints held again,
+# SIGHUP and SIGQUIT lock (robot forms, a one-servo loop, top).
+TEST_SCRIPTS += test/e2e/cli_robust.sh

@@ -13,9 +13,9 @@ config file in one loop (joint frame). Errors raise J288Error, whose .name is th
 from ._native import VERSION as __version__
 from .bus import MODE_FOC, MODE_LOCK, Bus, ServoStatus
 from ._native import Terminated
-from .errors import J288Error, NoReplyError, OfflineError, WatchdogError
+from .errors import BusLostError, J288Error, NoReplyError, OfflineError, WatchdogError
 from .robot import Cycle, Robot, State
 
 __all__ = ["Bus", "Robot", "ServoStatus", "Cycle", "State", "J288Error", "NoReplyError",
-           "OfflineError", "WatchdogError", "Terminated", "MODE_LOCK", "MODE_FOC",
+           "OfflineError", "BusLostError", "WatchdogError", "Terminated", "MODE_LOCK", "MODE_FOC",
            "__version__"]

@@ -72,7 +72,7 @@ class CycleInfo(Structure):
     _c_type_ = "j288_robot_cycle_t"
     _fields_ = [("cycle", c_uint32), ("start_us", c_uint32), ("duration_us", c_uint32),
                 ("fresh", c_uint), ("joints", c_uint), ("complete", c_bool),
-                ("watchdog", c_uint)]
+                ("watchdog", c_uint), ("lost", c_uint), ("back", c_uint)]
 
 
 class RobotStats(Structure):
@@ -80,7 +80,8 @@ class RobotStats(Structure):
 
     _c_type_ = "j288_robot_stats_t"
     _fields_ = [("cycles", c_uint32), ("complete_cycles", c_uint32),
-                ("last_cycle_us", c_uint32), ("worst_cycle_us", c_uint32)]
+                ("last_cycle_us", c_uint32), ("worst_cycle_us", c_uint32),
+                ("bus_losses", c_uint32), ("bus_returns", c_uint32)]
 
 
 class BusStats(Structure):
@@ -89,7 +90,9 @@ class BusStats(Structure):
     _c_type_ = "j288_robot_bus_stats_t"
     _fields_ = [("sweeps", c_uint32), ("empty_sweeps", c_uint32), ("down_events", c_uint32),
                 ("last_sweep_us", c_uint32), ("worst_sweep_us", c_uint32),
-                ("up", c_bool), ("gone", c_bool)]
+                ("up", c_bool), ("gone", c_bool), ("gone_events", c_uint32),
+                ("up_events", c_uint32), ("reopens", c_uint32), ("reopen_attempts", c_uint32),
+                ("lost_at_us", c_uint32), ("back_at_us", c_uint32)]
 
 
 class SlotStats(Structure):
@@ -116,7 +119,8 @@ class Options(Structure):
                 ("down_after", c_uint8), ("no_low_latency", c_bool),
                 ("on_event", c_void_p), ("on_cycle", c_void_p), ("user", c_void_p),
                 ("stop_on_bus_loss", c_bool), ("echo", c_bool), ("retries", c_uint8),
-                ("realtime", c_uint8), ("pin_cpu", c_bool), ("cpu", c_uint16)]
+                ("realtime", c_uint8), ("pin_cpu", c_bool), ("cpu", c_uint16),
+                ("no_reopen", c_bool)]
 
 
 class TimingSummary(Structure):
@@ -234,15 +238,24 @@ _H = TypeVar("_H", bound="Handle")
 
 
 class Terminated(SystemExit):
-    """SIGTERM inside a Bus or Robot with block: the block's exit stopped the servos; the
-    process then ends with status 143, as the j288 tool does."""
+    """SIGTERM, SIGHUP (a closed terminal or SSH session) or SIGQUIT inside a Bus or Robot
+    with block: the block's exit stopped the servos (broadcast lock, watchdog bit 0); the
+    process then ends with status 128 + the signal's number (143, 129, 131), as the j288
+    tool does. .signum: the signal."""
 
-    def __init__(self) -> None:
-        super().__init__(143)
+    def __init__(self, signum: int = signal.SIGTERM) -> None:
+        self.signum = int(signum)
+        super().__init__(128 + self.signum)
 
 
-def _raise_on_sigterm(signum: int, frame: object) -> None:
-    raise Terminated()
+def _raise_on_signal(signum: int, frame: object) -> None:
+    raise Terminated(signum)
+
+
+# The signals whose default action would end the process with the servos still driven
+# (Windows has only SIGTERM of them).
+_STOP_SIGNALS = tuple(getattr(signal, n) for n in ("SIGTERM", "SIGHUP", "SIGQUIT")
+                      if hasattr(signal, n))
 
 
 def path_arg(value: object, what: str) -> bytes:
@@ -300,13 +313,14 @@ class Handle:
             self._r = None
 
     def __enter__(self: _H) -> _H:
-        # SIGTERM as Ctrl-C: an exception in the with block, so that __exit__ stops the
-        # servos (the default action would end the process with the servos still driven).
-        # Only in the main thread, and only over the default action.
-        self._old_term = None
-        if (threading.current_thread() is threading.main_thread()
-                and signal.getsignal(signal.SIGTERM) == signal.SIG_DFL):
-            self._old_term = signal.signal(signal.SIGTERM, _raise_on_sigterm)
+        # SIGTERM, SIGHUP and SIGQUIT as Ctrl-C: an exception in the with block, so that
+        # __exit__ stops the servos (their default actions would end the process with the
+        # servos still driven). Only in the main thread, and only over the default action.
+        self._old_handlers = {}
+        if threading.current_thread() is threading.main_thread():
+            for sig in _STOP_SIGNALS:
+                if signal.getsignal(sig) == signal.SIG_DFL:
+                    self._old_handlers[sig] = signal.signal(sig, _raise_on_signal)
         return self
 
     def __exit__(self, *exc: object) -> None:
@@ -315,9 +329,9 @@ class Handle:
                 LIB.j288_robot_stop(self._r)
         finally:
             self.close()
-            if getattr(self, "_old_term", None) is not None:
-                signal.signal(signal.SIGTERM, self._old_term)
-                self._old_term = None
+            for sig, old in getattr(self, "_old_handlers", {}).items():
+                signal.signal(sig, old)
+            self._old_handlers = {}
 
     def __del__(self) -> None:
         try:

@@ -147,8 +147,8 @@ class Bus(_native.Handle):
                 kp: float = 0.0, kd: float = 0.0) -> ServoStatus:
         """One FOC command in the bus's frame: tau = torque + kp (pos - p) + kd (speed - v),
         with the servo's 1 s watchdog on. Returns the reply. Raises J288Error (e.g.
-        J288_ERR_NEG_GAIN, J288_ERR_LIMIT_POS beyond [-pi, pi] in the joint frame: nothing
-        was sent); WatchdogError when the servo had tripped its watchdog (no command for
+        J288_ERR_NEG_GAIN, J288_ERR_LIMIT_POS beyond [-pi, pi] in the joint frame with kp > 0:
+        nothing was sent); WatchdogError when the servo had tripped its watchdog (no command for
         1 s): the command was sent again with the watchdog bit 0, which cleared the trip,
         and the servo took it (the exception's .status is the reply)."""
         t = Target(*(real_arg(v, n) for v, n in ((pos, "pos"), (speed, "speed"),

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from typing import Dict
+from typing import Dict, List
 
 from ._native import LIB
 
@@ -70,6 +70,29 @@ class J288Error(Exception):
 
 class OfflineError(J288Error):
     """J288_ERR_OFFLINE: the device is gone (adapter unplugged, simulator exited)."""
+
+
+class BusLostError(OfflineError):
+    """A bus was lost: it stopped answering, or its device vanished (J288_ERR_OFFLINE).
+    Raised by Robot.cycle() (and run()) when it happened, unless the Robot was made with
+    tolerate_bus_loss=True; the other buses went on (unless stop_on_bus_loss).
+
+    Attributes:
+        buses: the names of the buses lost.
+        gone: of them, those whose device vanished (reopened when it reappears at its path).
+        joints: the names of their joints: not known (read() says so) until they are back.
+        cycle: the cycle's outcome (a Cycle; None from run()), to go on from.
+    """
+
+    def __init__(self, buses: List[str], gone: List[str], joints: List[str],
+                 cycle: object = None, detail: str = "") -> None:
+        self.buses = list(buses)
+        self.gone = list(gone)
+        self.joints = list(joints)
+        self.cycle = cycle
+        what = ", ".join(f"bus '{b}' lost ({'device vanished' if b in gone else 'no reply'})"
+                         for b in buses)
+        super().__init__(-39, detail, what)
 
 
 class NoReplyError(J288Error):

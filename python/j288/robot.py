@@ -13,7 +13,7 @@ from . import _native
 from ._native import (LIB, BusStats, CycleInfo, JointState, JointStats, RobotStats, Target,
                       TimingReport, TimingSummary, c_double, c_uint, c_uint8, int_arg, path_arg,
                       real_arg)
-from .errors import J288Error, error_for
+from .errors import BusLostError, J288Error, error_for
 
 try:  # NumPy is optional: arrays where a loop wants them, lists without it.
     import numpy as _np
@@ -38,6 +38,10 @@ class Cycle:
     complete: bool     #: every joint fresh
     watchdog: int = 0  #: servos found with their watchdog tripped in this cycle (cleared by
     #: the host layer: their next command went out with the watchdog bit 0); never silent
+    lost: Tuple[str, ...] = ()  #: buses lost since the previous cycle (stopped answering or
+    #: vanished; cycle() raises BusLostError for them unless tolerate_bus_loss)
+    back: Tuple[str, ...] = ()  #: buses back since then (answering again, or reopened: then
+    #: their joints restart at lock and their angles are found again; set targets anew)
 
 
 @dataclass(frozen=True)
@@ -90,10 +94,16 @@ class Robot(_native.Handle):
                 robot.set_targets(pos0 + 0.1)    # NumPy arrays, joint frame, rad
                 robot.cycle()
 
-    On exit from the with block (an exception or Ctrl-C included) every bus gets the
-    broadcast lock. A bus that stops answering is left behind by the cycles (its joints go
-    stale, bus_stats() says "down") and picked up again when it answers; a vanished device
-    is left out.
+    On exit from the with block (an exception, Ctrl-C, SIGTERM, SIGHUP or SIGQUIT included)
+    every bus gets the broadcast lock (watchdog bit 0: the servos stay locked).
+
+    A lost bus is never silent: cycle() (and run()) raises BusLostError when a bus stops
+    answering or its device vanishes, naming the buses and their joints (the others go on;
+    catch it to go on too, or make the Robot with tolerate_bus_loss=True and read Cycle.lost).
+    Its joints read not known (read()[3], state().known) until they are back. A bus that
+    stops answering is picked up again when it answers; a vanished device is opened again
+    when it reappears at the same path (a udev symlink), its joints restarted at lock and
+    their angles found again (Cycle.back names it; hold() or set targets anew once known).
 
     Args:
         config: path of the robot config file (str or os.PathLike).
@@ -102,7 +112,7 @@ class Robot(_native.Handle):
         down_after: sweeps without any reply before a bus is down and cycles stop waiting
             for it (default 3; until then a silent bus slows every cycle).
         stop_on_bus_loss: a bus that goes down or vanishes stops every bus and the cycle
-            raises OfflineError (a legged robot is better all locked than half held).
+            raises BusLostError (a legged robot is better all locked than half held).
         realtime: True (priority 80) or a SCHED_FIFO priority 1-99 for the thread that
             creates the Robot (the one that must run its loop: run(), pace(), cycle()), with
             the process's memory locked; close() undoes it. Without the rights a
@@ -110,6 +120,10 @@ class Robot(_native.Handle):
             CAP_SYS_NICE) and the robot runs at normal priority (realtime_notice keeps the
             text). docs/realtime.md.
         cpu: pin that thread to this CPU (one the process may run on, else ValueError).
+        tolerate_bus_loss: a lost bus raises nothing (Cycle.lost names it), and a cycle
+            that finds every bus gone returns a Cycle with nothing fresh instead of raising
+            OfflineError: for robots that ride out an unplugged adapter.
+        reopen: open a vanished device again when it reappears (default True).
     Raises:
         J288Error: J288_ERR_BAD_CONFIG (file errors, with "FILE:LINE: ..." in detail), a
             device that cannot be opened (OfflineError), ...
@@ -120,6 +134,7 @@ class Robot(_native.Handle):
     def __init__(self, config: Union[str, "os.PathLike[str]"],
                  port: Union[str, "os.PathLike[str]", None] = None, margin_us: int = 0,
                  down_after: int = 0, stop_on_bus_loss: bool = False,
+                 tolerate_bus_loss: bool = False, reopen: bool = True,
                  realtime: Union[bool, int] = False, cpu: Optional[int] = None) -> None:
         path = path_arg(config, "config")
         dev = path_arg(port, "port") if port is not None else None
@@ -131,10 +146,12 @@ class Robot(_native.Handle):
             prio = int_arg(realtime, "realtime", 1, 99)
         pin = cpu is not None
         cpu = int_arg(cpu, "cpu", 0, 1023) if pin else 0
+        self._tolerate = bool(tolerate_bus_loss)
+        self._stop_on_loss = bool(stop_on_bus_loss)
         self._r: Optional[ctypes.Array] = _native.new_robot()
         opt = _native.Options(port=dev, margin_us=margin_us, down_after=down_after,
                               stop_on_bus_loss=bool(stop_on_bus_loss), realtime=prio,
-                              pin_cpu=pin, cpu=cpu)
+                              pin_cpu=pin, cpu=cpu, no_reopen=not reopen)
         rc = LIB.j288_robot_open_file(self._r, path, ctypes.byref(opt))
         self._open(rc, os.fsdecode(path))
         r = self._r
@@ -151,6 +168,9 @@ class Robot(_native.Handle):
         self._speed = (c_double * self._n)()
         self._torque = (c_double * self._n)()
         self._known = (c_uint8 * self._n)()
+        # Each bus's (down, gone, back) counts so far: which buses a cycle's counts are about.
+        self._seen: List[Tuple[int, int, int]] = [(0, 0, 0)] * len(self.buses)
+        self._run_losses = 0
 
     # ---- plumbing
     def _check(self, rc: int, what: str = "") -> None:
@@ -169,20 +189,55 @@ class Robot(_native.Handle):
             raise IndexError(f"joint index {joint} outside 0-{self._n - 1}") from None
 
     # ---- the loop
+    def _bus_changes(self) -> Tuple[List[str], List[str], List[str]]:
+        """(lost, gone, back): the buses lost, of them those whose device vanished, and the
+        buses back, since the previous call (from each bus's counters)."""
+        lost, gone, back = [], [], []
+        s = BusStats()
+        for b, name in enumerate(self.buses):
+            self._check(LIB.j288_robot_bus_stats(self._robot(), b, ctypes.byref(s)))
+            seen = (s.down_events, s.gone_events, s.up_events + s.reopens)
+            if seen[0] + seen[1] != sum(self._seen[b][:2]):
+                lost.append(name)
+            if seen[1] != self._seen[b][1]:
+                gone.append(name)
+            if seen[2] != self._seen[b][2]:
+                back.append(name)
+            self._seen[b] = seen
+        return lost, gone, back
+
+    def _lost_error(self, lost: List[str], gone: List[str], cycle: Optional[Cycle]) -> BusLostError:
+        joints = [self.joints[j] for j in range(self._n)
+                  if self.buses[LIB.j288_robot_joint_bus(self._robot(), j)] in lost]
+        return BusLostError(lost, gone, joints, cycle, _native.error_text(self._r))
+
     def cycle(self, timeout: float = 1.0) -> Cycle:
         """Sweep every bus once. Returns the cycle's outcome, also when some joint got no
-        reply (complete False; watchdog > 0: servos found tripped, cleared). timeout: seconds,
-        (0, 4000]. Raises OfflineError when every bus is gone (with stop_on_bus_loss: when
-        one was lost; every bus was stopped)."""
+        reply (complete False; watchdog > 0: servos found tripped, cleared; back: buses back).
+        timeout: seconds, (0, 4000]. Raises BusLostError when a bus was lost since the
+        previous cycle (unless tolerate_bus_loss; with stop_on_bus_loss every bus was
+        stopped), OfflineError when every bus is gone (unless tolerate_bus_loss: then a
+        Cycle with nothing fresh, after waiting for the next reopen attempt)."""
         timeout = real_arg(timeout, "timeout")
         if not 0 < timeout <= _MAX_SECONDS:
             raise ValueError(f"timeout {timeout} s outside (0, {_MAX_SECONDS}]")
         info = CycleInfo()
         rc = LIB.j288_robot_cycle(self._robot(), int(timeout * 1e6), ctypes.byref(info))
+        lost: List[str] = []
+        gone: List[str] = []
+        back: List[str] = []
+        if info.lost or info.back or rc == -39:
+            lost, gone, back = self._bus_changes()
+        c = Cycle(info.cycle, info.duration_us, info.fresh, self._n, bool(info.complete),
+                  info.watchdog, tuple(lost), tuple(back))
+        stopped = rc == -39 and self._stop_on_loss  # the runner stopped every bus
+        if lost and (not self._tolerate or stopped):
+            raise self._lost_error(lost, gone, c)
+        if rc == -39 and self._tolerate and not stopped:
+            return c  # every bus gone: nothing fresh, nothing raised
         if rc not in (0, -31):
             self._check(rc)
-        return Cycle(info.cycle, info.duration_us, info.fresh, info.joints, bool(info.complete),
-                     info.watchdog)
+        return c
 
     def run(self, cycles: int = 0, rate_hz: float = 0.0, duration: float = 0.0) -> None:
         """Cycles in C (no Python per cycle): `cycles` of them (0: no limit) or for `duration`
@@ -192,7 +247,9 @@ class Robot(_native.Handle):
         slice takes it up where the last left it: the rate holds): Ctrl-C (KeyboardInterrupt)
         and other signals reach Python between them, and a with block around the loop then
         stops every bus. A call starts a new schedule. A missed deadline is skipped, never
-        caught up (see pace()). Raises OfflineError when every bus is gone."""
+        caught up (see pace()). Raises BusLostError at the end of the slice in which a bus was
+        lost (unless tolerate_bus_loss: then a run rides out even every bus gone, waiting for
+        the devices to come back)."""
         if not (0 <= cycles < 2**32 and (rate_hz == 0 or 1 / _MAX_SECONDS <= rate_hz)
                 and duration >= 0):
             raise ValueError(f"cycles 0 to 2**32 - 1, rate_hz 0 or from {1 / _MAX_SECONDS}, "
@@ -209,7 +266,14 @@ class Robot(_native.Handle):
             self._check(LIB.j288_robot_stats(r, ctypes.byref(stats)))
             before = stats.cycles
             start = time.monotonic()
-            self._check(LIB.j288_robot_run(r, period, left, this_us))
+            rc = LIB.j288_robot_run(r, period, left, this_us)
+            self._check(LIB.j288_robot_stats(r, ctypes.byref(stats)))
+            if stats.bus_losses != self._run_losses or rc == -39:
+                self._run_losses = stats.bus_losses
+                lost, gone, _ = self._bus_changes()
+                if lost and (not self._tolerate or rc == -39):
+                    raise self._lost_error(lost, gone, None)
+            self._check(rc)
             if left_us is not None:
                 left_us -= max(this_us, int((time.monotonic() - start) * 1e6))
             if cycles:
@@ -232,7 +296,8 @@ class Robot(_native.Handle):
         served meanwhile. A deadline already past when it is called (the loop overran) is
         missed: it returns at once, and whole periods behind are skipped, never run back to
         back. Each call ends a cycle: its duration, the wake-up's lateness, misses and
-        skips go into stats()["timing"]. Raises OfflineError when every bus is gone."""
+        skips go into stats()["timing"]. Raises OfflineError when every bus is gone and
+        reopen is False (with reconnection the next cycle() waits for a device instead)."""
         rate_hz = real_arg(rate_hz, "rate_hz")
         if not 1 / _MAX_SECONDS <= rate_hz <= 1e6:
             raise ValueError(f"rate_hz {rate_hz} outside [{1 / _MAX_SECONDS}, 1e6]")

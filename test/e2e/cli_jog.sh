@@ -171,6 +171,38 @@ t_ctrl_c() {
     press C-c
     wait_rc 130 && wait_broadcast "$LOG" "$before"
 }
+# jog_pid: the pid of the j288 that tmux's pane runs (its shell's child; env execs j288).
+jog_pid() { ps -o pid= --ppid "$(tmux_do display -p -t "$TMUX_NAME" '#{pane_pid}')" | tr -d ' '; }
+t_sighup() {
+    # Issue 29: SIGHUP (its terminal or SSH session closed) stops jog as SIGTERM does: the
+    # broadcast lock, exit 129 (2af1ea0: killed, nothing sent).
+    local before pid
+    start_jog "$COLS" "--config '$CFG' --joint knee"
+    wait_screen '^> knee +hold ' || return 1
+    pid=$(jog_pid)
+    before=$(broadcasts "$LOG")
+    kill -HUP "$pid" || return 1
+    wait_rc 129 && wait_broadcast "$LOG" "$before"
+}
+t_bus_back() {
+    # Issue 29: the simulator killed and started again at the same --link: jog says the bus is
+    # gone, then back with its joints at lock; space holds hip again where it is found; q
+    # then exits 1, naming the bus lost.
+    start_jog "$COLS" "--config '$CFG'"
+    wait_screen '^> hip +hold ' || return 1
+    stop_sim "$SIM_PID"
+    wait_screen "^bus 'left' is gone" || return 1
+    sim_start_linked jog --ids 1,2 --quiet --exit-after "$(e2e_scaled 200)" --start-angle 1:-0.25 || return 1
+    LOG=$SIM_DIR/jog.log
+    wait_screen "^bus 'left' is back: its joints at lock \(space holds\)" || return 1
+    wait_screen '^> hip +lock ' || return 1
+    mark
+    press Space
+    wait_screen '^hip holds at -0\.2[45][0-9]{2} rad' && wait_log ' id=1 status=1 wd=1 ' || return 1
+    press q
+    wait_rc 1 && screen | grep -q "^j288 jog: bus 'left' lost during the command (exit 1)" ||
+        { screen; return 1; }
+}
 t_port_form() {
     start_jog "$COLS" "--port '$DEV' --id 1 --margin-us 250000"
     wait_screen '^> id1 +hold +0\.[0-9]{4} ' && wait_screen 'limits \[-3\.1416, 3\.1416\] rad' || return 1
@@ -189,4 +221,6 @@ run_t every_key t_keys
 run_t ctrl_c_locks t_ctrl_c
 run_t port_form t_port_form
 run_t narrow_terminal t_narrow_terminal
+run_t sighup_locks t_sighup
+run_t bus_back t_bus_back
 e2e_summary

@@ -148,8 +148,8 @@ static void make_config(int nbuses, uint32_t margin_us)
 
 /* ---- events ---------------------------------------------------------------------------- */
 
-static unsigned g_ev_count[6];
-static unsigned g_ev_bus[6];
+static unsigned g_ev_count[7];
+static unsigned g_ev_bus[7];
 static unsigned g_cycles_seen;
 
 static void count_event(void *user, const j288_robot_event_t *ev)
@@ -409,6 +409,7 @@ static void test_missing_device(void)
 static void test_one_bus_stops_answering(void)
 {
     j288_robot_options_t o = counting_options();
+    o.no_reopen = true; /* a gone bus is given up: the run ends when every bus is */
     j288_robot_bus_stats_t bs;
     unsigned i, j;
     int k;
@@ -477,6 +478,118 @@ static void test_one_bus_stops_answering(void)
     (void)j288_robot_cycle(&g_robot, LOADED_CYCLE_US, NULL);
     TEST_ASSERT_EQUAL_INT(J288_ERR_OFFLINE, j288_robot_cycle(&g_robot, LOADED_CYCLE_US, NULL));
     TEST_ASSERT_EQUAL_INT(J288_ERR_OFFLINE, j288_robot_run(&g_robot, 0, 0, 0));
+}
+
+/* Simulator k serving its servos 1, 2, 3 (servo 1 at output angle angle1) on the link
+ * g_link[k], restarted there when it has exited. */
+static char g_link[NSIM][80];
+static void sim_start_linked(int k, const char *angle1)
+{
+    const char *extra[] = {"--link", g_link[k], "--start-angle", angle1, NULL};
+    (void)snprintf(g_link[k], sizeof g_link[k], "/tmp/j288-robot-test-%ld-%d.link",
+                   (long)getpid(), k);
+    sim_start_with(k, "1,2,3", extra);
+}
+
+/* Cycle (each bounded) until cond(): false after 60 s (reopen attempts come
+ * J288_ROBOT_REOPEN_US apart: a count of cycles would be no bound on a fast machine). */
+static bool cycle_until(bool (*cond)(void), j288_robot_cycle_t *sum)
+{
+    uint32_t t0 = j288_robot_now_us();
+    while (!cond() && j288_robot_now_us() - t0 < 60000000u) {
+        j288_robot_cycle_t info;
+        (void)j288_robot_cycle(&g_robot, LOADED_CYCLE_US, &info);
+        if (sum != NULL) {
+            sum->lost += info.lost;
+            sum->back += info.back;
+        }
+    }
+    return cond();
+}
+static bool leg1_gone(void) { return g_ev_count[J288_ROBOT_EV_BUS_GONE] == 1u; }
+static bool leg1_back(void) { return g_ev_count[J288_ROBOT_EV_BUS_BACK] == 1u; }
+static bool leg1_known(void)
+{
+    j288_robot_state_t st;
+    (void)j288_robot_read(&g_robot, 3, &st);
+    return st.known;
+}
+static bool leg0_back(void) { return g_ev_count[J288_ROBOT_EV_BUS_BACK] == 2u; }
+
+/* Reconnection: a bus whose simulator exits is gone (its joints read not known, the cycles
+ * count the loss, the other bus goes on); a simulator started again at the same --link brings
+ * it back restarted from scratch (its joint found again at the new simulator's angle, only
+ * locks sent until a target is set); with every bus gone the cycles say so, a run rides it
+ * out, and a device back at its path is taken again. */
+static void test_a_vanished_bus_comes_back(void)
+{
+    j288_robot_options_t o = counting_options();
+    j288_robot_cycle_t sum;
+    j288_robot_bus_stats_t bs;
+    j288_robot_stats_t rs;
+    j288_robot_state_t st;
+    sim_start_linked(0, "1:0.5");
+    sim_start_linked(1, "1:-1.0");
+    make_config(2, LOADED_MARGIN_US);
+    (void)snprintf(g_cfg.bus[0].port, sizeof g_cfg.bus[0].port, "%s", g_link[0]);
+    (void)snprintf(g_cfg.bus[1].port, sizeof g_cfg.bus[1].port, "%s", g_link[1]);
+    TEST_ASSERT_EQUAL_INT_MESSAGE(J288_OK, j288_robot_open(&g_robot, &g_cfg, &o),
+                                  j288_robot_error(&g_robot));
+    cycle_until_known();
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_robot_hold(&g_robot, 3));
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_robot_read(&g_robot, 3, &st));
+    TEST_ASSERT_DOUBLE_WITHIN(0.01, -1.0, st.pos);
+
+    memset(&sum, 0, sizeof sum);
+    sim_stop(1);
+    TEST_ASSERT_TRUE(cycle_until(leg1_gone, &sum));
+    /* (a simulator on its way out may first miss sweeps enough for a down event) */
+    TEST_ASSERT_EQUAL_UINT(g_ev_count[J288_ROBOT_EV_BUS_GONE] + g_ev_count[J288_ROBOT_EV_BUS_DOWN],
+                           sum.lost);
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_robot_read(&g_robot, 3, &st));
+    TEST_ASSERT_FALSE(st.known || st.online || st.fresh);
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_robot_read(&g_robot, 0, &st));
+    TEST_ASSERT_TRUE(st.known && st.fresh);
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_robot_bus_stats(&g_robot, 1, &bs));
+    TEST_ASSERT_TRUE(bs.gone && bs.gone_events == 1u && bs.reopens == 0u);
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_robot_stats(&g_robot, &rs));
+    TEST_ASSERT_EQUAL_UINT32(sum.lost, rs.bus_losses);
+
+    /* Back at the same link, its servo 1 now at +1.0 rad. */
+    sim_start_linked(1, "1:1.0");
+    TEST_ASSERT_TRUE(cycle_until(leg1_back, &sum));
+    TEST_ASSERT_EQUAL_UINT(1, g_ev_bus[J288_ROBOT_EV_BUS_BACK]);
+    TEST_ASSERT_TRUE(cycle_until(leg1_known, &sum));
+    TEST_ASSERT_EQUAL_UINT(g_ev_count[J288_ROBOT_EV_BUS_BACK] + g_ev_count[J288_ROBOT_EV_BUS_UP],
+                           sum.back);
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_robot_read(&g_robot, 3, &st));
+    TEST_ASSERT_DOUBLE_WITHIN(0.01, 1.0, st.pos);
+    TEST_ASSERT_TRUE(st.online && st.fresh);
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_robot_bus_stats(&g_robot, 1, &bs));
+    TEST_ASSERT_TRUE(!bs.gone && bs.up && bs.reopens == 1u && bs.reopen_attempts >= 1u);
+    /* Only locks (watchdog bit 0) went to the new simulator: its old hold was not resumed. */
+    TEST_ASSERT_TRUE(log_contains(1, " id=1 status=0 wd=0"));
+    TEST_ASSERT_FALSE(log_contains(1, "status=1"));
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_robot_hold(&g_robot, 3));
+    (void)j288_robot_cycle(&g_robot, LOADED_CYCLE_US, NULL);
+    TEST_ASSERT_TRUE(log_wait(1, " id=1 status=1 wd=1"));
+
+    /* Every bus gone: the cycles say so (each waits for a reopen attempt), a run goes on. */
+    sim_stop(0);
+    sim_stop(1);
+    {
+        int rc = J288_OK, i;
+        for (i = 0; i < 100 && rc != J288_ERR_OFFLINE; i++) /* (down first, then gone) */
+            rc = j288_robot_cycle(&g_robot, LOADED_CYCLE_US, NULL);
+        TEST_ASSERT_EQUAL_INT(J288_ERR_OFFLINE, rc);
+    }
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_robot_run(&g_robot, 0, 2, 0));
+    sim_start_linked(0, "1:0.5");
+    TEST_ASSERT_TRUE(cycle_until(leg0_back, NULL));
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_robot_stats(&g_robot, &rs));
+    TEST_ASSERT_EQUAL_UINT(3, g_ev_count[J288_ROBOT_EV_BUS_GONE]);
+    TEST_ASSERT_EQUAL_UINT32(g_ev_count[J288_ROBOT_EV_BUS_GONE] + g_ev_count[J288_ROBOT_EV_BUS_DOWN],
+                             rs.bus_losses);
 }
 
 /* The stop flag (a SIGINT handler's): the run stops every bus and returns ABORTED. */
@@ -1019,6 +1132,7 @@ int main(void)
     RUN_TEST(test_bad_configs);
     RUN_TEST(test_missing_device);
     RUN_TEST(test_one_bus_stops_answering);
+    RUN_TEST(test_a_vanished_bus_comes_back);
     RUN_TEST(test_stop_flag_stops_every_bus);
     RUN_TEST(test_stop_waits_for_a_long_margin);
     RUN_TEST(test_exchange_on_one_port);

@@ -29,7 +29,7 @@ static const char *const cause_names[BRIDGE_NCAUSES] = {
     "joint named twice",      "NaN or infinite value",  "target outside the joint's limits",
     "joint angle not known yet", "bad crc",             "motor mode not 0, 1 or 0x0A",
     "robot stopped after a bus loss", "joint commanded by another writer",
-    "refused by the joint layer",
+    "the joint's bus is gone", "refused by the joint layer",
 };
 
 const char *bridge_cause_name(bridge_cause_t c)
@@ -67,6 +67,7 @@ static bridge_cause_t cause_of(int rc)
     case J288_ERR_RANGE_KP: case J288_ERR_RANGE_KD:
         return BRIDGE_CAUSE_LIMIT;
     case J288_ERR_ANGLE_UNKNOWN: return BRIDGE_CAUSE_UNKNOWN_ANGLE;
+    case J288_ERR_OFFLINE: return BRIDGE_CAUSE_BUS_GONE;
     default: return BRIDGE_CAUSE_OTHER;
     }
 }
@@ -414,11 +415,43 @@ void bridge_dropped(bridge_t *b, uint32_t n, const char *guid)
     snprintf(b->dropped_guid, sizeof b->dropped_guid, "%s", guid);
 }
 
-void bridge_bus_lost(bridge_t *b, unsigned bus, const char *what)
+/* Every joint on bus: at lock and nobody's (the runner has it at lock: gone, or back anew). */
+static void release_joints(bridge_t *b, unsigned bus)
+{
+    unsigned j;
+    for (j = 0; j < j288_robot_njoints(b->robot); j++) {
+        if (j288_robot_joint_bus(b->robot, j) == (int)bus) {
+            b->joint[j].mode = JOINT_IDLE;
+            b->joint[j].owned = false;
+        }
+    }
+}
+
+void bridge_bus_lost(bridge_t *b, unsigned bus, const char *what, bool gone)
 {
     if (bus < J288_ROBOT_MAX_BUSES)
         b->bus_lost[bus]++;
-    fprintf(stderr, "j288-dds: bus '%s' %s\n", j288_robot_bus_name(b->robot, bus), what);
+    fprintf(stderr, "j288-dds: bus '%s' %s%s\n", j288_robot_bus_name(b->robot, bus), what,
+            gone ? ": its joints publish NaN until it is back; reopened when it reappears" : "");
+    if (gone)
+        release_joints(b, bus);
+}
+
+void bridge_bus_back(bridge_t *b, unsigned bus)
+{
+    fprintf(stderr, "j288-dds: bus '%s' is back (its device reopened): its joints restart at "
+                    "lock until commanded\n", j288_robot_bus_name(b->robot, bus));
+    release_joints(b, bus);
+}
+
+void bridge_every_bus_gone(bridge_t *b, bool gone)
+{
+    if (gone == b->all_gone)
+        return;
+    b->all_gone = gone;
+    fprintf(stderr, "j288-dds: %s\n", gone ? "every bus is gone: the bridge stays up, publishing "
+                                              "NaN, and reopens each device when it reappears"
+                                            : "a bus is back: the robot runs again");
 }
 
 void bridge_stopped(bridge_t *b, const char *why)
@@ -454,13 +487,25 @@ void bridge_stamp_now(builtin_interfaces_msg_dds__Time_ *t)
     t->nanosec = (uint32_t)ts.tv_nsec;
 }
 
+/* A joint's state, or NaN (ROS's mark of a value not known) for each value that is not the
+ * joint's now: not known, or not fresh (frozen data is worse than none to a controller). */
+static void state_or_nan(const bridge_t *b, unsigned j, j288_robot_state_t *st)
+{
+    (void)j288_robot_read(b->robot, j, st);
+    if (!st->known || !st->fresh) {
+        st->pos = NAN;
+        st->speed = NAN;
+        st->torque = NAN;
+    }
+}
+
 void bridge_fill_joint_state(bridge_t *b, sensor_msgs_msg_dds__JointState_ *m)
 {
     unsigned n = j288_robot_njoints(b->robot), j;
     for (j = 0; j < n; j++) {
         j288_robot_state_t st;
-        (void)j288_robot_read(b->robot, j, &st);
-        b->pos[j] = st.known ? st.pos : NAN; /* ROS: NaN where a value is unknown */
+        state_or_nan(b, j, &st);
+        b->pos[j] = st.pos;
         b->vel[j] = st.speed;
         b->eff[j] = st.torque;
     }
@@ -485,12 +530,12 @@ static int16_t temp_i16(double c)
     return (int16_t)(c > 32767.0 ? 32767 : c < -32768.0 ? -32768 : lround(c));
 }
 
-/* What both LowState_ carry of one joint: its state, mode (1 while it follows commands) and
- * the cycles its servo gave no reply. */
+/* What both LowState_ carry of one joint: its state (NaN as in joint_states), mode (1 while it
+ * follows commands) and the cycles its servo gave no reply. */
 static void motor_state(bridge_t *b, unsigned j, j288_robot_state_t *st, uint8_t *mode, uint32_t *lost)
 {
     j288_robot_joint_stats_t js;
-    (void)j288_robot_read(b->robot, j, st);
+    state_or_nan(b, j, st);
     (void)j288_robot_joint_stats(b->robot, j, &js);
     *mode = (b->joint[j].mode == JOINT_FOLLOWING) ? 1u : 0u;
     *lost = js.stale_cycles;

@@ -70,6 +70,7 @@ typedef enum {
     BRIDGE_CAUSE_BAD_MODE,    /* unitree mode: motor mode other than 0, 1 or 0x0A */
     BRIDGE_CAUSE_STOPPED,     /* a command while the robot is stopped (a bus lost) */
     BRIDGE_CAUSE_OWNED,       /* the joint is commanded by another writer */
+    BRIDGE_CAUSE_BUS_GONE,    /* the joint's bus is gone (until its device is reopened) */
     BRIDGE_CAUSE_OTHER,       /* any other refusal of the joint layer */
     BRIDGE_NCAUSES
 } bridge_cause_t;
@@ -123,6 +124,7 @@ typedef struct {
     char dropped_guid[BRIDGE_GUID_LEN]; /* the writer of the latest of them */
     uint8_t hg_mode_pr;         /* unitree_hg: the latest applied LowCmd_'s mode_pr */
     uint32_t bus_lost[J288_ROBOT_MAX_BUSES];
+    bool all_gone;              /* every bus is gone (said once an episode) */
     /* what the samples point at */
     char names[J288_ROBOT_MAX_JOINTS][BRIDGE_NAME_LEN];
     double pos[J288_ROBOT_MAX_JOINTS], vel[J288_ROBOT_MAX_JOINTS], eff[J288_ROBOT_MAX_JOINTS];
@@ -156,8 +158,18 @@ void bridge_dropped(bridge_t *b, uint32_t n, const char *guid);
 /* After each cycle: the timeout policy for joints whose command is too old. */
 void bridge_check_timeouts(bridge_t *b, uint32_t now_us);
 
-/* A bus went down or vanished (a runner event): reported and counted. */
-void bridge_bus_lost(bridge_t *b, unsigned bus, const char *what);
+/* A bus went down or vanished (a runner event): reported and counted; when it vanished
+ * (gone true) its joints are no longer followed (their commands are refused until it is
+ * back, no timeout acts on them). */
+void bridge_bus_lost(bridge_t *b, unsigned bus, const char *what, bool gone);
+
+/* A vanished bus's device was reopened (J288_ROBOT_EV_BUS_BACK): reported; its joints restart
+ * at lock, nobody's, until a command comes once their angles are known again. */
+void bridge_bus_back(bridge_t *b, unsigned bus);
+
+/* After each cycle: whether every bus is gone now; said once on stderr at the start and at
+ * the end of each such episode. */
+void bridge_every_bus_gone(bridge_t *b, bool gone);
 
 /* The runner stopped every bus on a bus loss (its stop_on_bus_loss): commands are refused
  * from then on, no joint is driven again (no timeout hold either); why says which bus. */
@@ -166,8 +178,10 @@ void bridge_stopped(bridge_t *b, const char *why);
 /* A servo's watchdog had tripped (a runner event, cleared by the runner): reported. */
 void bridge_watchdog(bridge_t *b, unsigned joint);
 
-/* The robot's state after the latest cycle into a JointState sample (stamp: CLOCK_REALTIME).
- * The sample points into b: valid until the next call. */
+/* The robot's state after the latest cycle into a JointState sample (stamp: CLOCK_REALTIME):
+ * position, velocity and effort NaN for a joint that is not known or not fresh (its angle not
+ * found yet, no reply in the latest cycle, its bus lost). The sample points into b: valid
+ * until the next call. The LowState_ below carry NaN in q, dq and tau_est alike. */
 void bridge_fill_joint_state(bridge_t *b, sensor_msgs_msg_dds__JointState_ *m);
 
 /* The same as a LowState_ (motors in config order, crc set; see docs/dds.md for the fields). */

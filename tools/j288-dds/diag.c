@@ -3,6 +3,7 @@
 #include <stdarg.h>
 #include <stdio.h>
 #include <string.h>
+#include <time.h>
 
 #include "bridge.h"
 
@@ -65,11 +66,50 @@ static void kv(diagnostic_msgs_msg_dds__DiagnosticStatus_ *s, const char *key, c
     s->values._maximum = s->values._length;
 }
 
+/* A time of the runner's clock (j288_robot_now_us()) as UTC wall-clock time, ISO 8601 to the
+ * millisecond ("2024-05-01T12:00:01.234Z"), and how long ago it was (s). */
+static char *wall_time(uint32_t at_us, double *ago_s)
+{
+    struct timespec now;
+    struct tm tm;
+    time_t sec;
+    double t;
+    char day[32];
+    *ago_s = (double)(uint32_t)(j288_robot_now_us() - at_us) * 1e-6;
+    (void)clock_gettime(CLOCK_REALTIME, &now);
+    t = (double)now.tv_sec + 1e-9 * (double)now.tv_nsec - *ago_s;
+    sec = (time_t)t;
+    if (gmtime_r(&sec, &tm) == NULL || strftime(day, sizeof day, "%Y-%m-%dT%H:%M:%S", &tm) == 0u)
+        return str("?");
+    return str("%s.%03dZ", day, (int)((t - (double)sec) * 1000.0));
+}
+
+/* The buses lost now (down or gone), named, with when ("" when none); *gone: how many are gone,
+ * *n: how many lost. */
+static char *lost_buses(bridge_t *b, unsigned *n, unsigned *gone)
+{
+    char *s = str(""), *w;
+    unsigned i;
+    double ago;
+    *n = *gone = 0;
+    for (i = 0; i < j288_robot_nbuses(b->robot); i++) {
+        j288_robot_bus_stats_t bs;
+        if (j288_robot_bus_stats(b->robot, i, &bs) != J288_OK || bs.up)
+            continue;
+        w = wall_time(bs.lost_at_us, &ago);
+        s = str("%s%sbus %s %s at %s", s, (*n)++ > 0u ? "; " : "", j288_robot_bus_name(b->robot, i),
+                bs.gone ? "vanished" : "stopped answering", w);
+        *gone += bs.gone ? 1u : 0u;
+    }
+    return s;
+}
+
 static void bridge_status(bridge_t *b, diagnostic_msgs_msg_dds__DiagnosticArray_ *m)
 {
-    unsigned c, timed_out = 0, j;
+    unsigned c, timed_out = 0, j, nlost, ngone;
     uint32_t total = 0, refused;
     diagnostic_msgs_msg_dds__DiagnosticStatus_ *s;
+    char *lost = lost_buses(b, &nlost, &ngone);
     for (c = 0; c < BRIDGE_NCAUSES; c++)
         total += b->refused[c];
     total += b->dropped;
@@ -77,13 +117,20 @@ static void bridge_status(bridge_t *b, diagnostic_msgs_msg_dds__DiagnosticArray_
     b->refused_reported = total;
     for (j = 0; j < j288_robot_njoints(b->robot); j++)
         timed_out += b->joint[j].mode == JOINT_TIMED_OUT;
-    s = status(m, b->stopped ? LEVEL_ERROR : (timed_out != 0u || refused != 0u) ? LEVEL_WARN : LEVEL_OK,
+    s = status(m, (b->stopped || nlost != 0u) ? LEVEL_ERROR
+                  : (timed_out != 0u || refused != 0u) ? LEVEL_WARN : LEVEL_OK,
                str("j288-dds: bridge"), str("j288-dds"));
     s->message = b->stopped ? str("stopped: %s", b->stop_reason)
+                 : ngone == j288_robot_nbuses(b->robot)
+                     ? str("every bus is gone (%s): waiting for the devices to reappear", lost)
+                 : nlost != 0u ? str("%s: its joints publish NaN", lost)
                  : timed_out != 0u ? str("%u joint(s) timed out", timed_out)
                  : refused != 0u ? str("%lu command(s) refused or dropped since the last report",
                                        (unsigned long)refused)
                                 : str("ok");
+    kv(s, "buses_lost", str("%u", nlost));
+    if (nlost != 0u)
+        kv(s, "lost", lost);
     kv(s, "messages", str("%lu", (unsigned long)b->messages));
     kv(s, "timeout_ms", str("%lu", (unsigned long)(b->timeout_us / 1000u)));
     kv(s, "refused", str("%lu", (unsigned long)(total - b->dropped)));
@@ -103,13 +150,29 @@ static void bus_status(bridge_t *b, unsigned bus, diagnostic_msgs_msg_dds__Diagn
     j288_robot_bus_stats_t bs;
     const char *name = j288_robot_bus_name(b->robot, bus);
     diagnostic_msgs_msg_dds__DiagnosticStatus_ *s;
+    char *lost_at = str("never"), *back_at = str("never");
+    double lost_ago = 0.0, back_ago = 0.0;
     (void)j288_robot_bus_stats(b->robot, bus, &bs);
+    if (bs.down_events + bs.gone_events != 0u)
+        lost_at = wall_time(bs.lost_at_us, &lost_ago);
+    if (bs.up_events + bs.reopens != 0u)
+        back_at = wall_time(bs.back_at_us, &back_ago);
     s = status(m, bs.gone ? LEVEL_ERROR : bs.up ? LEVEL_OK : LEVEL_ERROR,
                str("j288-dds: bus %s", name), str("bus:%s", name));
-    s->message = str("%s", bs.gone ? "gone (device vanished)" : bs.up ? "up" : "down (no reply)");
+    s->message = bs.gone ? str("gone: its device vanished at %s (%.1f s ago); reopened when it "
+                               "reappears at its path", lost_at, lost_ago)
+                 : !bs.up ? str("down: no reply since %s (%.1f s ago)", lost_at, lost_ago)
+                          : str("up");
     kv(s, "sweeps", str("%lu", (unsigned long)bs.sweeps));
     kv(s, "empty_sweeps", str("%lu", (unsigned long)bs.empty_sweeps));
     kv(s, "down_events", str("%lu", (unsigned long)bs.down_events));
+    kv(s, "gone_events", str("%lu", (unsigned long)bs.gone_events));
+    kv(s, "lost_at", lost_at);
+    if (bs.down_events + bs.gone_events != 0u)
+        kv(s, "lost_s_ago", str("%.1f", lost_ago));
+    kv(s, "back_at", back_at);
+    kv(s, "reopens", str("%lu", (unsigned long)bs.reopens));
+    kv(s, "reopen_attempts", str("%lu", (unsigned long)bs.reopen_attempts));
     kv(s, "last_sweep_us", str("%lu", (unsigned long)bs.last_sweep_us));
     kv(s, "worst_sweep_us", str("%lu", (unsigned long)bs.worst_sweep_us));
 }

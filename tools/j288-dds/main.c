@@ -57,6 +57,9 @@ static const char usage[] =
     "                      default 80); without the rights a notice says how to get them\n"
     "                      (ulimit -r, limits.d, CAP_SYS_NICE) and the loop runs on\n"
     "  --cpu N             pin the loop to CPU N (docs/realtime.md)\n"
+    "  --exit-when-gone    exit 1 once every bus is gone, for a supervisor that restarts the\n"
+    "                      bridge (default: stay up and reopen each device when it\n"
+    "                      reappears at its path)\n"
     "  --help, --version\n"
     "Gains: each joint's kp and kd from the config, else kp 20 N*m/rad, kd 2.5 N*m*s/rad.\n"
     "Pacing: cycle k is due at the first cycle's time + k/HZ; a cycle that overruns makes\n"
@@ -66,7 +69,12 @@ static const char usage[] =
     "(p50, p99, p99.9, max).\n"
     "One commander per joint: the first writer whose command for a joint is applied owns it\n"
     "until it has been silent for the timeout; other writers' commands for it are refused.\n"
-    "SIGINT / SIGTERM: every bus locked (broadcast lock, watchdog bit 0), then exit 0.\n"
+    "A joint not known or not fresh (its angle not found yet, no reply in the latest cycle,\n"
+    "its bus lost) is published as NaN (position, velocity, effort); rt/diagnostics names\n"
+    "each lost bus and when it was lost. A vanished device is reopened when it reappears at\n"
+    "the same path (a udev symlink): its joints restart at lock until commanded again.\n"
+    "SIGINT, SIGTERM, SIGHUP, SIGQUIT: every bus locked (broadcast lock, watchdog bit 0),\n"
+    "then exit 0 (1 with --exit-when-gone once every bus was gone).\n"
     "Under systemd (NOTIFY_SOCKET): READY=1 once up, WATCHDOG=1 from the loop when\n"
     "WatchdogSec is set; a loop that stops cycling is killed and restarted by systemd, and\n"
     "its servos lock by their own 1 s watchdog meanwhile.\n";
@@ -80,6 +88,7 @@ typedef struct {
     bridge_mode_t mode;
     bool per_joint;
     bool stop_on_bus_loss;
+    bool exit_when_gone;
     char ns[NS_MAX + 1]; /* without the leading /; "" for none */
     int realtime; /* SCHED_FIFO priority, 0: none */
     int cpu;      /* -1: not pinned */
@@ -90,6 +99,31 @@ static volatile sig_atomic_t stop_signal;
 static void on_signal(int sig)
 {
     stop_signal = sig;
+}
+
+static const char *signal_name(int sig)
+{
+    return sig == SIGINT ? "SIGINT" : sig == SIGHUP ? "SIGHUP" : sig == SIGQUIT ? "SIGQUIT" : "SIGTERM";
+}
+
+/* SIGHUP (a closed terminal or SSH session) and SIGQUIT stop the bridge as SIGTERM does: their
+ * default actions would end it with the servos running their last command until their own
+ * watchdog. One the bridge was started ignoring (nohup) stays ignored. */
+static void install_signals(void)
+{
+    struct sigaction sa, old;
+    static const int unless_ignored[] = {SIGHUP, SIGQUIT};
+    unsigned i;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = on_signal; /* no SA_RESTART: a blocked ppoll() or sleep returns */
+    sigemptyset(&sa.sa_mask);
+    (void)sigaction(SIGINT, &sa, NULL);
+    (void)sigaction(SIGTERM, &sa, NULL);
+    for (i = 0; i < sizeof unless_ignored / sizeof unless_ignored[0]; i++) {
+        if (sigaction(unless_ignored[i], NULL, &old) == 0 && old.sa_handler == SIG_IGN)
+            continue;
+        (void)sigaction(unless_ignored[i], &sa, NULL);
+    }
 }
 
 static int bad_usage(const char *what, const char *arg)
@@ -183,6 +217,9 @@ static int parse(int argc, char **argv, options_t *o, bool *done)
             if (a[10] == '=')
                 o->realtime = (int)v;
             takes = false;
+        } else if (strcmp(a, "--exit-when-gone") == 0) {
+            o->exit_when_gone = true;
+            takes = false;
         } else if (val == NULL) {
             return bad_usage(strncmp(a, "--", 2) == 0 ? "missing value" : "unknown argument", a);
         } else if (strcmp(a, "--config") == 0) {
@@ -241,7 +278,7 @@ static void on_event(void *user, const j288_robot_event_t *ev)
 {
     pending_t *p = user;
     bool bus = ev->kind == J288_ROBOT_EV_BUS_DOWN || ev->kind == J288_ROBOT_EV_BUS_GONE ||
-               ev->kind == J288_ROBOT_EV_BUS_UP;
+               ev->kind == J288_ROBOT_EV_BUS_UP || ev->kind == J288_ROBOT_EV_BUS_BACK;
     if (!bus && !(ev->kind == J288_ROBOT_EV_WATCHDOG && ev->joint >= 0))
         return;
     if (p->n < sizeof p->ev / sizeof p->ev[0]) {
@@ -261,10 +298,13 @@ static void handle_events(bridge_t *b, pending_t *p)
             fprintf(stderr, "j288-dds: bus '%s' answers again\n", j288_robot_bus_name(b->robot, k));
             break;
         case J288_ROBOT_EV_BUS_GONE:
-            bridge_bus_lost(b, k, "vanished (device gone)");
+            bridge_bus_lost(b, k, "vanished (device gone)", true);
             break;
         case J288_ROBOT_EV_BUS_DOWN:
-            bridge_bus_lost(b, k, "stopped answering");
+            bridge_bus_lost(b, k, "stopped answering", false);
+            break;
+        case J288_ROBOT_EV_BUS_BACK:
+            bridge_bus_back(b, k);
             break;
         default:
             bridge_watchdog(b, k);
@@ -687,16 +727,19 @@ static int run(const options_t *o)
         take_commands(&b, &io);
         collect_drops(&b);
         bridge_check_timeouts(&b, j288_robot_now_us());
+        /* (with every bus gone the cycle waits for the next reopen attempt, 0.2 s at most) */
         rc = j288_robot_cycle(&robot, 0, NULL);
         handle_events(&b, &pending);
         if (rc == J288_ERR_ABORTED)
             break;
-        if (rc == J288_ERR_OFFLINE && every_bus_gone(&robot)) {
-            fprintf(stderr, "j288-dds: every bus is gone: %s\n", j288_robot_error(&robot));
+        if (rc == J288_ERR_OFFLINE && o->exit_when_gone && every_bus_gone(&robot)) {
+            fprintf(stderr, "j288-dds: every bus is gone (--exit-when-gone): %s\n",
+                    j288_robot_error(&robot));
             status = 1;
             break;
         }
-        if (rc == J288_ERR_OFFLINE) /* stop on bus loss: the runner locked every bus */
+        bridge_every_bus_gone(&b, every_bus_gone(&robot));
+        if (rc == J288_ERR_OFFLINE && o->stop_on_bus_loss) /* the runner locked every bus */
             bridge_stopped(&b, j288_robot_error(&robot));
         publish_state(&b, &io, start_s);
         if ((uint32_t)(j288_robot_now_us() - last_diag) >= DIAG_PERIOD_US) {
@@ -704,20 +747,20 @@ static int run(const options_t *o)
             publish_diagnostics(&b, &io);
         }
         service_tick((uint64_t)(mono_s() * 1e6), service_status, &sc);
-        rc = j288_robot_pace(&robot, period_us); /* absolute deadlines, j288_rt.h */
-        if (rc == J288_ERR_OFFLINE) {
-            fprintf(stderr, "j288-dds: every bus is gone: %s\n", j288_robot_error(&robot));
-            status = 1;
+        /* absolute deadlines, j288_rt.h (every bus gone: the next cycle waits for one) */
+        if (j288_robot_pace(&robot, period_us) == J288_ERR_ABORTED)
             break;
-        }
     }
     if (stop_signal != 0) {
-        service_stopping(stop_signal == SIGINT ? "SIGINT: locking every bus" : "SIGTERM: locking every bus");
+        char why[64];
+        snprintf(why, sizeof why, "%s: locking every bus", signal_name(stop_signal));
+        service_stopping(why);
         rc = j288_robot_stop(&robot); /* again after an abort: harmless, and the cycle may not
                                          have seen the flag */
-        fprintf(stderr, "j288-dds: %s: every bus locked (%s)\n",
-                stop_signal == SIGINT ? "SIGINT" : "SIGTERM",
-                rc == J288_OK ? "broadcast lock sent" : j288_strerror(rc));
+        fprintf(stderr, "j288-dds: %s: every bus locked (%s)\n", signal_name(stop_signal),
+                rc == J288_OK ? "broadcast lock sent"
+                : every_bus_gone(&robot) ? "every bus is gone: nothing to send"
+                                         : j288_strerror(rc));
         publish_diagnostics(&b, &io);
     } else {
         service_stopping("every bus is gone");
@@ -733,14 +776,9 @@ int main(int argc, char **argv)
 {
     options_t o;
     bool done = false;
-    struct sigaction sa;
     int rc = parse(argc, argv, &o, &done);
     if (rc != 0 || done)
         return rc;
-    memset(&sa, 0, sizeof sa);
-    sa.sa_handler = on_signal; /* no SA_RESTART: a blocked ppoll() or sleep returns */
-    sigemptyset(&sa.sa_mask);
-    (void)sigaction(SIGINT, &sa, NULL);
-    (void)sigaction(SIGTERM, &sa, NULL);
+    install_signals();
     return run(&o);
 }

@@ -884,10 +884,13 @@ int main(int argc, char **argv)
 
     serve(&io, bus, exit_at, &run_mask);
 
-    /* Closing the master hangs up the slave: a client sees its device vanish. */
-    (void)close(io.master);
+    /* The link goes first: once the master is closed the pty's number goes to the next
+     * program that asks for one, and a client reopening the link (the runner's reconnection)
+     * must find nothing there rather than that program's terminal. Closing the master then
+     * hangs up the slave: a client sees its device vanish. */
     if (o.link != NULL)
         remove_link(o.link, path);
+    (void)close(io.master);
     j288_sim_bus_advance(bus, sim_now_us(&io));
     (void)write_truth(&io, bus, sim_now_us(&io), "exit");
     print_stats(&io, bus, "stats");

@@ -26,6 +26,8 @@
 #define CLI_EXIT_NO_TOOL 3 /* an optional helper program (gnuplot) is not installed */
 #define CLI_EXIT_SIGINT  130
 #define CLI_EXIT_SIGTERM 143
+#define CLI_EXIT_SIGHUP  129 /* a closed terminal or SSH session: handled as SIGTERM */
+#define CLI_EXIT_SIGQUIT 131 /* Ctrl-\: handled as SIGTERM */
 
 /* Global options given before the command (`j288 --port DEV --baud N COMMAND`). Commands
  * that talk to a bus take the same options after the command too, which override them. */

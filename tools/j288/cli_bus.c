@@ -115,6 +115,16 @@ void cli_signals_install(void)
     (void)SetConsoleCtrlHandler(on_console_event, TRUE);
 }
 #else
+/* A signal the tool was started ignoring stays ignored: nohup's SIGHUP, a background job's
+ * SIGQUIT (the command then runs on, driving its servos as before: nothing is left loose). */
+static void install_unless_ignored(int sig, const struct sigaction *sa)
+{
+    struct sigaction old;
+    if (sigaction(sig, NULL, &old) == 0 && old.sa_handler == SIG_IGN)
+        return;
+    sigaction(sig, sa, NULL);
+}
+
 void cli_signals_install(void)
 {
     struct sigaction sa;
@@ -124,11 +134,21 @@ void cli_signals_install(void)
     sa.sa_flags = 0; /* no SA_RESTART: a blocking call returns EINTR at once */
     sigaction(SIGINT, &sa, NULL);
     sigaction(SIGTERM, &sa, NULL);
+    /* A closed terminal or SSH session (SIGHUP) and Ctrl-\ (SIGQUIT, whose default would
+     * dump core) stop as SIGTERM does: their default actions leave the servos driven. */
+    install_unless_ignored(SIGHUP, &sa);
+    install_unless_ignored(SIGQUIT, &sa);
 }
 #endif
 
 int cli_signal_exit_code(void)
 {
+#ifndef _WIN32
+    if (cli_stop_signal == SIGHUP)
+        return CLI_EXIT_SIGHUP;
+    if (cli_stop_signal == SIGQUIT)
+        return CLI_EXIT_SIGQUIT;
+#endif
     return cli_stop_signal == SIGTERM ? CLI_EXIT_SIGTERM : CLI_EXIT_SIGINT;
 }
 
@@ -168,6 +188,22 @@ void cli_report_watchdog(const char *what)
     cli_error("%s had tripped its watchdog (no command for 1 s): cleared, and the command "
               "sent again with the watchdog bit 0",
               what);
+}
+
+unsigned cli_report_lost_buses(const j288_robot_t *r)
+{
+    char names[256] = "";
+    unsigned b, n = 0;
+    for (b = 0; b < j288_robot_nbuses(r); b++) {
+        j288_robot_bus_stats_t bs;
+        if (j288_robot_bus_stats(r, b, &bs) != J288_OK || bs.down_events + bs.gone_events == 0u)
+            continue;
+        (void)snprintf(names + strlen(names), sizeof names - strlen(names), "%s'%s'",
+                       n++ > 0u ? ", " : "", j288_robot_bus_name(r, b));
+    }
+    if (n > 0u)
+        cli_error("%s %s lost during the command (exit 1)", n > 1u ? "buses" : "bus", names);
+    return n;
 }
 
 int cli_bus_baud(uint32_t given, uint32_t *baud)

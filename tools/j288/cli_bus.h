@@ -105,6 +105,11 @@ void cli_print_notices(const char *notices);
  * J288_ROBOT_EV_WATCHDOG event). */
 void cli_report_watchdog(const char *what);
 
+/* Say in one error line which buses were lost (went down or vanished) since r was opened:
+ * "bus 'leg1' lost during the command (exit 1)". Returns how many; 0 says nothing. A front end
+ * that drives joints exits CLI_EXIT_FAIL on any (issue 29: no silent robot fault). */
+unsigned cli_report_lost_buses(const j288_robot_t *r);
+
 /* Start from the global options (cli_global_t). */
 void cli_bus_opts_init(cli_bus_opts_t *o, const cli_global_t *g);
 
@@ -120,10 +125,13 @@ int cli_parse_bus_args(int argc, char **argv, const cli_opt_t *opts, const char 
  * CLI_BUS_OPT_BASE are not common: returns 1 (not handled). */
 int cli_bus_common_opt(cli_bus_opts_t *o, int key, const char *value);
 
-/* SIGINT/SIGTERM record the signal in cli_stop_signal (the first one wins). */
+/* SIGINT, SIGTERM, SIGHUP (a closed terminal or SSH session) and SIGQUIT record the signal
+ * in cli_stop_signal (the first one wins): each stops a command the same way. A SIGHUP or
+ * SIGQUIT the process was started ignoring (nohup, a background job) stays ignored. */
 void cli_signals_install(void);
 
-/* Exit code for a command stopped by a signal (130 or 143). */
+/* Exit code for a command stopped by a signal, 128 + its number as a shell reports a process
+ * killed by it: 130 SIGINT, 143 SIGTERM, 129 SIGHUP, 131 SIGQUIT. */
 int cli_signal_exit_code(void);
 
 /* The line rate: given (a --baud, or 0), else $J288_BAUD when set, else 0 (the default). 0, or

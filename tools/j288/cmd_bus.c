@@ -1062,7 +1062,8 @@ static int run_drive(drive_args_t *d, cli_bus_opts_t *o)
     "limits starts from the nearest one (it is pulled in); farther out it is refused (exit 2).\n" \
     "The joint angle is watched: if it is lost (power cycle, slipped gear) the servo is\n"       \
     "locked and the command fails.\n"                                                             \
-    "Ctrl-C or SIGTERM: the servo is sent lock before exiting (exit 130 / 143).\n"                 \
+    "Ctrl-C, SIGTERM, SIGHUP or SIGQUIT: the servo is sent lock before exiting (exit 130, 143,\n" \
+    "129, 131).\n"                                                                                \
     "Exit status: 0 done; 1 no reply, servo stopped answering, joint angle unknown or lost,\n"     \
     "or device error; 2 bad arguments or a target outside the limits.\n"                         \
     "\n" CLI_BUS_RT_HELP

@@ -41,11 +41,13 @@ static const char jog_help[] =
     "  q                quit\n"
     "The target moves to a new value at --speed (or the joint's max_speed when lower), with\n"
     "that speed as feed-forward; the plot and --csv show that ramped target.\n"
-    "When jog ends (q, Ctrl-C, SIGTERM, every bus gone) it sends the broadcast lock on every\n"
+    "When jog ends (q, Ctrl-C, SIGTERM, SIGHUP, SIGQUIT) it sends the broadcast lock on every\n"
     "bus: every servo goes limp (no holding torque), so support a joint that carries a load\n"
     "before you quit. If jog itself dies (killed, frozen), the servos' 1 s watchdog (on for\n"
     "every moving command) locks them. At the end it prints each joint's last gains, to copy\n"
     "into the robot config (kp:, kd:).\n"
+    "A bus that vanishes locks its joints; jog stays, and reopens it when it reappears at the\n"
+    "same path (its joints then at lock: space holds one where it is).\n"
     "  --joint NAME     the joint selected first (default the config's first)\n"
     "  --id N           (with --port, without --config) the servo, 0-14\n"
     "  --step RAD       target step, 0.0001-1 (default 0.05)\n"
@@ -56,9 +58,9 @@ static const char jog_help[] =
     "                   (pos_des_rad is the ramped target; `j288 plot` reads it), then\n"
     "                   joint, kp, kd, cycle\n"
     "Exit status: 0 quit with q; 1 the joint never answered or its angle stayed unknown, a\n"
-    "device or config error, every bus gone, a servo's watchdog had tripped; 2 bad\n"
-    "arguments (and on Windows: not available there); 130/143 stopped by SIGINT/SIGTERM\n"
-    "after the locks.\n"
+    "device or config error, a bus lost (stopped answering or vanished) meanwhile, a servo's\n"
+    "watchdog had tripped; 2 bad arguments (and on Windows: not available there);\n"
+    "130/143/129/131 stopped by SIGINT/SIGTERM/SIGHUP/SIGQUIT after the locks.\n"
     "  --realtime[=PRIO], --cpu N  the loop under SCHED_FIFO (default 80) with memory locked,\n"
     "                   on CPU N (docs/realtime.md; as `j288 log --help` says)\n"
     "\n" CLI_BUS_COMMON_HELP;
@@ -314,11 +316,17 @@ static void on_event(void *user, const j288_robot_event_t *ev)
                        ev->joint >= 0 ? j288_robot_joint_name(g->r, (unsigned)ev->joint) : "?");
         say(g, "%s had tripped its watchdog: cleared", g->trip_what);
     } else if (ev->kind == J288_ROBOT_EV_BUS_DOWN || ev->kind == J288_ROBOT_EV_BUS_UP ||
-               ev->kind == J288_ROBOT_EV_BUS_GONE) {
+               ev->kind == J288_ROBOT_EV_BUS_GONE || ev->kind == J288_ROBOT_EV_BUS_BACK) {
+        unsigned j;
         say(g, "bus '%s' %s", j288_robot_bus_name(g->r, ev->bus),
-            ev->kind == J288_ROBOT_EV_BUS_DOWN ? "stopped answering"
-                                               : (ev->kind == J288_ROBOT_EV_BUS_UP ? "answers again"
-                                                                                   : "is gone"));
+            ev->kind == J288_ROBOT_EV_BUS_DOWN   ? "stopped answering"
+            : ev->kind == J288_ROBOT_EV_BUS_UP   ? "answers again"
+            : ev->kind == J288_ROBOT_EV_BUS_GONE ? "is gone"
+                                                 : "is back: its joints at lock (space holds)");
+        /* Its joints restart at lock (the runner's reconnection): nothing of theirs is held. */
+        for (j = 0; ev->kind == J288_ROBOT_EV_BUS_BACK && j < j288_robot_njoints(g->r); j++)
+            if (j288_robot_joint_bus(g->r, j) == (int)ev->bus)
+                g->j[j].held = false;
     }
 }
 
@@ -677,6 +685,8 @@ int cli_cmd_jog(int argc, char **argv, const cli_global_t *gl)
         cli_report_watchdog(g.trip_what);
     if (rc == J288_OK || rc == J288_ERR_ABORTED)
         print_gains(&g);
+    if (cli_stop_signal == 0 && rc == J288_OK && cli_report_lost_buses(&robot) != 0u)
+        rc = J288_ERR_OFFLINE;
     j288_robot_close(&robot);
     if (cli_stop_signal != 0)
         return cli_signal_exit_code();

@@ -196,7 +196,8 @@ static const char calibrate_help[] =
     "small a span, residuals beyond the tolerance, a ratio off N) writes nothing. A phase\n"
     "already in the file is ignored during the motion (the joint runs uncalibrated), and the\n"
     "new one is checked by a calibrated start at the end.\n"
-    "Ctrl-C or SIGTERM: the servo is sent lock, nothing written (exit 130 / 143).\n"
+    "Ctrl-C, SIGTERM, SIGHUP or SIGQUIT: the servo is sent lock, nothing written (exit 130,\n"
+    "143, 129, 131).\n"
     "Exit status: 0 written (or printed); 1 no reply, angle unknown or lost, a failed fit,\n"
     "the file could not be written; 2 bad arguments or no room inside the limits.\n"
     "\n" CLI_BUS_COMMON_HELP;

@@ -48,7 +48,8 @@ static const char log_help[] =
     "due: that tick starts late; ticks a whole period behind are skipped, never bunched),\n"
     "the loop's timing, bus statistics and, when driving, the tracking error. --csv is\n"
     "written from the loop (buffered, 64 KiB at a time): the tightest timing logs without\n"
-    "it. Ctrl-C or SIGTERM: every driven servo is sent lock before exiting (exit 130 / 143).\n"
+    "it. Ctrl-C, SIGTERM, SIGHUP or SIGQUIT: every driven servo is sent lock before exiting\n"
+    "(exit 130, 143, 129, 131).\n"
     "Exit status: 0 done; 1 a servo never answered, device error; 2 bad arguments.\n"
     "\n" CLI_BUS_RT_HELP "\n" CLI_BUS_COMMON_HELP;
 

@@ -37,7 +37,7 @@ static const char robot_help[] =
     "  --hold         (log) hold every joint while logging\n"
     "  --json         (status, log, hold, stop) machine-readable output\n"
     "  --stop-on-bus-loss  (log, hold) a bus that stops answering or vanishes stops every\n"
-    "                 bus and ends the command (exit 1): no half-held robot\n"
+    "                 bus and ends the command: no half-held robot\n"
     "  --realtime[=PRIO]  (log, hold) memory locked, the loop under SCHED_FIFO at PRIO\n"
     "                 (1-99, default 80); refused without the rights: a notice says how to\n"
     "                 get them (ulimit -r, limits.d, CAP_SYS_NICE), and the loop runs on\n"
@@ -47,11 +47,16 @@ static const char robot_help[] =
     "skipped, never sent back to back. The summary's timing lines: deadlines missed,\n"
     "periods skipped, cycles cut at their bound, wake-up lateness and cycle duration (p50,\n"
     "p99, p99.9, max); docs/realtime.md.\n"
-    "A bus that stops answering is left behind (its joints go stale, reported at the end);\n"
-    "a servo found with its watchdog tripped is cleared and reported (exit 1);\n"
-    "Ctrl-C or SIGTERM sends the broadcast lock on every bus before exiting (130 / 143).\n"
-    "Exit status: 0 done; 1 a device or config error, or a joint that never answered;\n"
-    "2 bad arguments.\n";
+    "A bus that stops answering or vanishes is lost: the others go on without it (its joints\n"
+    "go stale, reported at the end) and the command exits 1 when it ends. A vanished device\n"
+    "is opened again when it reappears at the same path (a udev symlink): its joints restart\n"
+    "at lock, their angles found again; hold (and log --hold) then holds each where it is.\n"
+    "A servo found with its watchdog tripped is cleared and reported (exit 1).\n"
+    "Ctrl-C, SIGTERM, SIGHUP or SIGQUIT sends the broadcast lock on every bus before exiting\n"
+    "(130, 143, 129, 131). After the tool has gone every servo stays locked (no torque).\n"
+    "Exit status: 0 done; 1 a device or config error, a joint that never answered, or a bus\n"
+    "lost during the command (whether or not --stop-on-bus-loss stopped the rest); 2 bad\n"
+    "arguments.\n";
 
 enum {
     OPT_CONFIG = 0,
@@ -93,6 +98,7 @@ typedef struct {
     unsigned joint_events, bus_events;
     bool held; /* every joint held where it was (pos_des: the hold pose) */
     double hold_pos[J288_ROBOT_MAX_JOINTS];
+    bool rehold[J288_ROBOT_MAX_JOINTS]; /* back with its bus: hold once its angle is known */
 } robot_run_t;
 
 
@@ -219,12 +225,16 @@ static void on_event(void *user, const j288_robot_event_t *ev)
 {
     robot_run_t *run = user;
     if (ev->kind == J288_ROBOT_EV_BUS_DOWN || ev->kind == J288_ROBOT_EV_BUS_UP ||
-        ev->kind == J288_ROBOT_EV_BUS_GONE) {
-        static const char *const what[] = {"", "", "stopped answering", "answers again",
-                                           "is gone"};
+        ev->kind == J288_ROBOT_EV_BUS_GONE || ev->kind == J288_ROBOT_EV_BUS_BACK) {
+        static const char *const what[] = {
+            "", "", "stopped answering", "answers again", "is gone", "",
+            "is back (its device reopened): its joints restart at lock"};
+        unsigned j;
         run->bus_events++;
         fprintf(stderr, "j288: bus '%s' %s\n", j288_robot_bus_name(run->robot, ev->bus),
                 what[ev->kind]);
+        for (j = 0; ev->kind == J288_ROBOT_EV_BUS_BACK && j < j288_robot_njoints(run->robot); j++)
+            run->rehold[j] = run->held && j288_robot_joint_bus(run->robot, j) == (int)ev->bus;
     } else if (ev->kind == J288_ROBOT_EV_JOINT) {
         run->joint_events++;
     } else if (ev->kind == J288_ROBOT_EV_WATCHDOG) {
@@ -236,10 +246,35 @@ static void on_event(void *user, const j288_robot_event_t *ev)
     }
 }
 
+/* A bus back from the dead: each of its joints is held where it is found (no jump), once
+ * its angle is known again; a joint found beyond its limits stays at lock. */
+static void rehold(robot_run_t *run, j288_robot_t *r)
+{
+    unsigned j;
+    for (j = 0; j < j288_robot_njoints(r); j++) {
+        j288_robot_state_t st;
+        int rc;
+        if (!run->rehold[j] || j288_robot_read(r, j, &st) != J288_OK || !st.known)
+            continue;
+        run->rehold[j] = false;
+        rc = j288_robot_hold(r, j);
+        if (rc == J288_OK) {
+            (void)j288_robot_read(r, j, &st);
+            run->hold_pos[j] = st.pos;
+            fprintf(stderr, "j288: joint '%s' found again at %.4f rad: held there\n",
+                    j288_robot_joint_name(r, j), st.pos);
+        } else {
+            cli_error("joint %s: found again at %.4f rad, not held (%s): left at lock",
+                      j288_robot_joint_name(r, j), st.pos, j288_strerror(rc));
+        }
+    }
+}
+
 static void on_cycle(void *user, j288_robot_t *r, const j288_robot_cycle_t *c)
 {
     robot_run_t *run = user;
     unsigned j;
+    rehold(run, r);
     if (run->csv == NULL)
         return;
     for (j = 0; j < j288_robot_njoints(r); j++) {
@@ -454,6 +489,8 @@ static int finish(j288_robot_t *r, int code)
     if (cli_stop_signal != 0) {
         (void)j288_robot_stop(r);
         code = cli_signal_exit_code();
+    } else if (code == CLI_EXIT_OK && cli_report_lost_buses(r) != 0u) {
+        code = CLI_EXIT_FAIL;
     }
     j288_robot_close(r);
     return code;

@@ -37,7 +37,8 @@ static const char top_help[] =
     "known yet, - when it never answered. Counters: docs/troubleshooting.md says what each\n"
     "means.\n"
     "Exit status: 0 quit with q, or one frame printed; 1 no servo answered, a device or\n"
-    "config error, every bus gone; 2 bad arguments; 130/143 stopped by SIGINT/SIGTERM.\n"
+    "config error, every bus gone; 2 bad arguments; 130/143/129/131 stopped by\n"
+    "SIGINT/SIGTERM/SIGHUP/SIGQUIT.\n"
     "\n" CLI_BUS_RT_HELP "\n" CLI_BUS_COMMON_HELP;
 
 #define TOP_ACQUIRE_CYCLES 200u /* the most cycles --once waits for every angle */
@@ -330,7 +331,8 @@ static int plot_joints(const j288_robot_t *r, const char *names, const top_args_
     return 0;
 }
 
-/* Redraw every interval until q, a signal or the loss of every bus; v cycles the plot. */
+/* Redraw every interval until q or a signal (a bus gone is shown, and reopened when it
+ * reappears at its path); v cycles the plot. */
 static int live(j288_robot_t *r, const top_args_t *a, const char *source, top_plot_t *pl)
 {
     uint32_t period_us = (uint32_t)(1e6 / a->rate_hz + 0.5);

@@ -57,8 +57,8 @@ static void usage(FILE *f)
           "\n"
           "exit status: 0 success; 1 invalid frame, device or bus failure (no reply, servo\n"
           "absent, device in use or gone); 2 bad command line; 3 optional helper missing\n"
-          "(plot without gnuplot); 130/143 stopped by SIGINT/SIGTERM after locking every\n"
-          "servo the command drove.\n",
+          "(plot without gnuplot); 130/143/129/131 stopped by SIGINT/SIGTERM/SIGHUP/SIGQUIT\n"
+          "after locking every servo the command drove.\n",
           f);
 }
 
