@@ -212,7 +212,8 @@ enum {
     OPT_WATCHDOG,
     OPT_KEEP,
     OPT_ARRIVE,
-    OPT_RANGE
+    OPT_RANGE,
+    OPT_THEN
 };
 
 typedef struct {
@@ -381,6 +382,9 @@ int cli_cmd_stop(int argc, char **argv, const cli_global_t *g)
  */
 
 typedef enum { DRIVE_HOLD, DRIVE_MOVE, DRIVE_TORQUE } drive_kind_t;
+/* How a drive that ends normally (--duration, --arrive, the move done) leaves the servo: a
+ * signal or a failure always locks. */
+typedef enum { THEN_LOCK = 0, THEN_HOLD = 1, THEN_KEEP } drive_then_t;
 enum { SIDE_ROTOR = 0, SIDE_OUTPUT = 1, SIDE_JOINT = 2 };
 
 typedef struct {
@@ -394,6 +398,8 @@ typedef struct {
     double duration_s; /* < 0: until a signal */
     bool watchdog;
     bool keep;
+    bool have_then;
+    drive_then_t then; /* move: THEN_HOLD by default; hold, torque: THEN_LOCK */
     double arrive; /* move --arrive: the tolerance in rad (on the move's side); < 0: none */
     /* The joint (side joint) */
     cli_joint_sel_t sel;
@@ -471,6 +477,15 @@ static int parse_drive_opt(void *ctx, int key, const char *v)
     case OPT_KEEP:
         d->keep = true;
         return 0;
+    case OPT_THEN: {
+        static const char *const ends[] = {"lock", "hold", NULL};
+        if (cli_parse_choice("--then", v, ends, &choice) != 0) {
+            return -1;
+        }
+        d->have_then = true;
+        d->then = choice == 1 ? THEN_HOLD : THEN_LOCK;
+        return 0;
+    }
     case OPT_ARRIVE:
         if (cli_parse_real("--arrive", v, &d->arrive) != 0) {
             return -1;
@@ -680,6 +695,8 @@ typedef struct {
     double last_target; /* side joint: the latest target position */
     bool reached;       /* move: the ramp got to --pos */
     bool arrived;       /* move --arrive: reached, and the servo within the tolerance */
+    bool holding;       /* --then hold: the last hold went out (watchdog bit 0), confirmed */
+    double hold_pos;    /* where, rad on the drive's side */
     bool progress;      /* a progress line is on the terminal */
     double shown_s;     /* when it was last redrawn */
 } drive_result_t;
@@ -733,7 +750,11 @@ static void drive_report_json(const drive_args_t *d, const drive_result_t *r, co
     cli_json_uint(&j, "failures", r->failed);
     cli_json_uint(&j, "overruns", r->overruns);
     cli_json_timing(&j, r->robot);
-    cli_json_bool(&j, "locked", !d->keep || cli_stop_signal != 0);
+    cli_json_bool(&j, "locked", !r->holding && (d->then != THEN_KEEP || cli_stop_signal != 0));
+    cli_json_bool(&j, "holding", r->holding);
+    if (r->holding) {
+        cli_json_real(&j, "hold_pos", r->hold_pos);
+    }
     if (d->side == SIDE_JOINT) {
         cli_json_str(&j, "side", "joint");
         cli_json_real(&j, "target_pos", r->last_target);
@@ -751,11 +772,26 @@ static void drive_report_json(const drive_args_t *d, const drive_result_t *r, co
     cli_json_newline(&j);
 }
 
+/* What the servo does now that the command has ended, for the summary line. */
+static const char *drive_end_text(const drive_args_t *d, const drive_result_t *r, char *buf,
+                                  size_t len)
+{
+    if (r->holding) {
+        (void)snprintf(buf, len,
+                       "holding at %.6g rad with the watchdog off: the servo keeps holding after "
+                       "exit (`j288 stop --id %lld` releases it)",
+                       r->hold_pos, d->id);
+        return buf;
+    }
+    return (d->then == THEN_KEEP && cli_stop_signal == 0) ? "last command left in force (--keep)"
+                                                          : "servo locked";
+}
+
 static void drive_report(const drive_args_t *d, const drive_result_t *r, const char *how,
                          bool json)
 {
     j288_side_t side = side_of(d);
-    char list[512];
+    char list[512], end[200];
     if (json) {
         drive_report_json(d, r, how);
         return;
@@ -779,8 +815,7 @@ static void drive_report(const drive_args_t *d, const drive_result_t *r, const c
     printf("%s: %lu commands, %lu replies, %lu failed, %lu late cycles; %s\n", how,
            (unsigned long)r->sent, (unsigned long)r->ok, (unsigned long)r->failed,
            (unsigned long)r->overruns,
-           (d->keep && cli_stop_signal == 0) ? "last command left in force (--keep)"
-                                             : "servo locked");
+           drive_end_text(d, r, end, sizeof end));
     cli_print_timing(stdout, r->robot);
 }
 
@@ -793,7 +828,7 @@ typedef enum {
 } drive_end_t;
 
 /* The options each command requires. */
-static int drive_check(const drive_args_t *d)
+static int drive_check(drive_args_t *d)
 {
     if (d->kind == DRIVE_MOVE && !d->have_pos) {
         cli_error("--pos is required");
@@ -802,6 +837,21 @@ static int drive_check(const drive_args_t *d)
     if (d->kind == DRIVE_TORQUE && !d->have_tau) {
         cli_error("--tau is required");
         return -1;
+    }
+    if (d->keep && d->have_then) {
+        cli_error("--keep and --then exclude each other");
+        return -1;
+    }
+    /* A torque left in force once the tool has gone has nothing to stop it at the joint's
+     * limits (they live in the host), and a position hold would be a command torque never
+     * sent: a torque ends locked. */
+    if (d->kind == DRIVE_TORQUE && d->then == THEN_HOLD) {
+        cli_error("--then hold: torque ends with lock (a torque left running after exit has "
+                  "no limits to stop it; hold the joint with `j288 hold --then hold`)");
+        return -1;
+    }
+    if (d->keep) {
+        d->then = THEN_KEEP;
     }
     return 0;
 }
@@ -981,20 +1031,70 @@ static drive_end_t drive_loop(cli_bus_t *b, drive_args_t *d, const drive_plan_t 
     return end;
 }
 
-/* After the loop: lock the servo (unless --keep at the end of --duration), report. Returns
- * the exit status. */
-static int drive_finish(cli_bus_t *b, const drive_args_t *d, const drive_result_t *res,
-                        drive_end_t end, bool json)
+/* The hold a drive ends with (--then hold): the last target it sent (--pos once the move got
+ * there), speed 0, its gains, with the watchdog bit 0 so that the servo keeps it after the tool
+ * has gone. Sent until confirmed (as a lock is); false when it was not (then the caller locks). */
+#define HOLD_CONFIRM_ATTEMPTS 5
+static bool drive_hold_after(cli_bus_t *b, drive_args_t *d, const drive_plan_t *p,
+                             drive_result_t *res)
 {
+    j288_cmd_raw_t cmd = res->last_cmd;
+    int attempt, rc = J288_ERR_TIMEOUT;
+    if (res->sent == 0u) { /* --duration 0: nothing went out yet */
+        drive_setpoint(d, p, 0.0, &cmd);
+    }
+    if (d->side == SIDE_JOINT) {
+        j288_joint_target_t tg;
+        memset(&tg, 0, sizeof tg);
+        tg.pos = (j288_real_t)res->last_target;
+        tg.kp = (j288_real_t)p->jkp;
+        tg.kd = (j288_real_t)p->jkd;
+        if (j288_joint_command(&d->j, &tg, &cmd, NULL) != J288_OK) {
+            return false;
+        }
+        res->hold_pos = res->last_target;
+    } else {
+        cmd.speed = 0;
+        res->hold_pos = (double)j288_pos_from_raw(cmd.pos, side_of(d));
+    }
+    cmd.watchdog = false;
+    for (attempt = 0; attempt < HOLD_CONFIRM_ATTEMPTS && rc != J288_OK; attempt++) {
+        if (cli_stop_signal != 0) {
+            return false;
+        }
+        rc = cli_bus_transfer(b, &cmd, NULL);
+        if (rc == J288_ERR_OFFLINE) {
+            return false;
+        }
+    }
+    res->holding = rc == J288_OK;
+    return res->holding;
+}
+
+/* After the loop: lock the servo, or (--then hold) leave it holding, or (--keep) leave its
+ * last command; report. A signal locks whatever --then says. Returns the exit status. */
+static int drive_finish(cli_bus_t *b, drive_args_t *d, const drive_plan_t *p,
+                        drive_result_t *res, drive_end_t end, bool json)
+{
+    const char *left;
     if (end == DRIVE_END_GONE || end == DRIVE_END_SILENT || end == DRIVE_END_JOINT) {
         return CLI_EXIT_FAIL;
     }
-    if (cli_stop_signal != 0 || !d->keep) {
+    if (cli_stop_signal == 0 && d->then == THEN_HOLD && !drive_hold_after(b, d, p, res) &&
+        cli_stop_signal == 0) {
+        (void)cli_bus_lock_driven(b);
+        cli_error("servo %lld did not confirm the hold at the end; lock sent", d->id);
+        return CLI_EXIT_FAIL;
+    }
+    if (cli_stop_signal != 0 || d->then == THEN_LOCK) {
+        res->holding = false;
         if (cli_bus_lock_driven(b) != 0) {
             cli_error("servo %lld did not confirm the lock (a broadcast lock was sent)", d->id);
             return cli_stop_signal != 0 ? cli_signal_exit_code() : CLI_EXIT_FAIL;
         }
     }
+    left = res->holding ? "holding at the last target"
+                        : (d->then == THEN_KEEP ? "last target left in force" : "servo locked");
     if (d->kind == DRIVE_MOVE && end == DRIVE_END_DONE &&
         !(d->arrive > 0.0 ? res->arrived : res->reached)) {
         /* --duration ended the move before --pos (or before the servo got there, with
@@ -1002,7 +1102,7 @@ static int drive_finish(cli_bus_t *b, const drive_args_t *d, const drive_result_
         drive_report(d, res, "cut short by --duration", json);
         cli_error("the move ended after --duration %g s before %s --pos %g (%s)", d->duration_s,
                   res->reached ? "the servo settled within --arrive of" : "reaching", d->pos,
-                  d->keep ? "last target left in force" : "servo locked");
+                  left);
         return CLI_EXIT_FAIL;
     }
     drive_report(d, res, end == DRIVE_END_SIGNAL ? "stopped by signal" : "done", json);
@@ -1036,10 +1136,10 @@ static int run_drive(drive_args_t *d, cli_bus_opts_t *o)
     }
     memset(&res, 0, sizeof res);
     if ((ec = drive_start(&b, d, &plan, &res)) == CLI_EXIT_OK) {
-        ec = drive_finish(&b, d, &res, drive_loop(&b, d, &plan, &res), o->json);
+        ec = drive_finish(&b, d, &plan, &res, drive_loop(&b, d, &plan, &res), o->json);
     }
-    if (d->keep && cli_stop_signal == 0) {
-        cli_bus_close_keep(&b); /* --keep: the last command stays in force */
+    if ((d->then == THEN_KEEP || res.holding) && cli_stop_signal == 0) {
+        cli_bus_close_keep(&b); /* --keep, --then hold: the last command stays in force */
     } else {
         cli_bus_close(&b);
     }
@@ -1050,8 +1150,8 @@ static int run_drive(drive_args_t *d, cli_bus_opts_t *o)
     "  --rate HZ        command refresh rate, default 200\n"                                       \
     "  --duration S     stop after S seconds; default: run until Ctrl-C or SIGTERM\n"              \
     "  --watchdog W     on (default): the servo locks itself if commands stop for 1 s\n"           \
-    "  --keep           at the end of --duration leave the last command in force instead\n"        \
-    "                   of locking (with the watchdog on the servo locks itself 1 s later)\n"      \
+    "  --keep           at the end leave the last command in force instead (with the\n"            \
+    "                   watchdog on the servo locks itself 1 s later); excludes --then\n"          \
     "  --side S         joint (default): the absolute joint frame (output encoder angle\n"         \
     "                   wrapped to [-pi, pi), or the --config joint's zero, direction,\n"          \
     "                   limits and gains); rotor: the raw rotor frame; output: rotor / N,\n"       \
@@ -1062,8 +1162,8 @@ static int run_drive(drive_args_t *d, cli_bus_opts_t *o)
     "limits starts from the nearest one (it is pulled in); farther out it is refused (exit 2).\n" \
     "The joint angle is watched: if it is lost (power cycle, slipped gear) the servo is\n"       \
     "locked and the command fails.\n"                                                             \
-    "Ctrl-C, SIGTERM, SIGHUP or SIGQUIT: the servo is sent lock before exiting (exit 130, 143,\n" \
-    "129, 131).\n"                                                                                \
+    "Ctrl-C, SIGTERM, SIGHUP or SIGQUIT is an abort, not an end: the servo is sent lock\n"        \
+    "before exiting, whatever --then says (exit 130, 143, 129, 131); so is a failure.\n"         \
     "Exit status: 0 done; 1 no reply, servo stopped answering, joint angle unknown or lost,\n"     \
     "or device error; 2 bad arguments or a target outside the limits.\n"                         \
     "\n" CLI_BUS_RT_HELP
@@ -1071,7 +1171,8 @@ static int run_drive(drive_args_t *d, cli_bus_opts_t *o)
 #define DRIVE_OPTS                                                                                 \
     {"--id", true, OPT_ID}, {"--joint", true, OPT_JOINT}, {"--side", true, OPT_SIDE},              \
         {"--rate", true, OPT_RATE}, {"--duration", true, OPT_DURATION},                            \
-        {"--watchdog", true, OPT_WATCHDOG}, {"--keep", false, OPT_KEEP}, CLI_BUS_RT_OPTS,         \
+        {"--watchdog", true, OPT_WATCHDOG}, {"--keep", false, OPT_KEEP},                          \
+        {"--then", true, OPT_THEN}, CLI_BUS_RT_OPTS,                                               \
         CLI_BUS_COMMON_OPTS
 
 static void drive_args_init(drive_args_t *d, drive_kind_t kind)
@@ -1084,6 +1185,7 @@ static void drive_args_init(drive_args_t *d, drive_kind_t kind)
     d->duration_s = -1.0;
     d->watchdog = true;
     d->arrive = -1.0;
+    d->then = kind == DRIVE_MOVE ? THEN_HOLD : THEN_LOCK;
 }
 
 static const char hold_help[] =
@@ -1092,7 +1194,12 @@ static const char hold_help[] =
     "\n"
     "Hold servo N at the position it is at now (FOC, stiffness kp, damping kd), refreshing\n"
     "the command at --rate. Default gains (joint or output side): the config's kp and kd,\n"
-    "else kp 20 N*m/rad, kd 2.5 N*m*s/rad.\n" DRIVE_COMMON_HELP "\n" CLI_BUS_COMMON_HELP;
+    "else kp 20 N*m/rad, kd 2.5 N*m*s/rad.\n"
+    "  --then lock|hold at the end of --duration: lock (the default: no torque, the servo\n"
+    "                   limp after exit), or hold: one last hold at the same position with\n"
+    "                   the servo's watchdog off, which the servo keeps after j288 exits\n"
+    "                   (under a load too) until `j288 stop` or another command\n"
+    DRIVE_COMMON_HELP "\n" CLI_BUS_COMMON_HELP;
 
 int cli_cmd_hold(int argc, char **argv, const cli_global_t *g)
 {
@@ -1122,6 +1229,10 @@ static const char move_help[] =
     "                   has settled there: within TOL rad, slower than TOL rad/s (on the\n"
     "                   move's side; 0 < TOL <= 1); --duration then bounds the wait: not\n"
     "                   there by then, the move is cut short (exit 1)\n"
+    "  --then hold|lock how the move ends (at --pos, or cut short by --duration): hold\n"
+    "                   (default) holds at the target it got to with the servo's watchdog\n"
+    "                   off, which the servo keeps after j288 exits (under a load too)\n"
+    "                   until `j288 stop` releases it; lock: no torque (a load falls)\n"
     DRIVE_COMMON_HELP "\n" CLI_BUS_COMMON_HELP;
 
 int cli_cmd_move(int argc, char **argv, const cli_global_t *g)
@@ -1149,7 +1260,9 @@ static const char torque_help[] =
     "                 [--side joint|rotor|output] [options]\n"
     "\n"
     "Apply a constant feed-forward torque (FOC, kp = kd = 0) to servo N; on the joint side\n"
-    "in the joint's direction, refused beyond its max_torque.\n" DRIVE_COMMON_HELP
+    "in the joint's direction, refused beyond its max_torque. It ends with lock (--then\n"
+    "lock only: a torque left running after exit has no limits to stop it).\n"
+    DRIVE_COMMON_HELP
     "\n" CLI_BUS_COMMON_HELP;
 
 int cli_cmd_torque(int argc, char **argv, const cli_global_t *g)
