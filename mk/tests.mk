@@ -163,6 +163,9 @@ TEST_SCRIPTS += test/e2e/cli_top.sh test/e2e/cli_jog.sh
 # What a new user tripped on: options before the command, one range per quantity named by
 # its source, $J288_BAUD for config buses, stop naming its bus, duplicate ids, the man page.
 TEST_SCRIPTS += test/e2e/cli_usability.sh
+# How move, hold and torque leave the servo after exit (move holds, --then lock releases),
+# against the simulator's truth under a load.
+TEST_SCRIPTS += test/e2e/cli_move_hold.sh
 
 # The scripts' own process helpers (whom they signal, what their cleanup removes).
 TEST_SCRIPTS += test/e2e/lib_sim_check.sh

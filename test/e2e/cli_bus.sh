@@ -81,10 +81,12 @@ pos = o["last_reply"]["output"]["pos_rad"]
 assert abs(pos - o["target_pos"]) < 0.02, (pos, o["target_pos"])
 assert abs(o["target_pos"] - 0.2) < 1e-3, o
 assert o["commands"] < 1000, o["commands"]'
-# The joint frame (the default): the move ends at joint angle 0.2 wherever the servo started.
+# The joint frame (the default): the move ends at joint angle 0.2 wherever the servo started,
+# and holds there (--then hold, the default: one last hold with the watchdog bit 0).
 e2e_run "$J288" --port "$MAIN" move --id 2 --pos 0.2 --speed 5 --duration "$(e2e_scaled 10)" --arrive 0.01 --json "${M[@]}"
 json_check move_reaches_target '
-assert o["ended"] == "done" and o["locked"] is True and o["side"] == "joint", o
+assert o["ended"] == "done" and o["locked"] is False and o["side"] == "joint", o
+assert o["holding"] is True and abs(o["hold_pos"] - 0.2) < 1e-9, o
 assert o["joint_known"] is True, o
 assert abs(o["joint_pos"] - 0.2) < 0.02, o["joint_pos"]
 assert abs(o["target_pos"] - 0.2) < 1e-9, o
@@ -92,10 +94,10 @@ assert abs(o["target_pos"] - 0.2) < 1e-9, o
 # machine frozen longer than the margin).
 assert o["commands"] >= 1 and o["replies"] + o["failures"] == o["commands"], o
 assert o["failures"] <= max(1, o["commands"] // 20), o'
-expect_true move_ends_with_lock bash -c "grep 'id=2 ' '$MAIN_LOG' | tail -n 1 | grep -q 'status=0'"
+expect_true move_ends_holding bash -c "grep 'id=2 ' '$MAIN_LOG' | tail -n 1 | grep -q 'status=1 wd=0 '"
 # --arrive not met by --duration: the ramp is there, the servo is not (kp 1 against the
-# simulator's friction leaves some 50 mrad): cut short, said so, exit 1.
-e2e_run "$J288" --port "$MAIN" move --id 2 --pos 0.3 --speed 5 --kp 1 --arrive 0.001 --duration 0.5 "${M[@]}"
+# simulator's friction leaves some 50 mrad): cut short, said so, exit 1; --then lock locks.
+e2e_run "$J288" --port "$MAIN" move --id 2 --pos 0.3 --speed 5 --kp 1 --arrive 0.001 --duration 0.5 --then lock "${M[@]}"
 if [ $E2E_RC -eq 1 ] && grep -q '^cut short by --duration: .*servo locked' <<<"$E2E_OUT" &&
     grep -q 'before the servo settled within --arrive of --pos 0.3 (servo locked)' <<<"$E2E_ERR"; then
     e2e_pass move_arrive_not_settled; else

@@ -63,7 +63,7 @@ stop_sim "$SIM_PID"
 # three attempts). (Under a shared simulator this once failed on a loaded machine: the
 # position query met a fault because the sequence had moved on by a speed-dependent count.)
 start_sim faultymove --ids 2 --seed 32 --drop 0.1 --corrupt 0.1 || exit 1
-e2e_run "$J288" --port "$DEV" move --id 2 --pos 0.1 --duration 1 --retries 0 --json "${MF[@]}"
+e2e_run "$J288" --port "$DEV" move --id 2 --pos 0.1 --duration 1 --retries 0 --then lock --json "${MF[@]}"
 json_check faulty_move_completes '
 assert o["ended"] == "done" and o["locked"] is True, o
 assert o["failures"] >= 1 and o["replies"] + o["failures"] == o["commands"], o'

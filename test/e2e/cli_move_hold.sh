@@ -42,11 +42,11 @@ t_move_holds() {
     # The issue's command: ramp, hold, exit; then 2 s with no host.
     e2e_run "$J288" --port "$DEV" move --id 1 --pos 0.5 --duration 3 "${M[@]}"
     [ "$E2E_RC" -eq 0 ] || { echo "move: exit $E2E_RC: $E2E_ERR"; return 1; }
-    grep -q "holding at 0.5 rad with the watchdog off: the servo keeps holding after exit" <<<"$E2E_OUT" ||
-        { echo "move said: $E2E_OUT"; return 1; }
-    last_frame_is 1 'status=1 wd=0 ' || return 1
     after_sim_seconds 2 || return 1
     near "$(truth_val 1 theta)" 0.5 0.05 || { echo "2 s after move exited"; return 1; }
+    last_frame_is 1 'status=1 wd=0 ' || return 1
+    grep -q "holding at 0.5 rad with the watchdog off: the servo keeps holding after exit" <<<"$E2E_OUT" ||
+        { echo "move said: $E2E_OUT"; return 1; }
     # hold --then hold: the same after a hold of the pose it is at.
     e2e_run "$J288" --port "$DEV" hold --id 1 --duration 0.5 --then hold "${M[@]}"
     [ "$E2E_RC" -eq 0 ] || { echo "hold --then hold: exit $E2E_RC: $E2E_ERR"; return 1; }
@@ -65,12 +65,13 @@ t_move_holds() {
 
 # A signal is an abort: lock, whatever --then says (the default hold included).
 t_signal_locks() {
-    local pid rc i
+    local pid rc i n
     start_sim ms --ids 1 --start-angle 1:0 "${LOAD[@]}" --quiet || return 1
     "$J288" --port "$DEV" move --id 1 --pos 2 --speed 0.2 --duration "$(e2e_scaled 30)" --then hold "${M[@]}" >"$E2E_TMP/sig.out" 2>"$E2E_TMP/sig.err" &
     pid=$!
     for i in $(seq 1 "$(e2e_scaled 200)"); do
-        [ "$(foc_frames 1 2>/dev/null || echo 0)" -ge 5 ] && break
+        n=$(foc_frames 1 2>/dev/null)
+        [ "${n:-0}" -ge 5 ] && break
         sleep 0.05
     done
     kill -TERM "$pid"

@@ -59,7 +59,7 @@ t_status_json() {
 t_move_reaches_target() {
     # --watchdog off: a loaded machine stalling Wine for a second would trip it (exit 1); the
     # check is where the servo ends, through Wine's serial path.
-    j288 --port COM11 move --id 1 --pos 1.2345 --speed 4 --duration 2.5 --watchdog off --json "${M[@]}"
+    j288 --port COM11 move --id 1 --pos 1.2345 --speed 4 --duration 2.5 --watchdog off --then lock --json "${M[@]}"
     [ "$E2E_RC" -eq 0 ] || { echo "exit $E2E_RC: $E2E_ERR"; return 1; }
     SIM_PID=$SIM_A TRUTH=$TRUTH_A
     truth_now || return 1

@@ -40,6 +40,7 @@ _j288() {
         --side) mapfile -t COMPREPLY < <(compgen -W "joint rotor output" -- "$cur"); return ;;
         --mode) mapfile -t COMPREPLY < <(compgen -W "lock foc" -- "$cur"); return ;;
         --watchdog) mapfile -t COMPREPLY < <(compgen -W "on off" -- "$cur"); return ;;
+        --then) mapfile -t COMPREPLY < <(compgen -W "hold lock" -- "$cur"); return ;;
     esac
     if [ -z "$cmd" ] && [[ $cur != -* ]]; then
         # the command list of `j288 --help` (indented words before their description)

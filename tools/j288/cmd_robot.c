@@ -53,7 +53,9 @@ static const char robot_help[] =
     "at lock, their angles found again; hold (and log --hold) then holds each where it is.\n"
     "A servo found with its watchdog tripped is cleared and reported (exit 1).\n"
     "Ctrl-C, SIGTERM, SIGHUP or SIGQUIT sends the broadcast lock on every bus before exiting\n"
-    "(130, 143, 129, 131). After the tool has gone every servo stays locked (no torque).\n"
+    "(130, 143, 129, 131). After the tool has gone every servo stays locked (no torque): hold\n"
+    "ends with lock too (a robot left holding with no host would have nobody watching its\n"
+    "buses and limits); one joint held on after exit: j288 hold --joint NAME --then hold.\n"
     "Exit status: 0 done; 1 a device or config error, a joint that never answered, or a bus\n"
     "lost during the command (whether or not --stop-on-bus-loss stopped the rest); 2 bad\n"
     "arguments.\n";
