@@ -569,7 +569,9 @@ static bool reopen_bus(j288_robot_t *r, j288_robot_bus_t *b, uint32_t now)
         (void)j288_sched_enable(&b->sched, id, (enabled & (1u << id)) != 0u);
     }
     memset(b->lock_under_foc, 0, sizeof b->lock_under_foc);
-    b->servo_joint_on = 0; /* the servo level's joints start anew too */
+    for (id = 0; id < J288_MAX_SERVOS; id++) /* the servo level's joints start anew too */
+        if ((b->servo_joint_on & (1u << id)) != 0u)
+            j288_joint_reset(&b->servo_joint[id]); /* (their configuration kept) */
     b->swept_ok = false;
     b->txn_done = false;
     b->empty_run = 0;
@@ -1473,6 +1475,80 @@ int j288_robot_exchange(j288_robot_t *r, unsigned bus, uint8_t id, const j288_ro
     return rc;
 }
 
+int j288_robot_servo_joint_setup(j288_robot_t *r, unsigned bus, const j288_joint_config_t *jc)
+{
+    j288_joint_t j;
+    int rc;
+    if (r == NULL || jc == NULL)
+        return J288_ERR_NULL;
+    if (bus >= r->nbuses)
+        return J288_ERR_BAD_ARG;
+    rc = j288_joint_init(&j, jc); /* checked before the servo's joint is touched */
+    if (rc != J288_OK)
+        return rc;
+    r->bus[bus].servo_joint[jc->id] = j;
+    r->bus[bus].servo_joint_on = (uint16_t)(r->bus[bus].servo_joint_on | (1u << jc->id));
+    return J288_OK;
+}
+
+const j288_joint_t *j288_robot_servo_joint(j288_robot_t *r, unsigned bus, uint8_t id)
+{
+    if (r == NULL || bus >= r->nbuses || id >= J288_MAX_SERVOS)
+        return NULL;
+    return servo_joint(&r->bus[bus], id);
+}
+
+/* Failed exchanges in a row that end the start-up reads. */
+#define ACQUIRE_MAX_FAILS 5u
+
+int j288_robot_acquire_joint(j288_robot_t *r, unsigned bus, uint8_t id, j288_txn_t *last,
+                             unsigned *replies)
+{
+    const j288_joint_state_t *st;
+    unsigned samples, tries, n, got = 0, fails = 0;
+    j288_cmd_raw_t cmd;
+    j288_txn_t txn;
+    int rc = J288_ERR_TIMEOUT;
+    if (replies != NULL)
+        *replies = 0;
+    if (r == NULL)
+        return J288_ERR_NULL;
+    if (bus >= r->nbuses)
+        return J288_ERR_BAD_ARG;
+    if (id >= J288_MAX_SERVOS)
+        return J288_ERR_BAD_ID;
+    st = j288_joint_state(servo_joint(&r->bus[bus], id));
+    samples = j288_joint_config(servo_joint(&r->bus[bus], id))->init_samples;
+    tries = samples * 4u > J288_ROBOT_ACQUIRE_TRIES ? samples * 4u : J288_ROBOT_ACQUIRE_TRIES;
+    lock_cmd(id, &cmd);
+    for (n = 0; n < tries && !st->known && !stop_requested(r); n++) {
+        rc = j288_robot_transfer(r, bus, &cmd, &txn, NULL);
+        /* A servo that does not answer the first exchange (after the bus's retries) is
+         * treated as absent, as a single exchange would be; later, a run of failures ends it. */
+        if (rc == J288_ERR_OFFLINE || (rc != J288_OK && got == 0u))
+            break;
+        fails = rc == J288_OK ? 0u : fails + 1u;
+        if (fails >= ACQUIRE_MAX_FAILS)
+            break;
+        if (rc == J288_OK) {
+            got++;
+            if (last != NULL)
+                *last = txn;
+        }
+        if ((st->encoder_fault || st->cal_mismatch) && got >= 2u * samples)
+            break;
+    }
+    if (replies != NULL)
+        *replies = got;
+    if (st->known)
+        return J288_OK;
+    if (stop_requested(r))
+        return J288_ERR_ABORTED;
+    if (rc != J288_OK)
+        return rc;
+    return st->cal_mismatch ? J288_ERR_CAL_MISMATCH : J288_ERR_ANGLE_UNKNOWN;
+}
+
 int j288_robot_exchange_joint(j288_robot_t *r, unsigned bus, uint8_t id,
                               const j288_robot_target_t *foc, j288_robot_servo_t *out)
 {
@@ -1482,25 +1558,18 @@ int j288_robot_exchange_joint(j288_robot_t *r, unsigned bus, uint8_t id,
     j288_cmd_raw_t cmd;
     j288_txn_t txn;
     bool cleared = false;
-    unsigned n;
-    int rc = J288_OK;
-    if (r == NULL)
-        return J288_ERR_NULL;
-    if (bus >= r->nbuses)
-        return J288_ERR_BAD_ARG;
-    if (id >= J288_MAX_SERVOS)
-        return J288_ERR_BAD_ID;
+    unsigned n = 0;
+    int rc;
     if (out == NULL)
         out = &local;
-    j = servo_joint(&r->bus[bus], id);
-    /* The start-up reads: locks until the angle is known (a silent servo: its first error). */
-    for (n = 0; n < J288_ROBOT_ACQUIRE_TRIES && !j288_joint_state(j)->known; n++) {
-        rc = j288_robot_exchange(r, bus, id, NULL, out);
-        if (rc == J288_ERR_OFFLINE || (rc != J288_OK && n == 0u))
-            return rc;
+    rc = j288_robot_acquire_joint(r, bus, id, &txn, &n); /* the start-up reads */
+    if (n != 0u) {
+        servo_from_reply(&txn, out);
+        joint_into_servo(servo_joint(&r->bus[bus], id), out);
     }
-    if (!j288_joint_state(j)->known)
-        return j288_joint_state(j)->cal_mismatch ? J288_ERR_CAL_MISMATCH : J288_ERR_ANGLE_UNKNOWN;
+    if (rc != J288_OK)
+        return rc;
+    j = servo_joint(&r->bus[bus], id);
     if (foc == NULL) {
         lock_cmd(id, &cmd);
     } else {

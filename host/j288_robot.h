@@ -520,6 +520,31 @@ int j288_robot_exchange(j288_robot_t *r, unsigned bus, uint8_t id, const j288_ro
 int j288_robot_exchange_joint(j288_robot_t *r, unsigned bus, uint8_t id,
                               const j288_robot_target_t *foc, j288_robot_servo_t *out);
 
+/* The servo-level joint of servo jc->id on a bus (the joint frame of
+ * j288_robot_exchange_joint(), fed by every j288_robot_transfer() reply from that servo)
+ * takes the configuration jc instead of the all-zero one: a front end driving one configured
+ * joint outside cycles (the j288 tool's move, hold, zero, calibrate). Its angle is found anew
+ * (j288_robot_acquire_joint()); a reopened bus keeps the configuration. Errors: J288_ERR_NULL,
+ * J288_ERR_BAD_ARG (bus), j288_joint_init()'s (nothing changes). */
+int j288_robot_servo_joint_setup(j288_robot_t *r, unsigned bus, const j288_joint_config_t *jc);
+
+/* That joint, to read (j288_joint_state(), j288_joint_config(): the defaults filled in) and to
+ * make commands from (j288_joint_command(), j288_joint_zero_here()); the runner feeds it. NULL
+ * for a bad bus or id. Valid until close. */
+const j288_joint_t *j288_robot_servo_joint(j288_robot_t *r, unsigned bus, uint8_t id);
+
+/* The start-up reads of that joint: locks (watchdog bit 0) until its angle is known, bounded:
+ * J288_ROBOT_ACQUIRE_TRIES exchanges, or 4 per start sample (init_samples) when more; ended
+ * early by a failed first exchange (no such servo), 5 failures in a row, the stop flag, or an
+ * encoder fault or calibration mismatch still there after two starts' worth of replies (they
+ * do not come right by asking again). *last (may be NULL) gets the latest good exchange,
+ * *replies (may be NULL) how many replies came. J288_OK (known); the last exchange's error
+ * (J288_ERR_TIMEOUT, J288_ERR_OFFLINE, ...); J288_ERR_ABORTED (stop flag);
+ * J288_ERR_CAL_MISMATCH or J288_ERR_ANGLE_UNKNOWN (the replies came, the angle was not found:
+ * j288_joint_state() says why); J288_ERR_NULL, J288_ERR_BAD_ARG, J288_ERR_BAD_ID. */
+int j288_robot_acquire_joint(j288_robot_t *r, unsigned bus, uint8_t id, j288_txn_t *last,
+                             unsigned *replies);
+
 /* One transaction of a raw command on a bus, outside cycles, through the runner's loop (the
  * same waits, vanished-device handling and watchdog policy as cycles): a lock goes out with
  * the watchdog bit 0 whatever cmd says; an FOC command whose reply reports a trip, or comes

@@ -208,7 +208,8 @@ typedef struct {
 typedef struct {
     uint8_t id;
     const j288_robot_config_joint_t *rj; /* the file's joint, or NULL (no file, or not in it) */
-    j288_joint_config_t jc;             /* checked by j288_joint_init() */
+    j288_joint_config_t jc;             /* checked, the library's defaults filled in
+                                           (j288_joint_config()) */
     char name[J288_ROBOT_CONFIG_NAME_MAX + 16]; /* "hip" or "servo 3", for messages */
 } cli_joint_sel_t;
 
@@ -223,12 +224,15 @@ int cli_robot_load(cli_robot_t *r, const char *path);
 int cli_joint_select(const cli_robot_t *r, const char *joint_name, long long id,
                      cli_bus_opts_t *o, cli_joint_sel_t *sel);
 
-/* Send lock to the joint's servo until j (initialised) knows its angle: the start's replies,
- * re-tried up to a bound. The last good exchange in *last, the replies taken in *replies.
- * CLI_EXIT_OK; the signal exit code; or CLI_EXIT_FAIL after one error line (no reply, or with
- * report_unknown: encoder fault, calibration mismatch, no agreement). */
-int cli_joint_acquire(cli_bus_t *b, j288_joint_t *j, const char *name, j288_txn_t *last,
-                      unsigned *replies, bool report_unknown);
+/* The joint of configuration jc on the open bus, through the host layer: the runner's
+ * servo-level joint set to jc (j288_robot_servo_joint_setup()), which every transfer on b
+ * feeds, in *j; then its start-up reads (j288_robot_acquire_joint(): locks until its angle is
+ * known, bounded). The last good exchange in *last, the replies in *replies. CLI_EXIT_OK; the
+ * signal exit code; or CLI_EXIT_FAIL after one error line (no reply, or with report_unknown:
+ * encoder fault, calibration mismatch, no agreement; without it *j's state says why). */
+int cli_joint_start(cli_bus_t *b, const j288_joint_config_t *jc, const char *name,
+                    const j288_joint_t **j, j288_txn_t *last, unsigned *replies,
+                    bool report_unknown);
 
 /* Why j's angle is unknown after replies replies, as one line (no prefix) in buf. */
 void cli_joint_why_unknown(const j288_joint_t *j, const char *name, unsigned replies, char *buf,
@@ -241,7 +245,7 @@ void cli_robot_fill_bus(const cli_robot_t *r, const j288_robot_config_joint_t *r
 
 /* One line for a library error on joint name's target, naming the value and the limit:
  * "hip: --pos 2: target position outside the joint's limits [-1.5, 1.5]; nothing sent". */
-void cli_joint_target_error(const j288_joint_t *j, const char *name, const char *what,
+void cli_joint_target_error(const j288_joint_config_t *jc, const char *name, const char *what,
                             double value, int rc);
 
 /* The gains of a drive: the command line's (have_*), else the file's joint's, else the host
@@ -257,10 +261,16 @@ void cli_joint_gains(const j288_robot_config_joint_t *rj, bool have_kp, double k
 /* The joint-frame pose hold and move start from, given the joint's angle q: q inside the
  * limits (or a clamping joint), else the nearest limit when q is beyond it by at most
  * CLI_JOINT_START_OUTSIDE_MAX. Farther out: an error line and -1. */
-int cli_joint_start_inside(const j288_joint_t *j, const char *name, double q, double *q_start);
+int cli_joint_start_inside(const j288_joint_config_t *jc, const char *name, double q,
+                           double *q_start);
 
-/* Whether a position target lies within the joint configuration's limits ([-pi, pi] when
- * both are 0) or the joint clamps. For checks before the bus is opened. */
+/* q, or the nearest limit of jc (filled in) when q is beyond it; q itself for a continuous
+ * joint. */
+double cli_joint_nearest_inside(const j288_joint_config_t *jc, double q);
+
+/* Whether a position target lies within the joint configuration's limits (filled in:
+ * cli_joint_select()), the joint is continuous, or it clamps. For checks before the bus is
+ * opened. */
 bool cli_joint_pos_allowed(const j288_joint_config_t *jc, double pos);
 
 /* The joint-frame members of a JSON object: joint_known, joint_calibrated, joint_pos (rad,

@@ -5,12 +5,6 @@
 
 #include "cli_bus.h"
 
-/* Lock exchanges allowed for a start: the start's samples several times over, so that a
- * dropped reply or a restarted collection does not fail it. */
-#define ACQUIRE_TRIES_PER_SAMPLE 4u
-#define ACQUIRE_TRIES_MIN 40u
-#define ACQUIRE_MAX_FAILS 5u /* failed exchanges in a row */
-
 int cli_robot_load(cli_robot_t *r, const char *path)
 {
     char err[J288_ROBOT_CONFIG_ERROR_MAX];
@@ -128,6 +122,7 @@ int cli_joint_select(const cli_robot_t *r, const char *joint_name, long long id,
                   j288_strerror(rc), J288_JOINT_MAX_ANGLE);
         return -1;
     }
+    sel->jc = *j288_joint_config(&probe); /* the library's defaults filled in */
     return 0;
 }
 
@@ -151,69 +146,48 @@ void cli_joint_why_unknown(const j288_joint_t *j, const char *name, unsigned rep
     }
 }
 
-int cli_joint_acquire(cli_bus_t *b, j288_joint_t *j, const char *name, j288_txn_t *last,
-                      unsigned *replies, bool report_unknown)
+int cli_joint_start(cli_bus_t *b, const j288_joint_config_t *jc, const char *name,
+                    const j288_joint_t **j, j288_txn_t *last, unsigned *replies,
+                    bool report_unknown)
 {
-    const j288_joint_state_t *st = j288_joint_state(j);
-    unsigned given = j288_joint_config(j)->init_samples;
-    unsigned samples = given != 0u ? given : 8u;
-    unsigned tries = samples * ACQUIRE_TRIES_PER_SAMPLE, n;
-    j288_cmd_raw_t cmd;
-    j288_txn_t txn;
-    unsigned fails = 0;
-    int rc = J288_ERR_TIMEOUT;
-    if (tries < ACQUIRE_TRIES_MIN) {
-        tries = ACQUIRE_TRIES_MIN;
-    }
+    int rc = j288_robot_servo_joint_setup(b->robot, 0, jc);
     *replies = 0;
-    cli_lock_cmd(j288_joint_config(j)->id, &cmd);
-    for (n = 0; n < tries && !st->known; n++) {
-        rc = cli_bus_transfer(b, &cmd, &txn);
-        /* A servo that does not answer the first exchange (after the bus's retries) is
-         * treated as absent, as a single exchange would be; later, a run of failures ends it. */
-        if (rc == J288_ERR_OFFLINE || cli_stop_signal != 0 || (rc != J288_OK && *replies == 0u)) {
-            break;
-        }
-        fails = rc == J288_OK ? 0u : fails + 1u;
-        if (fails >= ACQUIRE_MAX_FAILS) {
-            break;
-        }
-        if (rc == J288_OK) {
-            (*replies)++;
-            (void)j288_joint_take_reply(j, &txn.reply, NULL);
-            *last = txn;
-        }
-        /* An encoder the servo reports broken or a phase that does not fit will not come
-         * right by asking again and again: give up after a start's worth of replies. */
-        if ((st->encoder_fault || st->cal_mismatch) && *replies >= 2u * samples) {
-            break;
-        }
+    *j = j288_robot_servo_joint(b->robot, 0, jc->id);
+    if (rc != J288_OK || *j == NULL) {
+        cli_error("%s: %s", name, j288_strerror(rc != J288_OK ? rc : J288_ERR_BAD_ARG));
+        return CLI_EXIT_FAIL;
     }
-    if (st->known) {
+    rc = j288_robot_acquire_joint(b->robot, 0, jc->id, last, replies);
+    if (rc == J288_OK) {
         return CLI_EXIT_OK;
     }
     if (cli_stop_signal != 0) {
         return cli_signal_exit_code();
     }
-    if (*replies == 0u || rc == J288_ERR_OFFLINE || (report_unknown && rc != J288_OK)) {
-        cli_report_txn_failure(b, j288_joint_config(j)->id, rc);
+    if (*replies == 0u || rc == J288_ERR_OFFLINE ||
+        (report_unknown && rc != J288_ERR_ANGLE_UNKNOWN && rc != J288_ERR_CAL_MISMATCH)) {
+        cli_report_txn_failure(b, jc->id, rc);
     } else if (report_unknown) {
         char why[400];
-        cli_joint_why_unknown(j, name, *replies, why, sizeof why);
+        cli_joint_why_unknown(*j, name, *replies, why, sizeof why);
         cli_error("%s", why);
     }
     return CLI_EXIT_FAIL;
 }
 
+/* The joint's range (the defaults filled in: cli_joint_select()); a continuous joint has
+ * none. */
 static void joint_range(const j288_joint_config_t *jc, double *lo, double *hi)
 {
-    if (jc->pos_min == 0 && jc->pos_max == 0) {
-        *lo = -J288_PI;
-        *hi = J288_PI;
-    } else {
-        *lo = (double)jc->pos_min;
-        *hi = (double)jc->pos_max;
-    }
+    *lo = jc->continuous ? -HUGE_VAL : (double)jc->pos_min;
+    *hi = jc->continuous ? HUGE_VAL : (double)jc->pos_max;
+}
+
+double cli_joint_nearest_inside(const j288_joint_config_t *jc, double q)
+{
+    double lo, hi;
+    joint_range(jc, &lo, &hi);
+    return q < lo ? lo : (q > hi ? hi : q);
 }
 
 bool cli_joint_pos_allowed(const j288_joint_config_t *jc, double pos)
@@ -223,12 +197,13 @@ bool cli_joint_pos_allowed(const j288_joint_config_t *jc, double pos)
     return jc->clamp || (pos >= lo && pos <= hi);
 }
 
-int cli_joint_start_inside(const j288_joint_t *j, const char *name, double q, double *q_start)
+int cli_joint_start_inside(const j288_joint_config_t *jc, const char *name, double q,
+                           double *q_start)
 {
     double lo, hi, out;
-    joint_range(&j->cfg, &lo, &hi);
+    joint_range(jc, &lo, &hi);
     out = q < lo ? lo - q : (q > hi ? q - hi : 0.0);
-    if (j288_joint_config(j)->clamp || out == 0.0) {
+    if (jc->clamp || out == 0.0) {
         *q_start = q;
         return 0;
     }
@@ -242,20 +217,20 @@ int cli_joint_start_inside(const j288_joint_t *j, const char *name, double q, do
     return 0;
 }
 
-void cli_joint_target_error(const j288_joint_t *j, const char *name, const char *what,
+void cli_joint_target_error(const j288_joint_config_t *jc, const char *name, const char *what,
                             double value, int rc)
 {
     double lo, hi;
-    joint_range(&j->cfg, &lo, &hi);
+    joint_range(jc, &lo, &hi);
     if (rc == J288_ERR_LIMIT_POS) {
         cli_error("%s: %s %g: %s [%g, %g]; nothing sent", name, what, value, j288_strerror(rc),
                   lo, hi);
     } else if (rc == J288_ERR_LIMIT_SPEED) {
         cli_error("%s: %s %g: %s (%g rad/s); nothing sent", name, what, value,
-                  j288_strerror(rc), (double)j288_joint_config(j)->max_speed);
+                  j288_strerror(rc), (double)jc->max_speed);
     } else if (rc == J288_ERR_LIMIT_TORQUE) {
         cli_error("%s: %s %g: %s (%g N*m); nothing sent", name, what, value, j288_strerror(rc),
-                  (double)j288_joint_config(j)->max_torque);
+                  (double)jc->max_torque);
     } else {
         cli_error("%s: %s %g: %s", name, what, value, j288_strerror(rc));
     }

@@ -235,15 +235,15 @@ static int parse_id_opt(void *ctx, int key, const char *v)
 }
 
 
-/* --config and --id / --joint into a joint set up for the bus (o filled from the file). */
+/* --config and --id / --joint into a joint's configuration (o filled from the file). */
 static int select_joint(cli_bus_opts_t *o, const char *joint_name, long long id,
-                        cli_joint_sel_t *sel, j288_joint_t *j)
+                        cli_joint_sel_t *sel)
 {
     if (cli_robot_load(&g_robot, o->config) != 0 ||
         cli_joint_select(&g_robot, joint_name, id, o, sel) != 0) {
         return -1;
     }
-    return j288_joint_init(j, &sel->jc) == J288_OK ? 0 : -1;
+    return 0;
 }
 
 static void status_text(const cli_bus_t *b, const cli_joint_sel_t *sel, const j288_joint_t *j,
@@ -272,7 +272,7 @@ int cli_cmd_status(int argc, char **argv, const cli_global_t *g)
     cli_bus_t b;
     id_ctx_t c = {-1, NULL};
     cli_joint_sel_t sel;
-    j288_joint_t joint;
+    const j288_joint_t *joint = NULL;
     j288_txn_t txn;
     unsigned replies = 0;
     int ec;
@@ -281,21 +281,21 @@ int cli_cmd_status(int argc, char **argv, const cli_global_t *g)
     if (cli_parse_bus_args(argc, argv, opts, status_help, &o, parse_id_opt, &c, &ec) != 0) {
         return ec;
     }
-    if (select_joint(&o, c.joint, c.id, &sel, &joint) != 0) {
+    if (select_joint(&o, c.joint, c.id, &sel) != 0) {
         return CLI_EXIT_USAGE;
     }
     cli_signals_install();
     if ((ec = cli_bus_open(&b, &o, 2)) != CLI_EXIT_OK) {
         return ec;
     }
-    ec = cli_joint_acquire(&b, &joint, sel.name, &txn, &replies, false);
+    ec = cli_joint_start(&b, &sel.jc, sel.name, &joint, &txn, &replies, false);
     if (replies == 0u || (ec != CLI_EXIT_OK && ec != CLI_EXIT_FAIL)) {
         cli_bus_close(&b);
         return ec != CLI_EXIT_OK ? ec : CLI_EXIT_FAIL;
     }
     if (ec != CLI_EXIT_OK) {
         char why[400];
-        cli_joint_why_unknown(&joint, sel.name, replies, why, sizeof why);
+        cli_joint_why_unknown(joint, sel.name, replies, why, sizeof why);
         fprintf(stderr, "note: %s\n", why);
     }
     if (o.json) {
@@ -307,11 +307,11 @@ int cli_cmd_status(int argc, char **argv, const cli_global_t *g)
         if (sel.rj != NULL) {
             cli_json_str(&j, "joint", sel.rj->name);
         }
-        cli_json_joint_members(&j, &joint);
+        cli_json_joint_members(&j, joint);
         cli_json_end_object(&j);
         cli_json_newline(&j);
     } else {
-        status_text(&b, &sel, &joint, &txn);
+        status_text(&b, &sel, joint, &txn);
     }
     cli_bus_close(&b);
     return CLI_EXIT_OK;
@@ -401,9 +401,9 @@ typedef struct {
     bool have_then;
     drive_then_t then; /* move: THEN_HOLD by default; hold, torque: THEN_LOCK */
     double arrive; /* move --arrive: the tolerance in rad (on the move's side); < 0: none */
-    /* The joint (side joint) */
+    /* The joint (side joint): the runner's, once started (cli_joint_start()) */
     cli_joint_sel_t sel;
-    j288_joint_t j;
+    const j288_joint_t *j;
 } drive_args_t;
 
 static int parse_drive_opt(void *ctx, int key, const char *v)
@@ -549,7 +549,7 @@ static int plan_joint(const drive_args_t *d, drive_plan_t *p)
         return si_error("--kd", p->jkd, rc);
     }
     if (d->kind == DRIVE_MOVE && !cli_joint_pos_allowed(jc, d->pos)) {
-        cli_joint_target_error(&d->j, d->sel.name, "--pos", d->pos, J288_ERR_LIMIT_POS);
+        cli_joint_target_error(jc, d->sel.name, "--pos", d->pos, J288_ERR_LIMIT_POS);
         return -1;
     }
     if (d->kind == DRIVE_MOVE) {
@@ -559,13 +559,13 @@ static int plan_joint(const drive_args_t *d, drive_plan_t *p)
         }
     }
     if (d->kind == DRIVE_MOVE && jc->max_speed > 0 && !jc->clamp && p->jspeed > (double)jc->max_speed) {
-        cli_joint_target_error(&d->j, d->sel.name, "--speed", p->jspeed, J288_ERR_LIMIT_SPEED);
+        cli_joint_target_error(jc, d->sel.name, "--speed", p->jspeed, J288_ERR_LIMIT_SPEED);
         return -1;
     }
     if (d->kind == DRIVE_TORQUE) {
         int16_t tau;
         if (jc->max_torque > 0 && !jc->clamp && fabs(d->tau) > (double)jc->max_torque) {
-            cli_joint_target_error(&d->j, d->sel.name, "--tau", d->tau, J288_ERR_LIMIT_TORQUE);
+            cli_joint_target_error(jc, d->sel.name, "--tau", d->tau, J288_ERR_LIMIT_TORQUE);
             return -1;
         }
         if ((rc = j288_torque_to_raw((j288_real_t)d->tau, J288_SIDE_OUTPUT, &tau)) != J288_OK) {
@@ -659,7 +659,7 @@ static void drive_setpoint(const drive_args_t *d, const drive_plan_t *p, double 
 static void joint_setpoint(const drive_args_t *d, const drive_plan_t *p, double t,
                            j288_joint_target_t *tg)
 {
-    const j288_joint_state_t *st = j288_joint_state(&d->j);
+    const j288_joint_state_t *st = j288_joint_state(d->j);
     memset(tg, 0, sizeof *tg);
     tg->kp = (j288_real_t)p->jkp;
     tg->kd = (j288_real_t)p->jkd;
@@ -675,13 +675,8 @@ static void joint_setpoint(const drive_args_t *d, const drive_plan_t *p, double 
         }
     } else if (d->kind == DRIVE_TORQUE) {
         /* No stiffness: the position only has to pass the limit check. */
-        const j288_joint_config_t *jc = j288_joint_config(&d->j);
-        double lo = (double)jc->pos_min, hi = (double)jc->pos_max, q = (double)st->pos;
-        if (lo == 0.0 && hi == 0.0) {
-            lo = -J288_PI;
-            hi = J288_PI;
-        }
-        tg->pos = (j288_real_t)(q < lo ? lo : (q > hi ? hi : q));
+        double q = (double)st->pos;
+        tg->pos = (j288_real_t)cli_joint_nearest_inside(j288_joint_config(d->j), q);
         tg->torque = (j288_real_t)d->tau;
     }
 }
@@ -714,7 +709,7 @@ static void drive_progress(const drive_args_t *d, drive_result_t *r, double t)
     r->shown_s = t;
     r->progress = true;
     if (d->side == SIDE_JOINT) {
-        const j288_joint_state_t *st = j288_joint_state(&d->j);
+        const j288_joint_state_t *st = j288_joint_state(d->j);
         fprintf(stderr, "\r%s %s: %6.1f s  pos %9.4f rad  target %9.4f rad  torque %7.3f N*m ",
                 verb[d->kind], d->sel.name, t, (double)st->pos, r->last_target,
                 (double)st->torque);
@@ -758,7 +753,7 @@ static void drive_report_json(const drive_args_t *d, const drive_result_t *r, co
     if (d->side == SIDE_JOINT) {
         cli_json_str(&j, "side", "joint");
         cli_json_real(&j, "target_pos", r->last_target);
-        cli_json_joint_members(&j, &d->j);
+        cli_json_joint_members(&j, d->j);
     } else {
         cli_json_str(&j, "side", side == J288_SIDE_ROTOR ? "rotor" : "output");
         cli_json_real(&j, "target_pos", (double)j288_pos_from_raw(r->last_cmd.pos, side));
@@ -797,7 +792,7 @@ static void drive_report(const drive_args_t *d, const drive_result_t *r, const c
         return;
     }
     if (r->have_last && d->side == SIDE_JOINT) {
-        const j288_joint_state_t *st = j288_joint_state(&d->j);
+        const j288_joint_state_t *st = j288_joint_state(d->j);
         printf("%s: pos %.6g rad, speed %.5g rad/s, torque %.5g N*m (joint frame); target "
                "%.6g rad; faults %s\n",
                d->sel.name, (double)st->pos, (double)st->speed, (double)st->torque,
@@ -864,14 +859,14 @@ static int drive_start(cli_bus_t *b, drive_args_t *d, drive_plan_t *p, drive_res
     unsigned replies = 0;
     int rc;
     if (d->side == SIDE_JOINT) {
-        rc = cli_joint_acquire(b, &d->j, d->sel.name, &txn, &replies, true);
+        rc = cli_joint_start(b, &d->sel.jc, d->sel.name, &d->j, &txn, &replies, true);
         if (rc != CLI_EXIT_OK) {
             return rc;
         }
-        p->q0 = (double)j288_joint_state(&d->j)->pos;
+        p->q0 = (double)j288_joint_state(d->j)->pos;
         /* Just beyond a limit (a zero at a hard stop, a load): start from the limit, so the
          * joint can be brought back; the lib refuses any target outside. */
-        if (d->kind != DRIVE_TORQUE && cli_joint_start_inside(&d->j, d->sel.name, p->q0, &p->q0) != 0) {
+        if (d->kind != DRIVE_TORQUE && cli_joint_start_inside(&d->sel.jc, d->sel.name, p->q0, &p->q0) != 0) {
             return CLI_EXIT_USAGE;
         }
         res->last_target = p->q0;
@@ -897,10 +892,10 @@ static int joint_command_at(drive_args_t *d, const drive_plan_t *p, double t,
     j288_joint_target_t tg;
     int rc;
     joint_setpoint(d, p, t, &tg);
-    rc = j288_joint_command(&d->j, &tg, cmd, NULL);
+    rc = j288_joint_command(d->j, &tg, cmd, NULL);
     if (rc != J288_OK) {
         drive_progress_end(res);
-        cli_joint_target_error(&d->j, d->sel.name, "target", (double)tg.pos, rc);
+        cli_joint_target_error(&d->sel.jc, d->sel.name, "target", (double)tg.pos, rc);
         return -1;
     }
     cmd->watchdog = d->watchdog;
@@ -915,7 +910,7 @@ static bool drive_settled(const drive_args_t *d, const drive_plan_t *p, const dr
 {
     double err, speed;
     if (d->side == SIDE_JOINT) {
-        const j288_joint_state_t *st = j288_joint_state(&d->j);
+        const j288_joint_state_t *st = j288_joint_state(d->j);
         err = (double)st->pos - d->pos;
         speed = (double)st->speed;
     } else {
@@ -933,7 +928,6 @@ static int drive_step(cli_bus_t *b, drive_args_t *d, const drive_plan_t *p, doub
 {
     j288_cmd_raw_t cmd;
     j288_txn_t txn;
-    unsigned events = 0;
     int rc;
     if (d->side == SIDE_JOINT) {
         if (joint_command_at(d, p, t, res, &cmd) != 0) {
@@ -950,13 +944,13 @@ static int drive_step(cli_bus_t *b, drive_args_t *d, const drive_plan_t *p, doub
     if (rc == J288_OK) {
         res->ok++;
         res->last = txn.reply;
+        /* (the runner fed the reply to the joint: known before, unknown now is a lost angle) */
         if (d->side == SIDE_JOINT) {
-            (void)j288_joint_take_reply(&d->j, &txn.reply, &events);
-            if ((events & J288_JOINT_EV_BIT(J288_JOINT_EV_ANGLE_LOST)) != 0u) {
+            if (!j288_joint_state(d->j)->known) {
                 drive_progress_end(res);
                 cli_error("%s: the joint angle was lost (rotor and output encoder differ by %.4f "
                           "rad: a power cycle or a slipped gear); lock sent",
-                          d->sel.name, (double)j288_joint_state(&d->j)->residual);
+                          d->sel.name, (double)j288_joint_state(d->j)->residual);
                 return J288_ERR_ANGLE_UNKNOWN;
             }
         }
@@ -1049,7 +1043,7 @@ static bool drive_hold_after(cli_bus_t *b, drive_args_t *d, const drive_plan_t *
         tg.pos = (j288_real_t)res->last_target;
         tg.kp = (j288_real_t)p->jkp;
         tg.kd = (j288_real_t)p->jkd;
-        if (j288_joint_command(&d->j, &tg, &cmd, NULL) != J288_OK) {
+        if (j288_joint_command(d->j, &tg, &cmd, NULL) != J288_OK) {
             return false;
         }
         res->hold_pos = res->last_target;
@@ -1117,7 +1111,7 @@ static int drive_select(drive_args_t *d, cli_bus_opts_t *o)
         return -1;
     }
     d->id = d->sel.id;
-    return j288_joint_init(&d->j, &d->sel.jc) == J288_OK ? 0 : -1;
+    return 0;
 }
 
 static int run_drive(drive_args_t *d, cli_bus_opts_t *o)

@@ -109,7 +109,7 @@ int cli_cmd_zero(int argc, char **argv, const cli_global_t *g)
 {
     static const cli_opt_t opts[] = {
         {"--id", true, OPT_ID}, {"--joint", true, OPT_JOINT}, CLI_BUS_COMMON_OPTS, {NULL, false, 0}};
-    static j288_joint_t joint;
+    const j288_joint_t *joint = NULL;
     joint_args_t a;
     cli_bus_opts_t o;
     cli_bus_t b;
@@ -118,6 +118,7 @@ int cli_cmd_zero(int argc, char **argv, const cli_global_t *g)
     j288_robot_config_update_t upd;
     j288_real_t zero = 0;
     unsigned replies;
+    bool calibrated = false;
     int ec, wrote;
 
     joint_args_init(&a);
@@ -126,8 +127,7 @@ int cli_cmd_zero(int argc, char **argv, const cli_global_t *g)
         return ec;
     }
     if (cli_robot_load(&g_robot, o.config) != 0 ||
-        cli_joint_select(&g_robot, a.joint, a.id, &o, &sel) != 0 ||
-        j288_joint_init(&joint, &sel.jc) != J288_OK) {
+        cli_joint_select(&g_robot, a.joint, a.id, &o, &sel) != 0) {
         return CLI_EXIT_USAGE;
     }
     if (check_write_back(&sel) != 0) {
@@ -137,12 +137,15 @@ int cli_cmd_zero(int argc, char **argv, const cli_global_t *g)
     if ((ec = cli_bus_open(&b, &o, 2)) != CLI_EXIT_OK) {
         return ec;
     }
-    ec = cli_joint_acquire(&b, &joint, sel.name, &txn, &replies, true);
+    ec = cli_joint_start(&b, &sel.jc, sel.name, &joint, &txn, &replies, true);
+    if (ec == CLI_EXIT_OK) {
+        (void)j288_joint_zero_here(joint, &zero);
+        calibrated = j288_joint_state(joint)->calibrated;
+    }
     cli_bus_close(&b);
     if (ec != CLI_EXIT_OK) {
         return ec;
     }
-    (void)j288_joint_zero_here(&joint, &zero);
     memset(&upd, 0, sizeof upd);
     upd.set_zero = true;
     upd.zero = (double)zero;
@@ -159,7 +162,7 @@ int cli_cmd_zero(int argc, char **argv, const cli_global_t *g)
             cli_json_real(&j, "previous_zero", sel.rj->zero);
         }
         cli_json_real(&j, "zero", (double)zero);
-        cli_json_bool(&j, "calibrated", j288_joint_state(&joint)->calibrated);
+        cli_json_bool(&j, "calibrated", calibrated);
         cli_json_bool(&j, "written", wrote == 0);
         cli_json_end_object(&j);
         cli_json_newline(&j);
@@ -213,13 +216,10 @@ typedef struct {
 static int cal_window(const joint_args_t *a, const j288_joint_t *j, double q, cal_path_t *p,
                       const char *name)
 {
-    const j288_joint_config_t *cfg = j288_joint_config(j);
-    double lmin = (double)cfg->pos_min, lmax = (double)cfg->pos_max, q0;
-    if (lmin == 0.0 && lmax == 0.0) {
-        lmin = -J288_PI;
-        lmax = J288_PI;
-    }
-    if (cli_joint_start_inside(j, name, q, &q0) != 0) {
+    const j288_joint_config_t *cfg = j288_joint_config(j); /* the defaults filled in */
+    double lmin = cfg->continuous ? -HUGE_VAL : (double)cfg->pos_min;
+    double lmax = cfg->continuous ? HUGE_VAL : (double)cfg->pos_max, q0;
+    if (cli_joint_start_inside(cfg, name, q, &q0) != 0) {
         return -1;
     }
     lmin = fmin(lmin + CAL_LIMIT_MARGIN, q0);
@@ -269,7 +269,7 @@ static bool cal_target_at(const cal_path_t *p, double s, j288_joint_target_t *t)
 
 /* The motion, every reply into the fit. CLI_EXIT_OK, or an exit status after an error line
  * (the servo then locked by the caller). */
-static int cal_move(cli_bus_t *b, j288_joint_t *j, j288_cal_t *cal, const cal_path_t *p,
+static int cal_move(cli_bus_t *b, const j288_joint_t *j, j288_cal_t *cal, const cal_path_t *p,
                     const joint_args_t *a, const char *name)
 {
     uint32_t period_us = (uint32_t)lround(1e6 / a->rate_hz);
@@ -280,7 +280,6 @@ static int cal_move(cli_bus_t *b, j288_joint_t *j, j288_cal_t *cal, const cal_pa
         j288_joint_target_t t;
         j288_cmd_raw_t cmd;
         j288_txn_t txn;
-        unsigned events = 0;
         double el = (double)(uint32_t)(j288_robot_now_us() - t0) / 1e6;
         int rc;
         if (cli_stop_signal != 0) {
@@ -295,7 +294,8 @@ static int cal_move(cli_bus_t *b, j288_joint_t *j, j288_cal_t *cal, const cal_pa
         }
         rc = j288_joint_command(j, &t, &cmd, NULL);
         if (rc != J288_OK) {
-            cli_joint_target_error(j, name, "calibration motion to", (double)t.pos, rc);
+            cli_joint_target_error(j288_joint_config(j), name, "calibration motion to",
+                                   (double)t.pos, rc);
             return CLI_EXIT_FAIL;
         }
         rc = cli_bus_transfer(b, &cmd, &txn);
@@ -308,9 +308,8 @@ static int cal_move(cli_bus_t *b, j288_joint_t *j, j288_cal_t *cal, const cal_pa
             cli_error("%s stopped answering (%d commands in a row failed)", name, fails);
             return CLI_EXIT_FAIL;
         }
-        if (rc == J288_OK) {
-            (void)j288_joint_take_reply(j, &txn.reply, &events);
-            if ((events & J288_JOINT_EV_BIT(J288_JOINT_EV_ANGLE_LOST)) != 0u) {
+        if (rc == J288_OK) { /* (the runner fed the reply to j: known before, now lost) */
+            if (!j288_joint_state(j)->known) {
                 cli_error("%s: the joint angle was lost during the motion (residual %.4f rad)",
                           name, (double)j288_joint_state(j)->residual);
                 return CLI_EXIT_FAIL;
@@ -357,18 +356,15 @@ static const char *problem_list(unsigned problems, char *buf, size_t len)
 static int cal_check(cli_bus_t *b, const j288_joint_config_t *jc_uncal, double phase,
                      const char *name, double *eps)
 {
-    static j288_joint_t jt;
+    const j288_joint_t *jt = NULL;
     j288_joint_config_t jc = *jc_uncal;
     j288_txn_t txn;
     unsigned replies;
     int ec;
     jc.has_phase = true;
     jc.phase = (j288_real_t)phase;
-    if (j288_joint_init(&jt, &jc) != J288_OK) {
-        return CLI_EXIT_FAIL;
-    }
-    ec = cli_joint_acquire(b, &jt, name, &txn, &replies, true);
-    *eps = (double)j288_joint_state(&jt)->cal_residual;
+    ec = cli_joint_start(b, &jc, name, &jt, &txn, &replies, true);
+    *eps = jt != NULL ? (double)j288_joint_state(jt)->cal_residual : 0.0;
     return ec;
 }
 
@@ -414,24 +410,23 @@ static void cal_report(const cli_joint_sel_t *sel, const j288_cal_report_t *r, d
 static int cal_run(cli_bus_t *b, const joint_args_t *a, const cli_joint_sel_t *sel,
                    const j288_joint_config_t *jc, j288_cal_report_t *r, double *eps)
 {
-    static j288_joint_t joint;
     static j288_cal_t cal;
+    const j288_joint_t *joint = NULL;
     char list[200];
     cal_path_t path;
     j288_txn_t txn;
     unsigned replies;
     int ec, rc;
-    (void)j288_joint_init(&joint, jc);
     (void)j288_cal_init(&cal, jc);
-    if ((ec = cli_joint_acquire(b, &joint, sel->name, &txn, &replies, true)) != CLI_EXIT_OK) {
+    if ((ec = cli_joint_start(b, jc, sel->name, &joint, &txn, &replies, true)) != CLI_EXIT_OK) {
         return ec;
     }
-    if (cal_window(a, &joint, (double)j288_joint_state(&joint)->pos, &path, sel->name) != 0) {
+    if (cal_window(a, joint, (double)j288_joint_state(joint)->pos, &path, sel->name) != 0) {
         return CLI_EXIT_USAGE;
     }
     path.speed = a->speed;
     cli_joint_gains(sel->rj, a->have_kp, a->kp, a->have_kd, a->kd, &path.kp, &path.kd);
-    ec = cal_move(b, &joint, &cal, &path, a, sel->name);
+    ec = cal_move(b, joint, &cal, &path, a, sel->name);
     if (cli_bus_lock_driven(b) != 0 && ec == CLI_EXIT_OK) {
         cli_error("%s did not confirm the lock (a broadcast lock was sent)", sel->name);
         ec = CLI_EXIT_FAIL;

@@ -644,12 +644,12 @@ static int log_probe(log_run_t *r)
             }
             /* Just beyond a limit: hold or swing from the limit (every target outside is
              * refused); farther out, refused here. */
-            if (cli_joint_start_inside(&r->joint[id], r->sel[id].name, (double)st->pos, &r->q0[id]) != 0) {
+            if (cli_joint_start_inside(&r->sel[id].jc, r->sel[id].name, (double)st->pos, &r->q0[id]) != 0) {
                 return CLI_EXIT_USAGE;
             }
             if (r->a.motion == MOTION_SWING &&
                 !cli_joint_pos_allowed(&r->sel[id].jc, r->q0[id] + r->a.amp)) {
-                cli_joint_target_error(&r->joint[id], r->sel[id].name, "--swing to",
+                cli_joint_target_error(&r->sel[id].jc, r->sel[id].name, "--swing to",
                                        r->q0[id] + r->a.amp, J288_ERR_LIMIT_POS);
                 return CLI_EXIT_USAGE;
             }
@@ -690,7 +690,7 @@ static void joint_cycle_command(log_run_t *r, uint8_t id, double t)
             j288_sched_set_cmd(r->s, &cmd);
             return;
         }
-        cli_joint_target_error(&r->joint[id], r->sel[id].name, "target", (double)tg.pos, rc);
+        cli_joint_target_error(&r->sel[id].jc, r->sel[id].name, "target", (double)tg.pos, rc);
         r->lost = (uint16_t)(r->lost | (1u << id));
     }
     cli_lock_cmd(id, &cmd);
