@@ -680,6 +680,44 @@ static void test_exchange_on_one_port(void)
     TEST_ASSERT_TRUE(j288_robot_sizeof() == sizeof(j288_robot_t));
 }
 
+/* A configured servo-level joint (the j288 tool's move, hold, zero, calibrate): its start-up
+ * reads through the runner, its angle in the configuration's frame, bad input refused. */
+static void test_servo_joint_takes_a_config(void)
+{
+    static const char *const start[] = {"--start-angle", "2:0.4", NULL};
+    j288_joint_config_t jc;
+    j288_txn_t txn;
+    const j288_joint_t *j;
+    unsigned replies = 99;
+    j288_robot_options_t o;
+    memset(&o, 0, sizeof o);
+    o.margin_us = LOADED_MARGIN_US;
+    sim_start_with(0, "2", start);
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_robot_open_port(&g_robot, g_sim[0].pty, &o));
+    memset(&jc, 0, sizeof jc);
+    jc.id = 2;
+    jc.direction = 5;
+    TEST_ASSERT_EQUAL_INT(J288_ERR_BAD_CONFIG, j288_robot_servo_joint_setup(&g_robot, 0, &jc));
+    TEST_ASSERT_EQUAL_INT(J288_ERR_NULL, j288_robot_servo_joint_setup(&g_robot, 0, NULL));
+    jc.direction = -1;
+    jc.zero = 0.3f;
+    TEST_ASSERT_EQUAL_INT(J288_ERR_BAD_ARG, j288_robot_servo_joint_setup(&g_robot, 1, &jc));
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_robot_servo_joint_setup(&g_robot, 0, &jc));
+    TEST_ASSERT_NULL(j288_robot_servo_joint(&g_robot, 0, 15));
+    j = j288_robot_servo_joint(&g_robot, 0, 2);
+    TEST_ASSERT_NOT_NULL(j);
+    TEST_ASSERT_EQUAL_INT(-1, j288_joint_config(j)->direction);
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_robot_acquire_joint(&g_robot, 0, 2, &txn, &replies));
+    TEST_ASSERT_TRUE(replies >= 1u && txn.reply.id == 2u);
+    TEST_ASSERT_TRUE(j288_joint_state(j)->known);
+    /* direction -1 about zero 0.3: the output at 0.4 is joint angle -0.1 */
+    TEST_ASSERT_DOUBLE_WITHIN(0.002, -0.1, (double)j288_joint_state(j)->pos);
+    /* no such servo: its first exchange fails, nothing else is tried */
+    TEST_ASSERT_EQUAL_INT(J288_ERR_TIMEOUT, j288_robot_acquire_joint(&g_robot, 0, 9, NULL, &replies));
+    TEST_ASSERT_EQUAL_UINT(0, replies);
+    TEST_ASSERT_EQUAL_INT(J288_ERR_BAD_ID, j288_robot_acquire_joint(&g_robot, 0, 15, NULL, &replies));
+}
+
 /* A command whose reply never comes may still have reached the servo and moved it: close
  * stops the bus all the same. (The simulator is frozen while the command goes out; resumed,
  * it reads the command, then the stop.) */
@@ -1136,6 +1174,7 @@ int main(void)
     RUN_TEST(test_stop_flag_stops_every_bus);
     RUN_TEST(test_stop_waits_for_a_long_margin);
     RUN_TEST(test_exchange_on_one_port);
+    RUN_TEST(test_servo_joint_takes_a_config);
     RUN_TEST(test_close_stops_after_an_unanswered_command);
     RUN_TEST(test_hold_just_beyond_a_limit);
     RUN_TEST(test_a_second_session_after_a_stop_is_obeyed);
