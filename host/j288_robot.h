@@ -274,7 +274,8 @@ typedef struct {
                               with the bit 0 (clearing it), and this is that reply */
     /* The joint frame of servo-level use (j288_robot_exchange_joint()): the library's joint
      * with the all-zero configuration, the absolute output angle wrapped to [-pi, pi), as
-     * `j288 status --id N` without --config (its joint_pos). Fed by every exchange. */
+     * `j288 status --id N` without --config (its joint_pos), or the configuration
+     * j288_robot_servo_joint_setup() gave it. Fed by every exchange. */
     bool joint_known;   /* joint_pos is valid (after the start's replies) */
     double joint_pos;   /* rad */
     double joint_speed; /* rad/s */
@@ -513,9 +514,10 @@ int j288_robot_exchange(j288_robot_t *r, unsigned bus, uint8_t id, const j288_ro
 /* The same in the joint frame (see j288_robot_servo_t's joint_* members): foc NULL sends lock,
  * else an FOC command from a joint-frame target (the joint layer's checks: J288_ERR_LIMIT_POS
  * beyond [-pi, pi], ...). A servo whose angle is not known yet is first sent locks (watchdog
- * bit 0) until it is, bounded (J288_ROBOT_ACQUIRE_TRIES): the start-up reads. Errors: those of
- * j288_robot_exchange(), J288_ERR_ANGLE_UNKNOWN / J288_ERR_CAL_MISMATCH (the angle could not
- * be found: encoder fault), the joint layer's. */
+ * bit 0) until it is, bounded: the start-up reads (j288_robot_acquire_joint(); out gets their
+ * latest reply when one came). Errors: those of j288_robot_exchange(), J288_ERR_ANGLE_UNKNOWN /
+ * J288_ERR_CAL_MISMATCH (the angle could not be found: encoder fault), J288_ERR_ABORTED (the
+ * stop flag), the joint layer's. */
 #define J288_ROBOT_ACQUIRE_TRIES 40u
 int j288_robot_exchange_joint(j288_robot_t *r, unsigned bus, uint8_t id,
                               const j288_robot_target_t *foc, j288_robot_servo_t *out);

@@ -1,0 +1,54 @@
+build-clang/obj/tools/j288/cli_bus.o: tools/j288/cli_bus.c \
+  tools/j288/cli_bus.h tools/j288/args.h host/j288_range.h \
+  lib/include/j288/config.h tools/j288/cli.h lib/include/j288/j288.h \
+  lib/include/j288/error.h lib/include/j288/crc32.h \
+  lib/include/j288/frame.h lib/include/j288/units.h \
+  lib/include/j288/parser.h lib/include/j288/port.h \
+  lib/include/j288/bus.h lib/include/j288/sched.h \
+  lib/include/j288/joint.h lib/include/j288/jointq.h host/j288_robot.h \
+  port/desktop/j288_serial.h port/linux/j288_linux.h \
+  host/j288_robot_config.h host/j288_rt.h tools/j288/json.h
+
+tools/j288/cli_bus.h:
+
+tools/j288/args.h:
+
+host/j288_range.h:
+
+lib/include/j288/config.h:
+
+tools/j288/cli.h:
+
+lib/include/j288/j288.h:
+
+lib/include/j288/error.h:
+
+lib/include/j288/crc32.h:
+
+lib/include/j288/frame.h:
+
+lib/include/j288/units.h:
+
+lib/include/j288/parser.h:
+
+lib/include/j288/port.h:
+
+lib/include/j288/bus.h:
+
+lib/include/j288/sched.h:
+
+lib/include/j288/joint.h:
+
+lib/include/j288/jointq.h:
+
+host/j288_robot.h:
+
+port/desktop/j288_serial.h:
+
+port/linux/j288_linux.h:
+
+host/j288_robot_config.h:
+
+host/j288_rt.h:
+
+tools/j288/json.h:
