@@ -35,7 +35,8 @@ static void opts(cli_bus_opts_t *o)
     cli_bus_opts_init(o, &g);
 }
 
-/* No file: the id's all-zero configuration, the library's defaults. */
+/* No file: the id's all-zero configuration, the library's defaults filled in by the library
+ * (j288_joint_config()): the range [-pi, pi], 8 start samples, direction +1. */
 static void test_no_config(void)
 {
     cli_bus_opts_t o;
@@ -49,8 +50,10 @@ static void test_no_config(void)
     TEST_ASSERT_EQUAL_STRING("servo 3", sel.name);
     TEST_ASSERT_EQUAL_UINT8(3, sel.jc.id);
     TEST_ASSERT_FALSE(sel.jc.has_phase || sel.jc.clamp);
-    TEST_ASSERT_EQUAL_DOUBLE(0.0, (double)sel.jc.pos_min);
-    TEST_ASSERT_EQUAL_DOUBLE(0.0, (double)sel.jc.pos_max);
+    TEST_ASSERT_EQUAL_DOUBLE((double)(j288_real_t)-J288_PI, (double)sel.jc.pos_min);
+    TEST_ASSERT_EQUAL_DOUBLE((double)(j288_real_t)J288_PI, (double)sel.jc.pos_max);
+    TEST_ASSERT_EQUAL_UINT8(8, sel.jc.init_samples);
+    TEST_ASSERT_EQUAL_INT8(1, sel.jc.direction);
     TEST_ASSERT_NULL(o.port);
     TEST_ASSERT_EQUAL_INT(0, cli_error_lines(line, sizeof line));
 }
@@ -82,11 +85,15 @@ static void test_both(void)
     cli_expect_one_error("exclude each other");
 }
 
-/* The default range [-pi, pi] when both limits are 0; the configured one; clamp allows all. */
+/* The range of a configuration the library filled in ([-pi, pi] when both limits were 0); the
+ * configured one; clamp allows all; a continuous joint has no range. */
 static void test_pos_allowed(void)
 {
     j288_joint_config_t jc;
+    j288_joint_t j;
     memset(&jc, 0, sizeof jc);
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_joint_init(&j, &jc));
+    jc = *j288_joint_config(&j);
     TEST_ASSERT_TRUE(cli_joint_pos_allowed(&jc, 3.14));
     TEST_ASSERT_TRUE(cli_joint_pos_allowed(&jc, -3.14));
     TEST_ASSERT_FALSE(cli_joint_pos_allowed(&jc, 3.15));
@@ -97,6 +104,12 @@ static void test_pos_allowed(void)
     TEST_ASSERT_FALSE(cli_joint_pos_allowed(&jc, 0.0));
     jc.clamp = true;
     TEST_ASSERT_TRUE(cli_joint_pos_allowed(&jc, 0.0));
+    memset(&jc, 0, sizeof jc);
+    jc.continuous = true;
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_joint_init(&j, &jc));
+    jc = *j288_joint_config(&j);
+    TEST_ASSERT_TRUE(cli_joint_pos_allowed(&jc, 100.0));
+    TEST_ASSERT_EQUAL_DOUBLE(-7.0, cli_joint_nearest_inside(&jc, -7.0));
 }
 
 #ifdef J288_HAVE_LIBYAML
