@@ -38,6 +38,7 @@ falls_from() {
 }
 
 t_move_holds() {
+    local held
     start_sim mh --ids 1 --start-angle 1:0 "${LOAD[@]}" --quiet || return 1
     # The issue's command: ramp, hold, exit; then 2 s with no host.
     e2e_run "$J288" --port "$DEV" move --id 1 --pos 0.5 --duration 3 "${M[@]}"
@@ -47,13 +48,16 @@ t_move_holds() {
     last_frame_is 1 'status=1 wd=0 ' || return 1
     grep -q "holding at 0.5 rad with the watchdog off: the servo keeps holding after exit" <<<"$E2E_OUT" ||
         { echo "move said: $E2E_OUT"; return 1; }
-    # hold --then hold: the same after a hold of the pose it is at.
-    e2e_run "$J288" --port "$DEV" hold --id 1 --duration 0.5 --then hold "${M[@]}"
+    # hold --then hold: the same after a hold of the pose it is at (hold_pos: the angle it
+    # found, which the load had already pulled some tau/kp = 25 mrad below 0.5).
+    e2e_run "$J288" --port "$DEV" hold --id 1 --duration 0.5 --then hold --json "${M[@]}"
     [ "$E2E_RC" -eq 0 ] || { echo "hold --then hold: exit $E2E_RC: $E2E_ERR"; return 1; }
-    grep -q "holding at .* rad with the watchdog off" <<<"$E2E_OUT" || { echo "hold said: $E2E_OUT"; return 1; }
+    echo "$E2E_OUT" >"$E2E_TMP/hold.json"
+    [ "$(jget "$E2E_TMP/hold.json" holding)" = True ] || { echo "hold said: $E2E_OUT"; return 1; }
+    held=$(jget "$E2E_TMP/hold.json" hold_pos)
     last_frame_is 1 'status=1 wd=0 ' || return 1
     after_sim_seconds 2 || return 1
-    near "$(truth_val 1 theta)" 0.5 0.05 || { echo "2 s after hold --then hold exited"; return 1; }
+    near "$(truth_val 1 theta)" "$held" 0.05 || { echo "2 s after hold --then hold exited"; return 1; }
     # --then lock: locked at the end; the load then moves the joint away.
     e2e_run "$J288" --port "$DEV" move --id 1 --pos 0.3 --duration 2 --then lock "${M[@]}"
     [ "$E2E_RC" -eq 0 ] || { echo "move --then lock: exit $E2E_RC: $E2E_ERR"; return 1; }
