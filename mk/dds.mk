@@ -4,8 +4,9 @@
 #                      libsystemd (Debian: libsystemd-dev) it talks to systemd (sd_notify:
 #                      READY, WATCHDOG), without it a one-line notice (CI=true: an error)
 #   test/dds/*.sh      the namespace guard, golden XCDR1 bytes, the unitree crc and the type
-#                      hashes, the bridge end to end (ROS 2 and both unitree modes; soft limits and a wheel, limits_e2e.sh), the service
-#                      under a fake systemd, each in a private network namespace (TEST_SCRIPTS)
+#                      hashes, the bridge end to end (ROS 2 and both unitree modes; soft limits
+#                      and a wheel: limits_e2e.sh), the service under a fake systemd, each in a
+#                      private network namespace (TEST_SCRIPTS)
 #   make test-dds      those tests alone (CI's test-dds step)
 #   make test-dds-fastdds  a Fast DDS peer (ROS 2's default middleware) against the bridge, lo
 #                      with and without multicast (CI's test-fastdds step; Debian:
