@@ -572,9 +572,10 @@ static int plan_fields(const drive_args_t *d, drive_plan_t *p)
     if (d->side == SIDE_JOINT) {
         return plan_joint(d, p);
     }
-    if (d->sel.rj != NULL && d->sel.rj->has_limits && d->kind != DRIVE_TORQUE) {
+    if (d->sel.rj != NULL && d->sel.rj->has_limits) {
         /* The rotor and output frames count from power-up: a target there cannot be held to
-         * the joint's limits, so a joint that has limits is driven in its own frame. */
+         * the joint's limits, so a joint that has limits is driven in its own frame (a torque
+         * too: the joint frame stops it at its limits). */
         cli_error("%s: --side %s would bypass its limits [%g, %g]; drive it in the joint frame "
                   "(the default); nothing sent",
                   d->sel.name, d->side == SIDE_ROTOR ? "rotor" : "output",
