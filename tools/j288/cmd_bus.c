@@ -1058,6 +1058,10 @@ static int run_drive(drive_args_t *d, cli_bus_opts_t *o)
     "                   limits and gains); rotor: the raw rotor frame; output: rotor / N,\n"       \
     "                   counted from wherever the rotor started at power-up (no limits)\n"         \
     "  --id N           the servo; or --joint NAME with --config FILE\n"                           \
+    "On the joint side a torque toward a limit becomes a hold at the limit before the joint\n"   \
+    "gets there (the limit law, docs/joint.md); --id alone has the limits [-pi, pi]: a servo\n"  \
+    "that turns on takes --side output, or a --config joint with continuous: true. A --config\n" \
+    "joint that has limits is driven on the joint side only.\n"                                   \
     "A target outside the joint's limits is refused before anything is sent (exit 2),\n"          \
     "unless the joint is configured to clamp. A joint found up to 0.05 rad beyond its\n"          \
     "limits starts from the nearest one (it is pulled in); farther out it is refused (exit 2).\n" \
