@@ -838,7 +838,7 @@ static void test_speed_and_torque_stop_at_a_limit_and_a_wheel_turns(void)
     memset(&g_truth, 0, sizeof g_truth);
     (void)snprintf(g_truth.path, sizeof g_truth.path, "/tmp/j288-robot-test-%ld.truth",
                    (long)getpid());
-    g_truth.every_cycle_joint = 1u;
+    g_truth.every_cycle_joint = 99u; /* none until the angles are known */
     g_truth.every_cycle.torque = -1.0;
     o.on_cycle = truth_cycle;
     o.user = &g_truth;
@@ -856,7 +856,6 @@ static void test_speed_and_torque_stop_at_a_limit_and_a_wheel_turns(void)
     g_cfg.joint[2].continuous = true;
 #endif
     TEST_ASSERT_EQUAL_INT(J288_OK, j288_robot_open(&g_robot, &g_cfg, &o));
-    g_truth.every_cycle_joint = 99u; /* not before the angles are known */
     cycle_until_known();
     g_truth.every_cycle_joint = 1u;
     TEST_ASSERT_EQUAL_INT(J288_OK, j288_robot_read(&g_robot, 0, &st));
