@@ -20,7 +20,7 @@
 # a failure, scripts/need.sh).
 set -u
 export LC_ALL=C
-cd "$(dirname "$0")/.."
+cd "$(dirname "$0")/.." || exit 1
 
 # Modules of more files than S.h, S.c and S_priv.h: "HEADER: further files of its module".
 OWNERS='
@@ -90,7 +90,7 @@ done
 # A typedef of a private struct's tag elsewhere (typedef struct j288_robot j288_robot_t;).
 while read -r kw tag hdr; do
     [ "$kw" = struct ] || continue
-    grep -rhoE "typedef[ \t]+struct[ \t]+$tag[ \t]+[A-Za-z0-9_]+[ \t]*;" "$S" |
+    grep -rhoE "typedef[ \t]+struct[ \t]+${tag}[ \t]+[A-Za-z0-9_]+[ \t]*;" "$S" |
         sed -E "s/.*[ \t]([A-Za-z0-9_]+)[ \t]*;/\\1 ${hdr//\//\\/}/"
 done <"$tmp/private.txt" | sort -u >"$tmp/typedefs.txt"
 cat "$tmp/typedefs.txt" >>"$tmp/private.txt"
@@ -172,8 +172,8 @@ if { command -v idlc && pkg-config --exists CycloneDDS; } >/dev/null 2>&1 || [ "
     for idl in tools/j288-dds/idl/*.idl; do
         idlc -t -I tools/j288-dds/idl -o "$tmp/dds" "$idl" >>"$tmp/errors.txt" 2>&1
     done
-    cc_files gcc "${tool[@]}" -Itools/j288-dds -I"$tmp/dds" $(pkg-config --cflags CycloneDDS 2>/dev/null) \
-        -- tools/j288-dds/*.c
+    read -ra dds <<<"$(pkg-config --cflags CycloneDDS 2>/dev/null)"
+    cc_files gcc "${tool[@]}" -Itools/j288-dds -I"$tmp/dds" "${dds[@]}" -- tools/j288-dds/*.c
 else missing+=("idlc and CycloneDDS (for tools/j288-dds)"); fi
 
 wait
