@@ -1120,16 +1120,25 @@ static void to_joint_target(const j288_robot_target_t *t, j288_joint_target_t *j
     jt->kd = (j288_real_t)t->kd;
 }
 
-int j288_robot_set_target(j288_robot_t *r, unsigned joint, const j288_robot_target_t *t)
+/* The checks both target calls make, then t as the joint layer's target. */
+static int joint_target_of(const j288_robot_t *r, unsigned joint, const j288_robot_target_t *t,
+                           j288_joint_target_t *jt)
 {
-    j288_joint_target_t jt;
     int rc;
     if (r == NULL || t == NULL)
         return J288_ERR_NULL;
     rc = target_check(r, joint);
+    if (rc == J288_OK)
+        to_joint_target(t, jt);
+    return rc;
+}
+
+int j288_robot_set_target(j288_robot_t *r, unsigned joint, const j288_robot_target_t *t)
+{
+    j288_joint_target_t jt;
+    int rc = joint_target_of(r, joint, t, &jt);
     if (rc != J288_OK)
         return rc;
-    to_joint_target(t, &jt);
     rc = j288_joint_bus_set_target(&r->bus[r->joint_bus[joint]].jb, &r->joint[joint], &jt, NULL);
     if (rc == J288_OK)
         r->driven = true;
@@ -1140,13 +1149,9 @@ int j288_robot_check_target(const j288_robot_t *r, unsigned joint, const j288_ro
 {
     j288_joint_target_t jt;
     j288_cmd_raw_t cmd;
-    int rc;
-    if (r == NULL || t == NULL)
-        return J288_ERR_NULL;
-    rc = target_check(r, joint);
+    int rc = joint_target_of(r, joint, t, &jt);
     if (rc != J288_OK)
         return rc;
-    to_joint_target(t, &jt);
     return j288_joint_command(&r->joint[joint], &jt, &cmd, NULL);
 }
 

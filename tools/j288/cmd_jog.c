@@ -291,7 +291,12 @@ static void drive(jog_t *g)
         t.kp = jj->kp;
         t.kd = jj->kd;
         rc = j288_robot_set_target(g->r, j, &t);
-        if (rc != J288_OK) {
+        if (rc == J288_ERR_OFFLINE) { /* its bus is gone: keep the bus's news on screen */
+            lock_joint(g, j);
+            say(g, "bus '%s' is gone: %s locked",
+                j288_robot_bus_name(g->r, (unsigned)j288_robot_joint_bus(g->r, j)),
+                j288_robot_joint_name(g->r, j));
+        } else if (rc != J288_OK) {
             lock_joint(g, j);
             say(g, "%s locked: %s", j288_robot_joint_name(g->r, j), j288_strerror(rc));
         }
