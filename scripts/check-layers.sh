@@ -161,7 +161,9 @@ cc_files gcc "${host[@]}" -- host/j288_number.c host/j288_robot.c host/j288_robo
     host/j288_rt.c host/j288_rt_linux.c
 cc_files gcc "${tool[@]}" -Itools/j288 -- tools/j288/*.c
 cc_files gcc "${lib[@]}" -Itools/j288-sim -- tools/j288-sim/*.c
-cc_files gcc "${lib[@]}" -Iport/stm32_hal -I"$PWD/test/stm32/stub" -- port/stm32_hal/*.c
+cc_files gcc "${lib[@]}" -Iport/stm32_hal -I"$PWD/test/stm32/stub" -Iexamples/stm32_hal -- \
+    port/stm32_hal/*.c examples/stm32_hal/*.c
+cc_files gcc "${lib[@]}" -Iport/template -- port/template/*.c
 missing=()
 if bash scripts/need.sh x86_64-w64-mingw32-gcc mingw-w64 2>/dev/null || [ "${CI:-}" = true ]; then
     cc_files x86_64-w64-mingw32-gcc "${lib[@]}" -Iport/desktop -Iport/windows -Ihost -- \
