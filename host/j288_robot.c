@@ -1048,7 +1048,8 @@ int j288_robot_joint_config(const j288_robot_t *r, unsigned joint, j288_joint_co
 static bool joint_not_lost(const j288_robot_t *r, unsigned joint)
 {
     const j288_robot_bus_t *b = &r->bus[r->joint_bus[joint]];
-    return bus_live(b) && b->stats.up && j288_sched_slot(&b->sched, r->joint[joint].cfg.id)->online;
+    uint8_t id = j288_joint_config(&r->joint[joint])->id;
+    return bus_live(b) && b->stats.up && j288_sched_slot(&b->sched, id)->online;
 }
 
 int j288_robot_read(const j288_robot_t *r, unsigned joint, j288_robot_state_t *st)
@@ -1332,7 +1333,8 @@ static void txn_done(void *user, const j288_txn_t *txn)
  * it, and the submit was then left unfinished, the bus refusing every later one as busy. */
 static uint32_t txn_bound_us(const j288_robot_t *r, const j288_robot_bus_t *b)
 {
-    uint64_t t = (uint64_t)j288_bus_reply_budget_us(&b->bus) * 2u * (b->bus.cfg.retries + 1u) +
+    uint64_t attempts = j288_bus_config(&b->bus)->retries + 1u;
+    uint64_t t = (uint64_t)j288_bus_reply_budget_us(&b->bus) * 2u * attempts +
                  J288_ROBOT_STOP_TIMEOUT_US;
     uint32_t stop = stop_bound_us(r);
     if (t > 60000000u)

@@ -4,8 +4,9 @@
 #                      libsystemd (Debian: libsystemd-dev) it talks to systemd (sd_notify:
 #                      READY, WATCHDOG), without it a one-line notice (CI=true: an error)
 #   test/dds/*.sh      the namespace guard, golden XCDR1 bytes, the unitree crc and the type
-#                      hashes, the bridge end to end (ROS 2 and both unitree modes), the service
-#                      under a fake systemd, each in a private network namespace (TEST_SCRIPTS)
+#                      hashes, the bridge end to end (ROS 2 and both unitree modes; soft limits
+#                      and a wheel: limits_e2e.sh), the service under a fake systemd, each in a
+#                      private network namespace (TEST_SCRIPTS)
 #   make test-dds      those tests alone (CI's test-dds step)
 #   make test-dds-fastdds  a Fast DDS peer (ROS 2's default middleware) against the bridge, lo
 #                      with and without multicast (CI's test-fastdds step; Debian:
@@ -42,7 +43,7 @@ DDS_TOOL_OBJ := $(addprefix $(OBJ)/tools/j288-dds/,bridge.o diag.o unitree_crc.o
 DDS_TEST_PEER := $(BUILD)/test/dds_peer
 DDS_GOLDEN := $(BUILD)/test/dds_golden
 DDS_TESTS := test/dds/netns_guard.sh test/dds/golden.sh test/dds/bridge_e2e.sh test/dds/input_e2e.sh \
-    test/dds/unitree_e2e.sh test/dds/service.sh test/dds/loss_e2e.sh
+    test/dds/unitree_e2e.sh test/dds/service.sh test/dds/loss_e2e.sh test/dds/limits_e2e.sh
 DDS_PEERS := $(DDS_TEST_PEER) $(DDS_TEST_PEER)_xt $(DDS_GOLDEN)
 
 ifeq ($(DDS_FOUND),yes)

@@ -157,6 +157,8 @@ TEST_SCRIPTS += test/e2e/cli_offline.sh test/e2e/cli_bus.sh test/e2e/cli_bus_fau
 # The joint frame end to end against the simulator's truth (the tool, the config, the sim),
 # in three scripts that run side by side (test/e2e/lib_joint.sh).
 TEST_SCRIPTS += test/e2e/joint_seed.sh test/e2e/joint_range.sh test/e2e/joint_refuse.sh
+# Soft limits for the tool's torque (issue 29): it stops at a limit, the frames without limits refused.
+TEST_SCRIPTS += test/e2e/joint_limits.sh
 # j288 top on a terminal (tmux: capture-pane, send-keys) and through a pipe; j288 jog's every
 # key and its live plot against the CSV it logged.
 TEST_SCRIPTS += test/e2e/cli_top.sh test/e2e/cli_jog.sh

@@ -23,7 +23,9 @@ for f in "$BIN/j288" "$SIM"; do
 done
 
 rate() { # config file -> cycles/s (JSON field)
-    "$BIN/j288" --config "$1" log --rate 0 --duration "$DURATION" --json |
+    # (exit 1 when a bus stopped answering meanwhile, which a loaded machine's starved
+    # simulator can make: the rate is still the run's, and the tool has said so on stderr)
+    { "$BIN/j288" --config "$1" log --rate 0 --duration "$DURATION" --json || true; } |
         sed -n 's/.*"cycles_per_s": *\([0-9.]*\).*/\1/p'
 }
 

@@ -128,6 +128,11 @@ uint32_t j288_bus_reply_budget_us(const j288_bus_t *bus)
     return (bus == NULL) ? 0u : bus->reply_budget_us;
 }
 
+const j288_bus_config_t *j288_bus_config(const j288_bus_t *bus)
+{
+    return (bus == NULL) ? NULL : &bus->cfg;
+}
+
 static int check_config(const j288_bus_config_t *c)
 {
     if (c->retries > J288_CONFIG_MAX_RETRIES) {
@@ -448,11 +453,11 @@ static void take_frame(j288_bus_t *bus, const uint8_t *frame, uint32_t now)
  * consumed (stops after a frame). */
 static uint32_t take_reply_bytes(j288_bus_t *bus, const uint8_t *p, uint32_t n, uint32_t now)
 {
-    uint32_t crc_before = bus->parser.stats.crc_errors;
+    uint32_t crc_before = j288_parser_stats(&bus->parser)->crc_errors;
     const uint8_t *frame = NULL;
     size_t used = 0u;
     int rc = j288_parser_scan(&bus->parser, p, n, &used, &frame);
-    uint32_t crc_new = bus->parser.stats.crc_errors - crc_before;
+    uint32_t crc_new = j288_parser_stats(&bus->parser)->crc_errors - crc_before;
 
     if (crc_new != 0u) {
         bus->stats.crc_errors += crc_new;
@@ -726,7 +731,7 @@ J288_NOINLINE static bool reply_fast(j288_bus_t *bus, const uint8_t *data, size_
     uint32_t now;
 
     if ((len != J288_REPLY_LEN) || (bus->state != (uint8_t)J288_BUS_WAIT_REPLY) ||
-        !events_since_seen(bus, 0u) || (bus->parser.len != 0u) ||
+        !events_since_seen(bus, 0u) || (j288_parser_pending(&bus->parser) != 0u) ||
         (j288_get_u16le(data) != J288_REPLY_HEAD16) || ((data[2] & 0x0Fu) != bus->tx_id) ||
         !j288_reply_crc_ok(&bus->crc, data)) {
         return false;
@@ -734,7 +739,7 @@ J288_NOINLINE static bool reply_fast(j288_bus_t *bus, const uint8_t *data, size_
     now = bus->port->now_us(bus->port_ctx);
     bus->ring_head = head + J288_REPLY_LEN;
     bus->ring_tail = head + J288_REPLY_LEN;
-    bus->parser.stats.frames++;
+    j288_parser_counters(&bus->parser)->frames++;
     bus->in_advance = true;
     bus->again = false;
     j288_reply_unpack(data, &bus->txn[bus->cur].reply);
@@ -1019,5 +1024,5 @@ const j288_bus_stats_t *j288_bus_stats(const j288_bus_t *bus)
 
 const j288_parser_stats_t *j288_bus_parser_stats(const j288_bus_t *bus)
 {
-    return (bus == NULL) ? NULL : &bus->parser.stats;
+    return (bus == NULL) ? NULL : j288_parser_stats(&bus->parser);
 }

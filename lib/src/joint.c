@@ -187,7 +187,7 @@ static void fill_defaults(j288_joint_config_t *c, const j288_jointq_config_t *q)
 /* The state after the core's latest reply. */
 static void state_from_core(j288_joint_t *j)
 {
-    const j288_jointq_state_t *s = &j->core.st;
+    const j288_jointq_state_t *s = j288_jointq_state_of(&j->core);
     j->st.known = s->known;
     j->st.calibrated = s->calibrated;
     j->st.cal_mismatch = s->cal_mismatch;
@@ -369,7 +369,7 @@ int j288_joint_bus_add(j288_joint_bus_t *jb, j288_joint_t *j)
     }
     err = j288_jointq_bus_add(&jb->core, &j->core);
     if (err == J288_OK) {
-        jb->joint[j->core.cfg.id] = j; /* 0-14: the core checked it */
+        jb->joint[j288_jointq_config_of(&j->core)->id] = j; /* 0-14: the core checked it */
     }
     return err;
 }

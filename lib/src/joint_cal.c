@@ -59,8 +59,8 @@ int j288_cal_init(j288_cal_t *cal, const j288_joint_config_t *cfg)
         return err;
     }
     (void)memset(cal, 0, sizeof *cal);
-    cal->label = j.core.cfg;
-    cal->centre = j.core.centre;
+    cal->label = *j288_jointq_config_of(&j.core);
+    cal->centre = j288_jointq_centre(&j.core);
     cal->cal_tol = j.cfg.cal_tol;
     return J288_OK;
 }

@@ -16,6 +16,24 @@ int j288_jointq_check_config(const j288_jointq_config_t *cfg, j288_jointq_config
 j288_q24_t j288_jointq_label_theta(const j288_jointq_config_t *c, j288_q24_t centre,
                                    j288_q24_t theta);
 
+/* j288_jointq_state() and j288_jointq_config() inline, for the facade's path from each reply
+ * (no call there), and the middle of the joint's range (the turn labelling's centre) for the
+ * calibration fit. j not NULL. */
+static inline const j288_jointq_state_t *j288_jointq_state_of(const j288_jointq_t *j)
+{
+    return &j->st;
+}
+
+static inline const j288_jointq_config_t *j288_jointq_config_of(const j288_jointq_t *j)
+{
+    return &j->cfg;
+}
+
+static inline j288_q24_t j288_jointq_centre(const j288_jointq_t *j)
+{
+    return j->centre;
+}
+
 /* a - b in rotor LSB, modulo 2^32 (the wire's int32 may wrap), as an int32. */
 int32_t j288_jointq_lsb_diff(int32_t a, int32_t b);
 

@@ -16,6 +16,13 @@ static inline void j288_parser_drop(j288_parser_t *p)
     p->len = 0u;
 }
 
+/* The parser's statistics, writable: the bus counts a reply it takes whole, without the
+ * parser, as the parser would have (a frame). */
+static inline j288_parser_stats_t *j288_parser_counters(j288_parser_t *p)
+{
+    return &p->stats;
+}
+
 /*
  * j288_parser_feed() without the copy: on J288_PARSE_FRAME, *frame points at the good frame,
  * which is inside data when it arrived whole while the parser was hunting (checked where it

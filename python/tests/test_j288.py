@@ -67,6 +67,22 @@ class Sim:
                 self.proc.kill()
                 self.proc.wait()
 
+    def truth(self, path: Path, servo: int, wait: float = 20.0) -> float:
+        """Servo `servo`'s true output angle (rad), from the --truth file at `path` the
+        simulator was started with: asked for (SIGWINCH) and read once rewritten."""
+        def head() -> str:
+            return path.read_text().split("\n", 1)[0] if path.exists() else ""
+        before = head()
+        self.proc.send_signal(signal.SIGWINCH)
+        deadline = time.monotonic() + wait
+        while head() == before:
+            assert time.monotonic() < deadline, "the simulator did not rewrite its truth"
+            time.sleep(0.02)
+        for line in path.read_text().splitlines():
+            if line.startswith(f"id={servo} "):
+                return float(line.split()[1].split("=")[1])
+        raise AssertionError(f"servo {servo} not in {path}")
+
     def logged(self, needle: str, wait: float = 20.0) -> bool:
         """Whether the simulator logged needle, waiting up to `wait` s for it to read."""
         deadline = time.monotonic() + wait
@@ -265,8 +281,10 @@ def test_robot_two_buses(sims, tmp_path: Path) -> None:
 
 def test_robot_wheel_and_soft_limit(sims, tmp_path: Path) -> None:
     """A continuous joint from the config (continuous: true) turns past any turn, its angle
-    never wrapped; a speed target held toward a soft limit stops the other joint at it."""
-    s = sims("1,2")
+    never wrapped; a speed target held toward a soft limit stops the other joint at it, as the
+    simulator's truth has it."""
+    truth = tmp_path / "truth"
+    s = sims("1,2", "--truth", str(truth))
     cfg = tmp_path / "wheel.yaml"
     cfg.write_text(f"buses:\n  - name: b\n    port: {s.pty}\n    margin_us: {MARGIN}\n"
                    "joints:\n  - {name: wheel, id: 1, continuous: true}\n"
@@ -274,6 +292,7 @@ def test_robot_wheel_and_soft_limit(sims, tmp_path: Path) -> None:
     with j288.Robot(str(cfg)) as robot:
         cycle_until_known(robot)
         start = robot.state("wheel").pos
+        wheel0 = s.truth(truth, 1)
         arm = [robot.state("arm").pos]
         for _ in range(40000):  # until the wheel has turned three turns (about 2.5 s)
             robot.set_target("wheel", robot.state("wheel").pos, speed=8.0, kd=2.0)
@@ -288,6 +307,8 @@ def test_robot_wheel_and_soft_limit(sims, tmp_path: Path) -> None:
         # there: never further out than it started or 0.05 rad past the limit
         assert all(abs(q - 0.3) < 0.05 for q in arm[-10:]), (arm[0], arm[-10:])
         assert max(arm) <= max(arm[0], 0.3) + 0.05, (arm[0], max(arm))
+        assert abs(s.truth(truth, 2) - 0.3) < 0.05  # the simulator's own angle
+        assert s.truth(truth, 1) > wheel0 + 6.0 * math.pi  # the wheel did turn three turns
 
 
 def test_robot_stop_on_exception(sims, tmp_path: Path) -> None:

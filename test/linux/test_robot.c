@@ -1,7 +1,8 @@
 /*
  * The multi-bus runner against several j288-sim buses, each on its own pseudo-terminal:
  * cycles over every bus from one loop, fresh state per joint, the bad configs, a device
- * that is gone, a bus that stops answering while the others go on, the safe stop.
+ * that is gone, a bus that stops answering while the others go on, the safe stop; soft
+ * limits for speed and torque targets and a continuous joint, against the simulator's truth.
  *
  * Each test starts its simulators (fork/exec, --exit-after as a backstop); tearDown kills
  * and reaps them. The simulator binary: $J288_SIM, else the path compiled in. No check
@@ -60,7 +61,7 @@ static j288_robot_config_t g_cfg;
 static void sim_start_with(int k, const char *ids, const char *const *extra)
 {
     sim_t *s = &g_sim[k];
-    const char *args[16];
+    const char *args[SIM_PROCESS_MAX_ARGS + 1];
     int n = 0;
 
     args[n++] = "--quiet";
@@ -70,7 +71,7 @@ static void sim_start_with(int k, const char *ids, const char *const *extra)
     args[n++] = ids;
     args[n++] = "--log";
     args[n++] = s->log;
-    while (extra != NULL && *extra != NULL && n < 14)
+    while (extra != NULL && *extra != NULL && n < SIM_PROCESS_MAX_ARGS)
         args[n++] = *extra++;
     args[n] = NULL;
     sim_process_start(args, &s->pid, s->pty, sizeof s->pty);
@@ -761,6 +762,173 @@ static void test_hold_just_beyond_a_limit(void)
 }
 
 
+/* ---- soft limits in every mode and a continuous joint, against the simulator's truth ------- */
+
+/* The simulator's truth (--truth FILE, rewritten on SIGWINCH), sampled without blocking the
+ * loop: on_cycle reads the file when it has been rewritten, keeps each joint's extremes, and
+ * asks for the next one. */
+#define TRUTH_IDS 4
+typedef struct {
+    char path[80];
+    pid_t pid;
+    char head[256];  /* the header line of the latest file read (its seq) */
+    bool asked;      /* a SIGWINCH is out */
+    unsigned reads;  /* files read */
+    double theta[TRUTH_IDS], most[TRUTH_IDS], least[TRUTH_IDS];
+    /* joints set again every cycle (torque toward a limit, as a Python loop does) */
+    unsigned every_cycle_joint;
+    j288_robot_target_t every_cycle;
+} truth_t;
+
+static truth_t g_truth;
+
+/* Read the truth file if it is a new one; true when it was. */
+static bool truth_read(truth_t *t)
+{
+    char line[256];
+    bool fresh = false;
+    FILE *f = fopen(t->path, "r");
+    if (f == NULL)
+        return false;
+    if (fgets(line, sizeof line, f) != NULL && strncmp(line, "# j288-sim truth seq=", 21) == 0 &&
+        strncmp(line, t->head, sizeof t->head - 1) != 0) {
+        (void)snprintf(t->head, sizeof t->head, "%s", line);
+        fresh = true;
+        while (fgets(line, sizeof line, f) != NULL) {
+            unsigned id;
+            double th;
+            if (sscanf(line, "id=%u theta=%lf", &id, &th) == 2 && id >= 1u && id <= TRUTH_IDS) {
+                t->theta[id - 1u] = th;
+                if (t->reads == 0u || th > t->most[id - 1u])
+                    t->most[id - 1u] = th;
+                if (t->reads == 0u || th < t->least[id - 1u])
+                    t->least[id - 1u] = th;
+            }
+        }
+        t->reads++;
+    }
+    fclose(f);
+    return fresh;
+}
+
+static void truth_sample(truth_t *t)
+{
+    if (t->asked && truth_read(t))
+        t->asked = false;
+    if (!t->asked) {
+        (void)kill(t->pid, SIGWINCH);
+        t->asked = true;
+    }
+}
+
+/* The truth now (blocking, bounded: 20 s), extremes included. */
+static void truth_now(truth_t *t)
+{
+    int i;
+    (void)kill(t->pid, SIGWINCH);
+    for (i = 0; i < 2000 && !truth_read(t); i++)
+        usleep(10000);
+    TEST_ASSERT_TRUE_MESSAGE(i < 2000, "the simulator did not rewrite its truth file");
+    t->asked = false;
+}
+
+static void truth_cycle(void *user, j288_robot_t *r, const j288_robot_cycle_t *c)
+{
+    truth_t *t = user;
+    (void)c;
+    truth_sample(t);
+    if (t->every_cycle_joint < j288_robot_njoints(r)) {
+        j288_robot_state_t st;
+        (void)j288_robot_read(r, t->every_cycle_joint, &st);
+        t->every_cycle.pos = st.pos;
+        (void)j288_robot_set_target(r, t->every_cycle_joint, &t->every_cycle);
+    }
+}
+
+static void print_rad(const char *what, double x)
+{
+    char buf[96];
+    (void)snprintf(buf, sizeof buf, "%s: %.4f rad", what, x);
+    UnityPrint(buf);
+    UNITY_PRINT_EOL();
+}
+
+/*
+ * Issue 29 through the runner (the C API the bridge and the tool use): limits [-0.4, 0.4],
+ * - joint 0: a speed of 1 rad/s toward the upper limit, set once (the binding remakes its
+ *   command from every reply);
+ * - joint 1: a torque of -1 N*m toward the lower limit, no damping of its own, set again every
+ *   cycle with the joint's angle as its position (a Python loop's way);
+ * - joint 2: a continuous joint from 3 rad at 10 rad/s (several turns), then held: its angle
+ *   the simulator's, never wrapped.
+ * Each limited joint stops within 0.05 rad of its limit, as the simulator's truth has it.
+ */
+static void test_speed_and_torque_stop_at_a_limit_and_a_wheel_turns(void)
+{
+    static const char *const start[] = {"--start-angle", "1:0", "--start-angle", "2:0",
+                                        "--start-angle", "3:3", "--truth", g_truth.path, NULL};
+    j288_robot_options_t o = counting_options();
+    j288_robot_target_t speed = {0.0, 1.0, 0.0, 0.0, 1.0};
+    j288_robot_target_t wheel = {0.0, 10.0, 0.0, 0.0, 1.0};
+    j288_robot_state_t st;
+    unsigned j;
+
+    memset(&g_truth, 0, sizeof g_truth);
+    (void)snprintf(g_truth.path, sizeof g_truth.path, "/tmp/j288-robot-test-%ld.truth",
+                   (long)getpid());
+    g_truth.every_cycle_joint = 99u; /* none until the angles are known */
+    g_truth.every_cycle.torque = -1.0;
+    o.on_cycle = truth_cycle;
+    o.user = &g_truth;
+    sim_start_with(0, "1,2,3", start);
+    g_truth.pid = g_sim[0].pid;
+    make_config(1, LOADED_MARGIN_US);
+    for (j = 0; j < 2; j++) {
+        g_cfg.joint[j].has_limits = true;
+        g_cfg.joint[j].pos_min = -0.4;
+        g_cfg.joint[j].pos_max = 0.4;
+        g_cfg.joint[j].has_kd = true;
+        g_cfg.joint[j].kd = 1.0;
+    }
+#ifndef OLD_API
+    g_cfg.joint[2].continuous = true;
+#endif
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_robot_open(&g_robot, &g_cfg, &o));
+    cycle_until_known();
+    g_truth.every_cycle_joint = 1u;
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_robot_read(&g_robot, 0, &st));
+    speed.pos = st.pos;
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_robot_set_target(&g_robot, 0, &speed));
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_robot_read(&g_robot, 2, &st));
+    wheel.pos = st.pos;
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_robot_set_target(&g_robot, 2, &wheel));
+    truth_now(&g_truth);
+    /* 2 s of cycles at 500 Hz (the scenario's length, on the simulator's wall clock) */
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_robot_run(&g_robot, 2000u, 0u, 2000000u));
+    truth_now(&g_truth);
+    print_rad("speed 1 rad/s for 2 s toward 0.4: end", g_truth.theta[0]);
+    print_rad("  furthest", g_truth.most[0]);
+    print_rad("torque -1 N*m for 2 s toward -0.4: end", g_truth.theta[1]);
+    print_rad("  furthest", g_truth.least[1]);
+    print_rad("a wheel at 10 rad/s for 2 s from 3 rad", g_truth.theta[2]);
+    TEST_ASSERT_DOUBLE_WITHIN(0.05, 0.4, g_truth.theta[0]);
+    TEST_ASSERT_TRUE(g_truth.most[0] <= 0.4 + 0.05);
+    TEST_ASSERT_DOUBLE_WITHIN(0.05, -0.4, g_truth.theta[1]);
+    TEST_ASSERT_TRUE(g_truth.least[1] >= -0.4 - 0.05);
+    TEST_ASSERT_TRUE(g_truth.theta[2] > 3.0 + 10.0); /* turned on, several turns */
+    /* the wheel held where it is, at rest: its angle is the simulator's */
+    g_truth.every_cycle_joint = 99u;
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_robot_hold(&g_robot, 2));
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_robot_run(&g_robot, 2000u, 0u, 1000000u));
+    truth_now(&g_truth);
+    TEST_ASSERT_EQUAL_INT(J288_OK, j288_robot_read(&g_robot, 2, &st));
+    print_rad("the wheel held: its angle", st.pos);
+    print_rad("  the simulator's", g_truth.theta[2]);
+    TEST_ASSERT_TRUE(st.known);
+    TEST_ASSERT_DOUBLE_WITHIN(0.002, g_truth.theta[2], st.pos);
+    (void)unlink(g_truth.path);
+}
+
 /* 3 s without a command: longer than the servo's 1 s watchdog (the scenario, not a bound),
  * by enough that a simulator starved across the trip time, which excuses its whole stall
  * (stalls of up to 1.6 s were seen beside stress-ng), still sees more than 1 s. */
@@ -1177,6 +1345,7 @@ int main(void)
     RUN_TEST(test_servo_joint_takes_a_config);
     RUN_TEST(test_close_stops_after_an_unanswered_command);
     RUN_TEST(test_hold_just_beyond_a_limit);
+    RUN_TEST(test_speed_and_torque_stop_at_a_limit_and_a_wheel_turns);
     RUN_TEST(test_a_second_session_after_a_stop_is_obeyed);
     RUN_TEST(test_exchange_clears_and_reports_a_trip);
     RUN_TEST(test_cycles_clear_and_report_a_trip);

@@ -188,6 +188,22 @@ static void test_reply_budget_and_wire_time(void)
     TEST_ASSERT_EQUAL_UINT32(0u, j288_bus_reply_budget_us(NULL));
 }
 
+/* j288_bus_config(): the configuration as given, defaults filled in (the host reads its
+ * retries through it, not through the bus's fields). */
+static void test_config_accessor(void)
+{
+    j288_bus_config_t cfg;
+    memset(&cfg, 0, sizeof cfg);
+    cfg.retries = 2u;
+    cfg.margin_us = 3000u;
+    setup_cfg(&cfg);
+    TEST_ASSERT_NOT_NULL(j288_bus_config(&bus));
+    TEST_ASSERT_EQUAL_UINT8(2u, j288_bus_config(&bus)->retries);
+    TEST_ASSERT_EQUAL_UINT32(3000u, j288_bus_config(&bus)->margin_us);
+    TEST_ASSERT_EQUAL_UINT32(6000000u, j288_bus_config(&bus)->baud); /* 0: the default */
+    TEST_ASSERT_NULL(j288_bus_config(NULL));
+}
+
 /* j288_wire_time_us() divides without a division: exact against 64-bit arithmetic (modulo
  * 2^32 where the result does not fit), at the edges and at random. */
 static uint32_t wire_time_ref(uint32_t baud, uint32_t nbytes)
@@ -2110,6 +2126,7 @@ int main(void)
     UNITY_BEGIN();
     RUN_TEST(test_init_rejections);
     RUN_TEST(test_reply_budget_and_wire_time);
+    RUN_TEST(test_config_accessor);
     RUN_TEST(test_wire_time_exact);
     RUN_TEST(test_configured_guard);
     RUN_TEST(test_normal_transaction);

@@ -82,6 +82,7 @@ static void assert_stats(const j288_parser_t *p, uint32_t frames, uint32_t garba
     TEST_ASSERT_EQUAL_UINT32_MESSAGE(crc_errors, p->stats.crc_errors, "crc_errors");
     TEST_ASSERT_EQUAL_UINT32_MESSAGE(truncated, p->stats.truncated, "truncated");
     TEST_ASSERT_EQUAL_UINT32_MESSAGE(dropped, p->stats.dropped_bytes, "dropped_bytes");
+    TEST_ASSERT_EQUAL_PTR(&p->stats, j288_parser_stats(p)); /* the accessor the tools use */
 }
 
 /* Golden replies [first, first + n) back to back into dst; returns the length. */

@@ -591,7 +591,7 @@ void j288_sim_bus_feed(j288_sim_bus_t *b, const uint8_t *data, size_t len, uint6
         (void)j288_parser_flush(&b->parser);
     b->last_byte_us = now_us;
     for (i = 0u; i < len; i++) {
-        uint32_t crc_before = b->parser.stats.crc_errors;
+        uint32_t crc_before = j288_parser_stats(&b->parser)->crc_errors;
         size_t used = 0u;
         int rc;
         memmove(b->window, b->window + 1, J288_CMD_LEN - 1u);
@@ -607,7 +607,7 @@ void j288_sim_bus_feed(j288_sim_bus_t *b, const uint8_t *data, size_t len, uint6
                     b->log(b->user, now_us, b->window, &cmd);
                 dispatch(b, &cmd, now_us);
             }
-        } else if (b->parser.stats.crc_errors != crc_before) {
+        } else if (j288_parser_stats(&b->parser)->crc_errors != crc_before) {
             if (b->log != NULL)
                 b->log(b->user, now_us, b->window, NULL);
             bad_crc(b);

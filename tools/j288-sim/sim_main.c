@@ -490,7 +490,7 @@ static void print_stats(const sim_io_t *io, const j288_sim_bus_t *bus, const cha
             (unsigned long long)st->dropped, (unsigned long long)st->corrupted,
             (unsigned long long)st->late, (unsigned long long)st->noise,
             (unsigned long long)st->duplicates, (unsigned long long)st->watchdog_trips,
-            (unsigned long)bus->parser.stats.garbage_bytes,
+            (unsigned long)j288_parser_stats(&bus->parser)->garbage_bytes,
             (unsigned long long)(io->lost_no_client + io->queue_full),
             (unsigned long long)st->power_cycles);
     fflush(stderr);

@@ -587,9 +587,10 @@ static int plan_fields(const drive_args_t *d, drive_plan_t *p)
     if (d->side == SIDE_JOINT) {
         return plan_joint(d, p);
     }
-    if (d->sel.rj != NULL && d->sel.rj->has_limits && d->kind != DRIVE_TORQUE) {
+    if (d->sel.rj != NULL && d->sel.rj->has_limits) {
         /* The rotor and output frames count from power-up: a target there cannot be held to
-         * the joint's limits, so a joint that has limits is driven in its own frame. */
+         * the joint's limits, so a joint that has limits is driven in its own frame (a torque
+         * too: the joint frame stops it at its limits). */
         cli_error("%s: --side %s would bypass its limits [%g, %g]; drive it in the joint frame "
                   "(the default); nothing sent",
                   d->sel.name, d->side == SIDE_ROTOR ? "rotor" : "output",
@@ -1151,6 +1152,10 @@ static int run_drive(drive_args_t *d, cli_bus_opts_t *o)
     "                   limits and gains); rotor: the raw rotor frame; output: rotor / N,\n"       \
     "                   counted from wherever the rotor started at power-up (no limits)\n"         \
     "  --id N           the servo; or --joint NAME with --config FILE\n"                           \
+    "On the joint side a torque toward a limit becomes a hold at the limit before the joint\n"   \
+    "gets there (the limit law, docs/joint.md); --id alone has the limits [-pi, pi]: a servo\n"  \
+    "that turns on takes --side output, or a --config joint with continuous: true. A --config\n" \
+    "joint that has limits is driven on the joint side only.\n"                                   \
     "A target outside the joint's limits is refused before anything is sent (exit 2),\n"          \
     "unless the joint is configured to clamp. A joint found up to 0.05 rad beyond its\n"          \
     "limits starts from the nearest one (it is pulled in); farther out it is refused (exit 2).\n" \

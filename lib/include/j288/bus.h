@@ -257,6 +257,10 @@ uint32_t j288_wire_time_us(uint32_t baud, uint32_t nbytes);
 /* The reply deadline budget this bus uses, in microseconds from the start of transmit. */
 uint32_t j288_bus_reply_budget_us(const j288_bus_t *bus);
 
+/* The configuration the bus runs with: j288_bus_init()'s, defaults filled in (baud, guard,
+ * ...), e.g. its retries. Valid as long as the bus; NULL for a NULL bus. Thread or ISR. */
+const j288_bus_config_t *j288_bus_config(const j288_bus_t *bus);
+
 #ifdef __cplusplus
 }
 #endif

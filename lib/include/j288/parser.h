@@ -92,6 +92,13 @@ int j288_parser_flush(j288_parser_t *p);
 /* Drop any partial frame without counting it (e.g. before a new transaction). Stats stay. */
 void j288_parser_reset(j288_parser_t *p);
 
+/* The parser's statistics (frames, CRC errors, ... since init), valid as long as the parser.
+ * ISR-safe like the rest of the parser; never NULL for a non-NULL p. */
+static inline const j288_parser_stats_t *j288_parser_stats(const j288_parser_t *p)
+{
+    return &p->stats;
+}
+
 /* Bytes currently held (0 = hunting). */
 static inline size_t j288_parser_pending(const j288_parser_t *p) { return p->len; }
 
