@@ -1145,8 +1145,8 @@ static int run_drive(drive_args_t *d, cli_bus_opts_t *o)
     "  --rate HZ        command refresh rate, default 200\n"                                       \
     "  --duration S     stop after S seconds; default: run until Ctrl-C or SIGTERM\n"              \
     "  --watchdog W     on (default): the servo locks itself if commands stop for 1 s\n"           \
-    "  --keep           at the end leave the last command in force instead (with the\n"            \
-    "                   watchdog on the servo locks itself 1 s later); excludes --then\n"          \
+    "  --keep           leave the last command in force at the end (the watchdog on: the\n"       \
+    "                   servo locks itself 1 s later); excludes --then\n"                         \
     "  --side S         joint (default): the absolute joint frame (output encoder angle\n"         \
     "                   wrapped to [-pi, pi), or the --config joint's zero, direction,\n"          \
     "                   limits and gains); rotor: the raw rotor frame; output: rotor / N,\n"       \
@@ -1161,8 +1161,8 @@ static int run_drive(drive_args_t *d, cli_bus_opts_t *o)
     "limits starts from the nearest one (it is pulled in); farther out it is refused (exit 2).\n" \
     "The joint angle is watched: if it is lost (power cycle, slipped gear) the servo is\n"       \
     "locked and the command fails.\n"                                                             \
-    "Ctrl-C, SIGTERM, SIGHUP or SIGQUIT is an abort, not an end: the servo is sent lock\n"        \
-    "before exiting, whatever --then says (exit 130, 143, 129, 131); so is a failure.\n"         \
+    "Ctrl-C, SIGTERM, SIGHUP or SIGQUIT (an abort), or a failure: lock, whatever --then says\n"  \
+    "(exit 130, 143, 129, 131).\n"                                                                \
     "Exit status: 0 done; 1 no reply, servo stopped answering, joint angle unknown or lost,\n"     \
     "or device error; 2 bad arguments or a target outside the limits.\n"                         \
     "\n" CLI_BUS_RT_HELP
@@ -1228,10 +1228,8 @@ static const char move_help[] =
     "                   has settled there: within TOL rad, slower than TOL rad/s (on the\n"
     "                   move's side; 0 < TOL <= 1); --duration then bounds the wait: not\n"
     "                   there by then, the move is cut short (exit 1)\n"
-    "  --then hold|lock how the move ends (at --pos, or cut short by --duration): hold\n"
-    "                   (default) holds at the target it got to with the servo's watchdog\n"
-    "                   off, which the servo keeps after j288 exits (under a load too)\n"
-    "                   until `j288 stop` releases it; lock: no torque (a load falls)\n"
+    "  --then hold|lock the end: hold (default) holds the target reached with the watchdog\n"
+    "                   off, after exit too, until `j288 stop`; lock: no torque (loads fall)\n"
     DRIVE_COMMON_HELP "\n" CLI_BUS_COMMON_HELP;
 
 int cli_cmd_move(int argc, char **argv, const cli_global_t *g)
