@@ -349,6 +349,19 @@ static void test_nothing_asked_nothing_done(void)
     TEST_ASSERT_EQUAL_INT(-1, g_st.cpu);
 }
 
+/* ASan intercepts mlockall() and returns 0 without locking anything (its shadow memory could
+ * not be locked), so under it the memory check below cannot fail: it is skipped there. */
+#if defined(__SANITIZE_ADDRESS__)
+#define MLOCK_IS_REAL 0
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define MLOCK_IS_REAL 0
+#endif
+#endif
+#ifndef MLOCK_IS_REAL
+#define MLOCK_IS_REAL 1
+#endif
+
 /* The real refusal: a child process without the rights (root drops to nobody, which ends
  * its capabilities; everyone lowers RLIMIT_RTPRIO and RLIMIT_MEMLOCK to 0) asks for priority
  * 80: the kernel says EPERM, set-up says how to allow it and returns J288_OK, and the child
@@ -369,6 +382,8 @@ static int refused_child(void)
     if (strstr(st.notice, "SCHED_FIFO priority 80 refused (Operation not permitted)") == NULL ||
         strstr(st.notice, "ulimit -r 80") == NULL || strstr(st.notice, "CAP_SYS_NICE") == NULL)
         return 14;
+    if (!MLOCK_IS_REAL)
+        return 0;
     if (st.memory_locked || strstr(st.notice, "memory not locked") == NULL)
         return 15;
     return 0;
