@@ -32,10 +32,6 @@ port/windows/j288_windows.h: port/desktop/j288_serial_os.h port/windows/j288_win
 '
 # Files allowed to read private fields for now, each "FILE: why". Keep it empty.
 ALLOW='
-# TEMPORARY (issue 28): the CLI joint commands keep j288_joint_t objects of their own
-# (cli_joint.c:229 and :249 read .cfg) until they drive joints through host/ (branch
-# movehold). Delete this comment and the line below when that lands.
-tools/j288/cli_joint.c: movehold
 '
 
 tmp=$(mktemp -d)
