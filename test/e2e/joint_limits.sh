@@ -61,6 +61,10 @@ t_torque_other_sides_refused() {
         expect_bad "torque_side_${side}_refused" 2 "^j288 torque: joint j: --side $side would bypass its limits \[-0.4, 0.4\]" \
             "$J288" torque --joint j --config "$CFG" --side "$side" --tau 0.5 --duration 1 "${M[@]}"
     done
+    # A torque kept in force after exit has no host to stop it at a limit (a5e8821 left it
+    # running: 0.38, 0.99, 1.82 rad 1, 2, 3 s after exit with the watchdog off).
+    expect_bad torque_keep_refused 2 "^j288 torque: joint j: --keep: a torque left in force after exit has nothing to stop it at the joint's limits \[-0.4, 0.4\]; nothing sent" \
+        "$J288" torque --joint j --config "$CFG" --tau 0.15 --duration 0.3 --keep --watchdog off "${M[@]}"
     [ "$(wc -l <"$SLOG")" = "$frames" ] || { echo "frames were sent"; return 1; }
     stop_sim
 }

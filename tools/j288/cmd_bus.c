@@ -584,6 +584,14 @@ static int plan_fields(const drive_args_t *d, drive_plan_t *p)
     p->base.id = (uint8_t)d->id;
     p->base.status = J288_MODE_FOC;
     p->base.watchdog = d->watchdog;
+    if (d->side == SIDE_JOINT && d->kind == DRIVE_TORQUE && d->keep && !d->sel.jc.continuous) {
+        /* The limit law runs in the host: a torque left in force after exit would carry the
+         * joint through its limits (for up to 1 s with the watchdog on, for good without). */
+        cli_error("%s: --keep: a torque left in force after exit has nothing to stop it at the "
+                  "joint's limits [%g, %g]; nothing sent",
+                  d->sel.name, (double)d->sel.jc.pos_min, (double)d->sel.jc.pos_max);
+        return -1;
+    }
     if (d->side == SIDE_JOINT) {
         return plan_joint(d, p);
     }
@@ -1258,7 +1266,8 @@ static const char torque_help[] =
     "\n"
     "Apply a constant feed-forward torque (FOC, kp = kd = 0) to servo N; on the joint side\n"
     "in the joint's direction, refused beyond its max_torque. It ends with lock (--then\n"
-    "lock only: a torque left running after exit has no limits to stop it).\n"
+    "lock only: a torque left running after exit has no limits to stop it; for the same\n"
+    "reason --keep is refused on the joint side but for a continuous joint).\n"
     DRIVE_COMMON_HELP
     "\n" CLI_BUS_COMMON_HELP;
 
