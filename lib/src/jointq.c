@@ -495,6 +495,8 @@ int j288_jointq_init(j288_jointq_t *j, const j288_jointq_config_t *cfg)
     if ((j == NULL) || (cfg == NULL)) {
         return J288_ERR_NULL;
     }
+    /* (padding bytes too: a joint's bytes depend on its configuration alone) */
+    (void)memset(&c, 0, sizeof c);
     err = j288_jointq_check_config(cfg, &c, &centre);
     if (err != J288_OK) {
         return err;
