@@ -23,8 +23,8 @@ def run(binary, args):
     return p.returncode, p.stdout, p.stderr
 
 
-# J288_E2E_VECTOR_STRIDE=N checks every N-th vector of each file only (make test-valgrind:
-# each run of the tool under memcheck costs a fraction of a second).
+# J288_E2E_VECTOR_STRIDE=N checks every N-th vector of each file only (make test-valgrind, 20,
+# and test-asan, 4: each run of the tool there costs a fraction of a second).
 STRIDE = max(1, int(os.environ.get("J288_E2E_VECTOR_STRIDE", "1")))
 
 
