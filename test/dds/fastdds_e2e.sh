@@ -52,7 +52,11 @@ t_no_multicast_profile() {
         start_bridge || { ip link set lo multicast on; return 1; }
     grep -q 'not multicast-capable' "$SIM_DIR/bridge.err" ||
         { echo "the bridge's Cyclone did not see lo without multicast"; ip link set lo multicast on; return 1; }
-    if DDS_DOMAIN=$DDS_DOMAIN "$FASTDDS" states --timeout 8 >/dev/null 2>&1; then
+    # (A peer that starts while the bridge's Cyclone still makes its start-up announcements
+    # can hear one (seen once in CI on an idle machine); the control is a peer started after
+    # them, so a second one is tried before the check is called void.)
+    if DDS_DOMAIN=$DDS_DOMAIN "$FASTDDS" states --timeout 8 >/dev/null 2>&1 &&
+        DDS_DOMAIN=$DDS_DOMAIN "$FASTDDS" states --timeout 8 >/dev/null 2>&1; then
         echo "a Fast DDS peer without the profile found the bridge: the check proves nothing"
         stop_bridge; ip link set lo multicast on; return 1
     fi
