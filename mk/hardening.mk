@@ -69,10 +69,10 @@ test-valgrind:
 	 $(MAKE) --no-print-directory $(HOST_TESTS) $(TEST_DEPS) && \
 	 VALGRIND="$(VALGRIND)" $(TEST_ENV) bash scripts/test-valgrind.sh "$(HOST_TESTS)" "$(VALGRIND_SCRIPTS)"
 
-# The scripts run with j288 and j288-sim under memcheck: all but the DDS bridge's, whose
-# program under test (j288-dds) is not wrapped (its memory is checked by test-asan) and whose
-# simulators run the same code as every other script's.
-VALGRIND_SCRIPTS = $(filter-out $(DDS_TESTS),$(TEST_SCRIPTS))
+# The scripts run with j288 and j288-sim under memcheck: all but the DDS bridge's and
+# Python's, whose programs under test (j288-dds; libj288.so inside python3) are not wrapped
+# (test-asan checks the bridge) and whose simulators run the same code as every other script's.
+VALGRIND_SCRIPTS = $(filter-out $(DDS_TESTS) scripts/python-test.sh,$(TEST_SCRIPTS))
 
 # ---- static analysis and the symbol check ----------------------------------------------------
 .PHONY: lint check-symbols
