@@ -47,7 +47,8 @@ static int32_t round_twice(j288_real_t v2, j288_real_t a2)
 }
 
 
-/* x beyond 16384 saturated at int32's ends (beyond every range); NaN: 0 and *ok false. */
+/* x from 16384 - 2^-16 on saturated at int32's ends (beyond every range); NaN: 0 and *ok
+ * false. */
 static j288_q16_t q16_slow(j288_real_t x, bool *ok)
 {
     if (x != x) {
