@@ -66,7 +66,7 @@ TEST_SCRIPTS :=
 TEST_DEPS :=
 ALL_TARGETS := $(LIB_A)
 
-.PHONY: all lib test unit-tests unity clean help install uninstall
+.PHONY: all lib test test-host unit-tests unity clean help install uninstall
 .DEFAULT_GOAL := all
 .SECONDARY:
 
@@ -130,6 +130,11 @@ unit-tests: $(UNIT_TESTS)
 
 test: $(HOST_TESTS) $(TEST_DEPS)
 	$(call RUN_TESTS,$(HOST_TESTS) $(TEST_SCRIPTS))
+
+# Every program and test built, the compiled tests run (not the scripts, which drive the
+# same programs end to end): CI's second compiler (test-clang).
+test-host: $(HOST_TESTS) $(TEST_DEPS) $(ALL_TARGETS)
+	$(call RUN_TESTS,$(HOST_TESTS))
 
 # make test N times in a row, with stress-ng --cpu LOAD beside it (scripts/test-loop.sh).
 N ?= 10
