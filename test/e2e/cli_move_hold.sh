@@ -40,8 +40,8 @@ falls_from() {
 t_move_holds() {
     local held
     start_sim mh --ids 1 --start-angle 1:0 "${LOAD[@]}" --quiet || return 1
-    # The command: ramp, hold, exit; then 2 s with no host.
-    e2e_run "$J288" --port "$DEV" move --id 1 --pos 0.5 --duration 3 "${M[@]}"
+    # The command (its 3 s scaled under memcheck): ramp, hold, exit; then 2 s with no host.
+    e2e_run "$J288" --port "$DEV" move --id 1 --pos 0.5 --duration "$(e2e_scaled 3)" "${M[@]}"
     [ "$E2E_RC" -eq 0 ] || { echo "move: exit $E2E_RC: $E2E_ERR"; return 1; }
     after_sim_seconds 2 || return 1
     near "$(truth_val 1 theta)" 0.5 0.05 || { echo "2 s after move exited"; return 1; }
