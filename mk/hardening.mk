@@ -2,7 +2,7 @@
 # 32-bit runs, coverage and the fault soak (docs/security.md).
 #   make fuzz            every libFuzzer target for FUZZ_SECONDS (default 30) with ASan+UBSan,
 #                        as many at once as make's -j allows
-#   make fuzz-ci         the same, 20 s each (what .ci/run calls; the corpora replay in make test)
+#   make fuzz-ci         the same, 10 s each (what .ci/run calls; the corpora replay in make test)
 #   make fuzz-corpus     regenerate the committed seed corpora from test/vectors
 #   make test-asan       the whole host test suite built with ASan+UBSan (no recovery)
 #   make test-valgrind   the host test binaries, and the scripts' j288 / j288-sim, under memcheck
@@ -46,7 +46,7 @@ $(FUZZ_NAMES:%=fuzz-run-%): fuzz-run-%: $(BUILD)/fuzz/fuzz_%
 	@bash scripts/fuzz.sh $* $(FUZZ_SECONDS) $(BUILD)/fuzz
 
 fuzz-ci:
-	@$(MAKE) --no-print-directory fuzz FUZZ_SECONDS=20
+	@$(MAKE) --no-print-directory fuzz FUZZ_SECONDS=10
 
 fuzz-corpus:
 	$(PYTHON) test/fuzz/make_corpus.py
